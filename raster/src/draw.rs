@@ -1,0 +1,376 @@
+//! Drawing an indexed triangle mesh: the pipeline from vertices to pixels.
+//!
+//! [`draw_indexed`] runs the vertex stage once per vertex into caller-provided scratch, then for
+//! each triangle: rejects it if all three vertices are outside one clipping plane, clips it if any
+//! vertex is outside the clipping volume, culls back faces, and fills it with a strict-less depth
+//! test. The wireframe overlay, when asked for, is drawn afterwards over the filled frame.
+
+use core::fmt;
+
+use glam::{Mat3, Mat4, Vec3};
+
+use crate::clip::{self, clip_triangle, ClipVertex};
+use crate::edge::{fill_triangle, signed_area2, Coverage, Facing, ScreenVertex};
+use crate::target::{Pixel, Target};
+use crate::vertex::{shade_vertex, Light, ShadedVertex, Viewport};
+use crate::wire::draw_line;
+
+/// Borrowed mesh data: per-vertex arrays of equal length and triangles indexing them.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Mesh<'a> {
+    /// Object-space positions.
+    pub positions: &'a [[f32; 3]],
+    /// Object-space vertex normals (needed by [`Shading::Gouraud`]).
+    pub normals: Option<&'a [[f32; 3]]>,
+    /// Per-vertex colours; [`DrawParams::base_color`] is used without them.
+    pub colors: Option<&'a [[u8; 3]]>,
+    /// Triangles, counter-clockwise when seen from the front.
+    pub triangles: &'a [[u32; 3]],
+    /// Per-triangle colours that replace the vertex or base colour (for example a false colour by
+    /// hierarchy depth); lighting still applies.
+    pub face_colors: Option<&'a [[u8; 3]]>,
+}
+
+/// How colour is spread over a triangle.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Shading {
+    /// One colour per triangle, lit by its face normal.
+    Flat,
+    /// Colours lit at the vertices by their normals and interpolated.
+    #[default]
+    Gouraud,
+    /// Vertex colours interpolated without lighting.
+    Unlit,
+}
+
+/// Everything about a draw call except the mesh and the target.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DrawParams {
+    /// Object space to clip space (depth range `0..=1`, e.g. glam's `perspective_rh * look_at_rh`).
+    pub mvp: Mat4,
+    /// Maps normals into the space of [`Light::direction`]; the inverse transpose of the model
+    /// matrix's upper 3x3 (identity when lighting in object space).
+    pub normal_matrix: Mat3,
+    /// The light.
+    pub light: Light,
+    /// Shading mode.
+    pub shading: Shading,
+    /// Colour of vertices when the mesh has none.
+    pub base_color: [u8; 3],
+    /// Skip triangles facing away from the camera.
+    pub cull_back_faces: bool,
+    /// Draw triangle edges in this colour over the filled frame.
+    pub wireframe: Option<[u8; 3]>,
+}
+
+impl Default for DrawParams {
+    fn default() -> Self {
+        DrawParams {
+            mvp: Mat4::IDENTITY,
+            normal_matrix: Mat3::IDENTITY,
+            light: Light::default(),
+            shading: Shading::default(),
+            base_color: [200, 200, 200],
+            cull_back_faces: true,
+            wireframe: None,
+        }
+    }
+}
+
+/// What became of the triangles of one draw call.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct DrawStats {
+    /// Triangles submitted.
+    pub submitted: u32,
+    /// Triangles (or clipped pieces) scanned by the edge stage.
+    pub rasterized: u32,
+    /// Back-facing or zero-area triangles (or clipped pieces).
+    pub culled: u32,
+    /// Triangles entirely outside one clipping plane.
+    pub outside: u32,
+    /// Triangles that needed clipping.
+    pub clipped: u32,
+    /// Triangles dropped for a NaN or infinite vertex.
+    pub invalid: u32,
+}
+
+/// Why a draw call drew nothing.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DrawError {
+    /// The scratch slice is shorter than the vertex count.
+    ScratchTooSmall {
+        /// Vertices in the mesh.
+        needed: usize,
+        /// Length of the scratch slice.
+        available: usize,
+    },
+    /// A triangle refers to a vertex that does not exist.
+    IndexOutOfRange {
+        /// Position of the triangle in the mesh.
+        triangle: usize,
+        /// The offending index.
+        index: u32,
+        /// Vertices in the mesh.
+        vertices: usize,
+    },
+    /// A per-vertex or per-triangle array has the wrong length.
+    AttributeLength {
+        /// Which array.
+        attribute: &'static str,
+        /// The length it must have.
+        expected: usize,
+        /// The length it has.
+        actual: usize,
+    },
+    /// Gouraud shading needs vertex normals.
+    MissingNormals,
+}
+
+impl fmt::Display for DrawError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            DrawError::ScratchTooSmall { needed, available } => write!(
+                f,
+                "scratch holds {available} vertices, the mesh has {needed}"
+            ),
+            DrawError::IndexOutOfRange {
+                triangle,
+                index,
+                vertices,
+            } => write!(
+                f,
+                "triangle {triangle} uses vertex {index}, but the mesh has {vertices} vertices"
+            ),
+            DrawError::AttributeLength {
+                attribute,
+                expected,
+                actual,
+            } => write!(f, "{attribute} has {actual} entries, expected {expected}"),
+            DrawError::MissingNormals => write!(f, "Gouraud shading needs vertex normals"),
+        }
+    }
+}
+
+impl core::error::Error for DrawError {}
+
+fn check_len(attribute: &'static str, expected: usize, actual: usize) -> Result<(), DrawError> {
+    if expected == actual {
+        Ok(())
+    } else {
+        Err(DrawError::AttributeLength {
+            attribute,
+            expected,
+            actual,
+        })
+    }
+}
+
+fn validate(mesh: &Mesh<'_>, params: &DrawParams, scratch: usize) -> Result<(), DrawError> {
+    let n = mesh.positions.len();
+    if scratch < n {
+        return Err(DrawError::ScratchTooSmall {
+            needed: n,
+            available: scratch,
+        });
+    }
+    if let Some(normals) = mesh.normals {
+        check_len("normals", n, normals.len())?;
+    } else if params.shading == Shading::Gouraud {
+        return Err(DrawError::MissingNormals);
+    }
+    if let Some(colors) = mesh.colors {
+        check_len("colors", n, colors.len())?;
+    }
+    if let Some(faces) = mesh.face_colors {
+        check_len("face_colors", mesh.triangles.len(), faces.len())?;
+    }
+    for (triangle, tri) in mesh.triangles.iter().enumerate() {
+        if let Some(&index) = tri.iter().find(|&&i| i as usize >= n) {
+            return Err(DrawError::IndexOutOfRange {
+                triangle,
+                index,
+                vertices: n,
+            });
+        }
+    }
+    Ok(())
+}
+
+fn rgb_f32(c: [u8; 3]) -> [f32; 3] {
+    c.map(|v| v as f32)
+}
+
+/// Draws an indexed mesh.
+///
+/// `scratch` must hold at least one [`ShadedVertex`] per mesh vertex; it is overwritten. Nothing
+/// is drawn when an error is returned.
+///
+/// ```
+/// use glam::{Mat4, Vec3};
+/// use vdlod_raster::{draw_indexed, DrawParams, Mesh, Rgba8, ShadedVertex, Shading, Target};
+/// let positions = [[-1.0, -1.0, 0.0], [1.0, -1.0, 0.0], [0.0, 1.0, 0.0]];
+/// let mesh = Mesh { positions: &positions, triangles: &[[0, 1, 2]], ..Mesh::default() };
+/// let proj = Mat4::perspective_rh(1.0, 1.0, 0.1, 10.0);
+/// let view = Mat4::look_at_rh(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, Vec3::Y);
+/// let params = DrawParams { mvp: proj * view, shading: Shading::Flat, ..DrawParams::default() };
+/// let mut color = [Rgba8::default(); 32 * 32];
+/// let mut depth = [0u32; 32 * 32];
+/// let mut target = Target::new(&mut color, &mut depth, 32, 32).unwrap();
+/// target.clear(Rgba8([0, 0, 0, 255]));
+/// let mut scratch = [ShadedVertex::default(); 3];
+/// let stats = draw_indexed(&mut target, &mesh, &params, &mut scratch).unwrap();
+/// assert_eq!(stats.rasterized, 1);
+/// assert!(target.color().iter().any(|p| p.0[0] > 0));
+/// ```
+pub fn draw_indexed<P: Pixel>(
+    target: &mut Target<'_, P>,
+    mesh: &Mesh<'_>,
+    params: &DrawParams,
+    scratch: &mut [ShadedVertex],
+) -> Result<DrawStats, DrawError> {
+    validate(mesh, params, scratch.len())?;
+    let viewport = Viewport::new(target.width, target.height);
+    let scratch = &mut scratch[..mesh.positions.len()];
+    let base = rgb_f32(params.base_color);
+
+    // Vertex stage.
+    for (i, out) in scratch.iter_mut().enumerate() {
+        let rgb = mesh.colors.map_or(base, |c| rgb_f32(c[i]));
+        let lighting = match (params.shading, mesh.normals) {
+            (Shading::Gouraud, Some(n)) => Some((&params.normal_matrix, &params.light, Vec3::from(n[i]))),
+            _ => None,
+        };
+        *out = shade_vertex(&params.mvp, &viewport, Vec3::from(mesh.positions[i]), lighting, rgb);
+    }
+
+    let facing = if params.cull_back_faces {
+        Facing::Front
+    } else {
+        Facing::Both
+    };
+    let mut stats = DrawStats {
+        submitted: mesh.triangles.len() as u32,
+        ..DrawStats::default()
+    };
+    for (t, tri) in mesh.triangles.iter().enumerate() {
+        let v = tri.map(|i| scratch[i as usize]);
+        let union = v[0].outcode | v[1].outcode | v[2].outcode;
+        if union & clip::INVALID != 0 {
+            stats.invalid += 1;
+            continue;
+        }
+        if v[0].outcode & v[1].outcode & v[2].outcode != 0 {
+            stats.outside += 1;
+            continue;
+        }
+        let colors = triangle_colors(mesh, params, t, tri, &v);
+        let mut plot = |tri: &[ScreenVertex; 3]| {
+            let coverage = fill_triangle(target, tri, facing, |c, d, f| {
+                if f.z < *d {
+                    *d = f.z;
+                    *c = P::from_rgb(f.rgb[0], f.rgb[1], f.rgb[2]);
+                }
+            });
+            match coverage {
+                Coverage::Scanned => stats.rasterized += 1,
+                Coverage::Culled => stats.culled += 1,
+            }
+        };
+        if union == 0 {
+            let mut s = v.map(|v| v.screen);
+            for (s, c) in s.iter_mut().zip(colors) {
+                s.rgb = c;
+            }
+            plot(&s);
+        } else {
+            stats.clipped += 1;
+            for_each_clipped(&viewport, &v, colors, union, |s| plot(s));
+        }
+    }
+
+    if let Some(wire) = params.wireframe {
+        let color = P::from_rgb(wire[0], wire[1], wire[2]);
+        for tri in mesh.triangles {
+            let v = tri.map(|i| scratch[i as usize]);
+            let union = v[0].outcode | v[1].outcode | v[2].outcode;
+            if union & clip::INVALID != 0 || v[0].outcode & v[1].outcode & v[2].outcode != 0 {
+                continue;
+            }
+            let mut edges = |s: &[ScreenVertex; 3]| {
+                if params.cull_back_faces && signed_area2(s) >= 0 {
+                    return;
+                }
+                for k in 0..3 {
+                    draw_line(target, &s[k], &s[(k + 1) % 3], color);
+                }
+            };
+            if union == 0 {
+                edges(&v.map(|v| v.screen));
+            } else {
+                for_each_clipped(&viewport, &v, [[0.0; 3]; 3], union, |s| edges(s));
+            }
+        }
+    }
+    Ok(stats)
+}
+
+/// The colours the three corners of triangle `t` are drawn with.
+#[inline]
+fn triangle_colors(
+    mesh: &Mesh<'_>,
+    params: &DrawParams,
+    t: usize,
+    tri: &[u32; 3],
+    v: &[ShadedVertex; 3],
+) -> [[f32; 3]; 3] {
+    let face = mesh.face_colors.map(|f| rgb_f32(f[t]));
+    match params.shading {
+        Shading::Gouraud | Shading::Unlit => match face {
+            Some(c) => v.map(|v| c.map(|c| c * v.light)),
+            None => v.map(|v| v.screen.rgb),
+        },
+        Shading::Flat => {
+            let p = tri.map(|i| Vec3::from(mesh.positions[i as usize]));
+            let normal = params.normal_matrix * (p[1] - p[0]).cross(p[2] - p[0]);
+            let light = params.light.intensity(normal);
+            let c = face.unwrap_or_else(|| {
+                // Unlit vertex colours: their mean.
+                let mut sum = [0.0f32; 3];
+                for v in v {
+                    for (s, c) in sum.iter_mut().zip(v.screen.rgb) {
+                        *s += c;
+                    }
+                }
+                sum.map(|s| s / 3.0)
+            });
+            let lit = c.map(|c| c * light);
+            [lit; 3]
+        }
+    }
+}
+
+/// Clips a triangle with its corner colours and calls `f` with each projected piece.
+fn for_each_clipped(
+    viewport: &Viewport,
+    v: &[ShadedVertex; 3],
+    colors: [[f32; 3]; 3],
+    planes: u8,
+    mut f: impl FnMut(&[ScreenVertex; 3]),
+) {
+    let tri: [ClipVertex; 3] = core::array::from_fn(|k| ClipVertex {
+        pos: v[k].clip,
+        rgb: colors[k],
+    });
+    let poly = clip_triangle(&tri, planes);
+    let verts = poly.vertices();
+    if verts.len() < 3 {
+        return;
+    }
+    let first = viewport.project(verts[0].pos, verts[0].rgb);
+    let mut prev = viewport.project(verts[1].pos, verts[1].rgb);
+    for cv in &verts[2..] {
+        let cur = viewport.project(cv.pos, cv.rgb);
+        f(&[first, prev, cur]);
+        prev = cur;
+    }
+}
