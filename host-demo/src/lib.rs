@@ -1,1 +1,9 @@
+//! Host side of vdlod: mesh loading, camera paths, frames and PNG output.
+//!
+//! The `vdlod-demo` binary is a thin command line over this library; the workspace's tests and
+//! benchmarks use it too, so what they render is exactly what the demo renders.
 
+pub mod camera;
+pub mod frame;
+pub mod mesh;
+pub mod render;

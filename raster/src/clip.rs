@@ -186,10 +186,7 @@ mod tests {
         assert_eq!(outcode(Vec4::new(-5.0, 0.0, 0.5, 1.0)), LEFT);
         assert_eq!(outcode(Vec4::new(0.0, 5.0, 0.5, 1.0)), TOP);
         assert_eq!(outcode(Vec4::new(0.0, 0.0, 2.0, 1.0)), FAR);
-        assert_eq!(
-            outcode(Vec4::new(0.0, 0.0, -0.1, 0.0)),
-            NEAR | W_POSITIVE
-        );
+        assert_eq!(outcode(Vec4::new(0.0, 0.0, -0.1, 0.0)), NEAR | W_POSITIVE);
         assert_eq!(outcode(Vec4::new(f32::INFINITY, 0.0, 0.5, 1.0)), INVALID);
         assert_eq!(outcode(Vec4::new(0.0, f32::NAN, 0.5, 1.0)), INVALID);
     }

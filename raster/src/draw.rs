@@ -10,9 +10,9 @@ use core::fmt;
 use glam::{Mat3, Mat4, Vec3};
 
 use crate::clip::{self, clip_triangle, ClipVertex};
-use crate::edge::{fill_triangle, signed_area2, Coverage, Facing, ScreenVertex};
+use crate::edge::{fill_triangle, signed_area2, signed_area2_xy, Coverage, Facing, ScreenVertex};
 use crate::target::{Pixel, Target};
-use crate::vertex::{shade_vertex, Light, ShadedVertex, Viewport};
+use crate::vertex::{light_normal, shade_vertex, to_clip, Light, ShadedVertex, Viewport};
 use crate::wire::draw_line;
 
 /// Borrowed mesh data: per-vertex arrays of equal length and triangles indexing them.
@@ -196,6 +196,7 @@ fn validate(mesh: &Mesh<'_>, params: &DrawParams, scratch: usize) -> Result<(), 
     Ok(())
 }
 
+#[inline(always)]
 fn rgb_f32(c: [u8; 3]) -> [f32; 3] {
     c.map(|v| v as f32)
 }
@@ -236,11 +237,14 @@ pub fn draw_indexed<P: Pixel>(
     // Vertex stage.
     for (i, out) in scratch.iter_mut().enumerate() {
         let rgb = mesh.colors.map_or(base, |c| rgb_f32(c[i]));
-        let lighting = match (params.shading, mesh.normals) {
-            (Shading::Gouraud, Some(n)) => Some((&params.normal_matrix, &params.light, Vec3::from(n[i]))),
-            _ => None,
-        };
-        *out = shade_vertex(&params.mvp, &viewport, Vec3::from(mesh.positions[i]), lighting, rgb);
+        let light = vertex_light(mesh, params, i);
+        *out = shade_vertex(
+            &params.mvp,
+            &viewport,
+            Vec3::from(mesh.positions[i]),
+            light,
+            rgb,
+        );
     }
 
     let facing = if params.cull_back_faces {
@@ -263,6 +267,14 @@ pub fn draw_indexed<P: Pixel>(
             stats.outside += 1;
             continue;
         }
+        if union == 0 {
+            // Cull before any colour work: half the triangles of a closed mesh face away.
+            let area = signed_area2_xy(v.map(|v| [v.x, v.y]));
+            if area == 0 || (area > 0 && params.cull_back_faces) {
+                stats.culled += 1;
+                continue;
+            }
+        }
         let colors = triangle_colors(mesh, params, t, tri, &v);
         let mut plot = |tri: &[ScreenVertex; 3]| {
             let coverage = fill_triangle(target, tri, facing, |c, d, f| {
@@ -277,14 +289,14 @@ pub fn draw_indexed<P: Pixel>(
             }
         };
         if union == 0 {
-            let mut s = v.map(|v| v.screen);
+            let mut s = v.map(|v| v.screen());
             for (s, c) in s.iter_mut().zip(colors) {
                 s.rgb = c;
             }
             plot(&s);
         } else {
             stats.clipped += 1;
-            for_each_clipped(&viewport, &v, colors, union, |s| plot(s));
+            for_each_clipped(&viewport, params, mesh, tri, colors, union, |s| plot(s));
         }
     }
 
@@ -305,17 +317,30 @@ pub fn draw_indexed<P: Pixel>(
                 }
             };
             if union == 0 {
-                edges(&v.map(|v| v.screen));
+                edges(&v.map(|v| v.screen()));
             } else {
-                for_each_clipped(&viewport, &v, [[0.0; 3]; 3], union, |s| edges(s));
+                for_each_clipped(&viewport, params, mesh, tri, [[0.0; 3]; 3], union, |s| {
+                    edges(s)
+                });
             }
         }
     }
     Ok(stats)
 }
 
+/// Light intensity at vertex `i` for per-vertex shading (1 when unlit).
+#[inline(always)]
+fn vertex_light(mesh: &Mesh<'_>, params: &DrawParams, i: usize) -> f32 {
+    match (params.shading, mesh.normals) {
+        (Shading::Gouraud, Some(n)) => {
+            light_normal(&params.normal_matrix, &params.light, Vec3::from(n[i]))
+        }
+        _ => 1.0,
+    }
+}
+
 /// The colours the three corners of triangle `t` are drawn with.
-#[inline]
+#[inline(always)]
 fn triangle_colors(
     mesh: &Mesh<'_>,
     params: &DrawParams,
@@ -326,8 +351,11 @@ fn triangle_colors(
     let face = mesh.face_colors.map(|f| rgb_f32(f[t]));
     match params.shading {
         Shading::Gouraud | Shading::Unlit => match face {
-            Some(c) => v.map(|v| c.map(|c| c * v.light)),
-            None => v.map(|v| v.screen.rgb),
+            Some(c) => tri.map(|i| {
+                let light = vertex_light(mesh, params, i as usize);
+                c.map(|c| c * light)
+            }),
+            None => v.map(|v| rgb_f32(v.rgb)),
         },
         Shading::Flat => {
             let p = tri.map(|i| Vec3::from(mesh.positions[i as usize]));
@@ -337,14 +365,13 @@ fn triangle_colors(
                 // Unlit vertex colours: their mean.
                 let mut sum = [0.0f32; 3];
                 for v in v {
-                    for (s, c) in sum.iter_mut().zip(v.screen.rgb) {
-                        *s += c;
+                    for (s, c) in sum.iter_mut().zip(v.rgb) {
+                        *s += c as f32;
                     }
                 }
                 sum.map(|s| s / 3.0)
             });
-            let lit = c.map(|c| c * light);
-            [lit; 3]
+            [c.map(|c| c * light); 3]
         }
     }
 }
@@ -352,13 +379,15 @@ fn triangle_colors(
 /// Clips a triangle with its corner colours and calls `f` with each projected piece.
 fn for_each_clipped(
     viewport: &Viewport,
-    v: &[ShadedVertex; 3],
+    params: &DrawParams,
+    mesh: &Mesh<'_>,
+    tri: &[u32; 3],
     colors: [[f32; 3]; 3],
     planes: u8,
     mut f: impl FnMut(&[ScreenVertex; 3]),
 ) {
     let tri: [ClipVertex; 3] = core::array::from_fn(|k| ClipVertex {
-        pos: v[k].clip,
+        pos: to_clip(&params.mvp, Vec3::from(mesh.positions[tri[k] as usize])),
         rgb: colors[k],
     });
     let poly = clip_triangle(&tri, planes);

@@ -78,8 +78,14 @@ pub enum Coverage {
 /// device coordinates (front-facing), because screen y grows downwards.
 #[inline(always)]
 pub fn signed_area2(v: &[ScreenVertex; 3]) -> i64 {
-    let (x0, y0) = (v[0].x as i64, v[0].y as i64);
-    (v[1].x as i64 - x0) * (v[2].y as i64 - y0) - (v[1].y as i64 - y0) * (v[2].x as i64 - x0)
+    signed_area2_xy(v.map(|v| [v.x, v.y]))
+}
+
+/// [`signed_area2`] of three snapped points.
+#[inline(always)]
+pub fn signed_area2_xy(p: [[i32; 2]; 3]) -> i64 {
+    let [[x0, y0], [x1, y1], [x2, y2]] = p.map(|p| p.map(|c| c as i64));
+    (x1 - x0) * (y2 - y0) - (y1 - y0) * (x2 - x0)
 }
 
 /// One edge function `E(p) = dx * (p.y - a.y) - dy * (p.x - a.x)` for the edge `a -> b`.
@@ -109,47 +115,45 @@ impl Edge {
     }
 }
 
-/// An affine attribute stepped in fixed point.
+/// Depth and the three colour channels, stepped together in 48.16 fixed point.
 #[derive(Clone, Copy)]
-struct Attr {
-    start: i64,
-    step_x: i64,
-    step_y: i64,
+struct Attrs {
+    start: [i64; 4],
+    step_x: [i64; 4],
+    step_y: [i64; 4],
 }
 
-impl Attr {
-    /// Plane through the three vertex values `a`, evaluated at the pixel centre `(px, py)`.
+impl Attrs {
+    /// Planes through the vertices' depth and colour, evaluated at the pixel centre `(px, py)`
+    /// (in snapped units). `bary[i]` holds the change of vertex `i`'s barycentric weight per
+    /// pixel to the right and per pixel down.
     #[inline(always)]
-    fn new(v: &[ScreenVertex; 3], a: [f32; 3], e: &[[f32; 2]; 3], px: i64, py: i64) -> Attr {
-        // e[i] = (dE_i/dx, dE_i/dy) / area for the edge opposite vertex i, per snapped unit.
-        let gx = e[0][0] * a[0] + e[1][0] * a[1] + e[2][0] * a[2];
-        let gy = e[0][1] * a[0] + e[1][1] * a[1] + e[2][1] * a[2];
-        let ox = (px - v[0].x as i64) as f32;
-        let oy = (py - v[0].y as i64) as f32;
-        let start = a[0] + gx * ox + gy * oy;
-        let one = SUBPIXEL_ONE as f32 * ATTR_ONE;
-        Attr {
-            start: clamp(start * ATTR_ONE, ATTR_START_MAX) as i64,
-            step_x: clamp(gx * one, ATTR_STEP_MAX) as i64,
-            step_y: clamp(gy * one, ATTR_STEP_MAX) as i64,
+    fn new(v: &[ScreenVertex; 3], bary: &[[f32; 2]; 3], px: i64, py: i64) -> Attrs {
+        let a = v.map(|v| [v.z, v.rgb[0], v.rgb[1], v.rgb[2]]);
+        let ox = (px - v[0].x as i64) as f32 * (1.0 / SUBPIXEL_ONE as f32);
+        let oy = (py - v[0].y as i64) as f32 * (1.0 / SUBPIXEL_ONE as f32);
+        let mut out = Attrs {
+            start: [0; 4],
+            step_x: [0; 4],
+            step_y: [0; 4],
+        };
+        #[allow(clippy::needless_range_loop)] // k walks four parallel arrays
+        for k in 0..4 {
+            let gx = bary[0][0] * a[0][k] + bary[1][0] * a[1][k] + bary[2][0] * a[2][k];
+            let gy = bary[0][1] * a[0][k] + bary[1][1] * a[1][k] + bary[2][1] * a[2][k];
+            let start = a[0][k] + gx * ox + gy * oy;
+            out.start[k] = fixed(start, ATTR_START_MAX);
+            out.step_x[k] = fixed(gx, ATTR_STEP_MAX);
+            out.step_y[k] = fixed(gy, ATTR_STEP_MAX);
         }
+        out
     }
 }
 
-/// Clamps to `[-max, max]`; NaN becomes 0.
+/// `v` in 48.16 fixed point, clamped to `[-max, max]`; NaN becomes `-max`.
 #[inline(always)]
-fn clamp(v: f32, max: f32) -> f32 {
-    if v >= -max {
-        if v <= max {
-            v
-        } else {
-            max
-        }
-    } else if v < -max {
-        -max
-    } else {
-        0.0
-    }
+fn fixed(v: f32, max: f32) -> i64 {
+    (v * ATTR_ONE).max(-max).min(max) as i64
 }
 
 #[inline(always)]
@@ -209,40 +213,59 @@ where
         return Coverage::Scanned;
     }
     let px = (x0 << SUBPIXEL_BITS) + HALF;
-    let py = (y0 << SUBPIXEL_BITS) + HALF;
-
+    let mut py = (y0 << SUBPIXEL_BITS) + HALF;
     let e = [
         Edge::new(&v[1], &v[2], px, py),
         Edge::new(&v[2], &v[0], px, py),
         Edge::new(&v[0], &v[1], px, py),
     ];
-    // Barycentric gradients per snapped unit.
-    let inv = 1.0 / area as f32;
-    let bary = e.map(|e| {
-        [
-            e.step_x as f32 * inv / SUBPIXEL_ONE as f32,
-            e.step_y as f32 * inv / SUBPIXEL_ONE as f32,
-        ]
-    });
-    let z = Attr::new(&v, [v[0].z, v[1].z, v[2].z], &bary, px, py);
-    let ch = |c: usize| Attr::new(&v, [v[0].rgb[c], v[1].rgb[c], v[2].rgb[c]], &bary, px, py);
-    let (r, g, b) = (ch(0), ch(1), ch(2));
-
-    let width = target.width;
     let (x0, x1) = (x0 as usize, x1 as usize);
-    let mut row = [e[0].start, e[1].start, e[2].start, z.start, r.start, g.start, b.start];
-    for y in y0 as usize..=y1 as usize {
+    let span = x1 - x0 + 1;
+
+    // Most triangles of a detailed mesh cover no pixel centre or only a few: find the first covered
+    // row with the integer edge functions alone before paying for the attribute set-up.
+    let mut row_e = [e[0].start, e[1].start, e[2].start];
+    let mut y = y0 as usize;
+    loop {
+        let [mut e0, mut e1, mut e2] = row_e;
+        let mut covered = false;
+        for _ in 0..span {
+            covered |= (e0 | e1 | e2) >= 0;
+            e0 += e[0].step_x;
+            e1 += e[1].step_x;
+            e2 += e[2].step_x;
+        }
+        if covered {
+            break;
+        }
+        if y as i64 >= y1 {
+            return Coverage::Scanned;
+        }
+        y += 1;
+        py += SUBPIXEL_ONE as i64;
+        for (r, e) in row_e.iter_mut().zip(&e) {
+            *r += e.step_y;
+        }
+    }
+
+    let inv = 1.0 / area as f32;
+    let bary = e.map(|e| [e.step_x as f32 * inv, e.step_y as f32 * inv]);
+    let attrs = Attrs::new(&v, &bary, px, py);
+    let mut row_a = attrs.start;
+    let width = target.width;
+    for y in y..=y1 as usize {
         let base = y * width;
         let crow = &mut target.color[base + x0..=base + x1];
         let drow = &mut target.depth[base + x0..=base + x1];
-        let [mut e0, mut e1, mut e2, mut zz, mut rr, mut gg, mut bb] = row;
+        let [mut e0, mut e1, mut e2] = row_e;
+        let [mut z, mut r, mut g, mut b] = row_a;
         let mut entered = false;
         for (c, d) in crow.iter_mut().zip(drow.iter_mut()) {
             if (e0 | e1 | e2) >= 0 {
                 entered = true;
                 let frag = Fragment {
-                    z: (zz >> ATTR_BITS).clamp(0, DEPTH_MAX as i64) as u32,
-                    rgb: [channel(rr), channel(gg), channel(bb)],
+                    z: (z >> ATTR_BITS).clamp(0, DEPTH_MAX as i64) as u32,
+                    rgb: [channel(r), channel(g), channel(b)],
                 };
                 plot(c, d, frag);
             } else if entered {
@@ -251,18 +274,17 @@ where
             e0 += e[0].step_x;
             e1 += e[1].step_x;
             e2 += e[2].step_x;
-            zz += z.step_x;
-            rr += r.step_x;
-            gg += g.step_x;
-            bb += b.step_x;
+            z += attrs.step_x[0];
+            r += attrs.step_x[1];
+            g += attrs.step_x[2];
+            b += attrs.step_x[3];
         }
-        row[0] += e[0].step_y;
-        row[1] += e[1].step_y;
-        row[2] += e[2].step_y;
-        row[3] += z.step_y;
-        row[4] += r.step_y;
-        row[5] += g.step_y;
-        row[6] += b.step_y;
+        for (r, e) in row_e.iter_mut().zip(&e) {
+            *r += e.step_y;
+        }
+        for (r, s) in row_a.iter_mut().zip(&attrs.step_y) {
+            *r += s;
+        }
     }
     Coverage::Scanned
 }
@@ -360,10 +382,11 @@ mod tests {
     }
 
     #[test]
-    fn clamp_maps_nan_to_zero() {
-        assert_eq!(clamp(f32::NAN, 4.0), 0.0);
-        assert_eq!(clamp(f32::INFINITY, 4.0), 4.0);
-        assert_eq!(clamp(-9.0, 4.0), -4.0);
-        assert_eq!(clamp(1.5, 4.0), 1.5);
+    fn fixed_point_conversion_saturates() {
+        let max = ATTR_STEP_MAX;
+        assert_eq!(fixed(f32::NAN, max), -(max as i64));
+        assert_eq!(fixed(f32::INFINITY, max), max as i64);
+        assert_eq!(fixed(-1e30, max), -(max as i64));
+        assert_eq!(fixed(1.5, max), 3 << (ATTR_BITS - 1));
     }
 }

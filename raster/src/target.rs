@@ -55,7 +55,11 @@ impl Pixel for Rgb565 {
         let r = ((self.0 >> 11) & 0x1F) as u8;
         let g = ((self.0 >> 5) & 0x3F) as u8;
         let b = (self.0 & 0x1F) as u8;
-        [(r << 3) | (r >> 2), (g << 2) | (g >> 4), (b << 3) | (b >> 2)]
+        [
+            (r << 3) | (r >> 2),
+            (g << 2) | (g >> 4),
+            (b << 3) | (b >> 2),
+        ]
     }
 }
 

@@ -11,7 +11,12 @@ use crate::target::{Pixel, Target};
 pub const WIRE_DEPTH_BIAS: u32 = DEPTH_MAX / 4096;
 
 /// Draws the segment `a -> b` in `color` over what the target holds.
-pub fn draw_line<P: Pixel>(target: &mut Target<'_, P>, a: &ScreenVertex, b: &ScreenVertex, color: P) {
+pub fn draw_line<P: Pixel>(
+    target: &mut Target<'_, P>,
+    a: &ScreenVertex,
+    b: &ScreenVertex,
+    color: P,
+) {
     const FRAC: u32 = 16;
     let (ax, ay) = (a.x as i64, a.y as i64);
     let (dx, dy) = (b.x as i64 - ax, b.y as i64 - ay);

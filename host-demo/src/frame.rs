@@ -1,0 +1,142 @@
+//! Frames: owned buffers for the rasterizer, and PNG in and out.
+//!
+//! The rasterizer borrows its buffers; on the host, a [`Frame`] owns them (colour, depth and the
+//! vertex scratch) and reuses them from frame to frame.
+
+use std::path::Path;
+
+use vdlod_raster::{draw_indexed, DrawParams, DrawStats, Mesh, Rgba8, ShadedVertex, Target};
+
+/// Background colour of demo frames.
+pub const BACKGROUND: Rgba8 = Rgba8([24, 26, 32, 255]);
+
+/// Why a frame could not be drawn or written.
+#[derive(Debug)]
+pub enum FrameError {
+    /// The viewport or the buffers are unusable.
+    Target(vdlod_raster::TargetError),
+    /// The mesh does not fit the draw call.
+    Draw(vdlod_raster::DrawError),
+    /// PNG encoding or decoding failed.
+    Png(String),
+    /// Writing or reading the file failed.
+    Io(std::io::Error),
+}
+
+impl std::fmt::Display for FrameError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            FrameError::Target(e) => e.fmt(f),
+            FrameError::Draw(e) => e.fmt(f),
+            FrameError::Png(e) => write!(f, "PNG: {e}"),
+            FrameError::Io(e) => e.fmt(f),
+        }
+    }
+}
+
+impl std::error::Error for FrameError {}
+
+/// An RGBA8 frame with its depth buffer and vertex scratch.
+pub struct Frame {
+    width: usize,
+    height: usize,
+    color: Vec<Rgba8>,
+    depth: Vec<u32>,
+    scratch: Vec<ShadedVertex>,
+}
+
+impl Frame {
+    /// A frame of `width` by `height` pixels (checked against the rasterizer's limits).
+    pub fn new(width: usize, height: usize) -> Result<Frame, FrameError> {
+        let n = width.saturating_mul(height);
+        if width > vdlod_raster::MAX_DIMENSION || height > vdlod_raster::MAX_DIMENSION {
+            return Err(FrameError::Target(vdlod_raster::TargetError::TooLarge {
+                width,
+                height,
+            }));
+        }
+        let mut frame = Frame {
+            width,
+            height,
+            color: vec![BACKGROUND; n],
+            depth: vec![0; n],
+            scratch: Vec::new(),
+        };
+        frame.target()?; // validates the size
+        Ok(frame)
+    }
+
+    fn target(&mut self) -> Result<Target<'_, Rgba8>, FrameError> {
+        Target::new(&mut self.color, &mut self.depth, self.width, self.height)
+            .map_err(FrameError::Target)
+    }
+
+    /// Width in pixels.
+    pub fn width(&self) -> usize {
+        self.width
+    }
+
+    /// Height in pixels.
+    pub fn height(&self) -> usize {
+        self.height
+    }
+
+    /// Width over height.
+    pub fn aspect(&self) -> f32 {
+        self.width as f32 / self.height as f32
+    }
+
+    /// The pixels, row-major.
+    pub fn pixels(&self) -> &[Rgba8] {
+        &self.color
+    }
+
+    /// Clears to [`BACKGROUND`] and draws `mesh`.
+    pub fn draw(&mut self, mesh: &Mesh<'_>, params: &DrawParams) -> Result<DrawStats, FrameError> {
+        if self.scratch.len() < mesh.positions.len() {
+            self.scratch
+                .resize(mesh.positions.len(), ShadedVertex::default());
+        }
+        let mut scratch = std::mem::take(&mut self.scratch);
+        let result = {
+            let mut target = self.target()?;
+            target.clear(BACKGROUND);
+            draw_indexed(&mut target, mesh, params, &mut scratch).map_err(FrameError::Draw)
+        };
+        self.scratch = scratch;
+        result
+    }
+
+    /// Encodes the frame as PNG.
+    pub fn to_png(&self) -> Result<Vec<u8>, FrameError> {
+        let size = tiny_skia::IntSize::from_wh(self.width as u32, self.height as u32)
+            .ok_or_else(|| FrameError::Png("empty frame".into()))?;
+        let bytes = self.color.iter().flat_map(|p| p.0).collect();
+        let pixmap = tiny_skia::Pixmap::from_vec(bytes, size)
+            .ok_or_else(|| FrameError::Png("buffer does not match the size".into()))?;
+        pixmap
+            .encode_png()
+            .map_err(|e| FrameError::Png(e.to_string()))
+    }
+
+    /// Writes the frame as a PNG file.
+    pub fn save_png(&self, path: &Path) -> Result<(), FrameError> {
+        std::fs::write(path, self.to_png()?).map_err(FrameError::Io)
+    }
+}
+
+/// Reads a PNG file as `(width, height, RGBA8 pixels)`.
+pub fn load_png(path: &Path) -> Result<(usize, usize, Vec<Rgba8>), FrameError> {
+    let bytes = std::fs::read(path).map_err(FrameError::Io)?;
+    let pixmap =
+        tiny_skia::Pixmap::decode_png(&bytes).map_err(|e| FrameError::Png(e.to_string()))?;
+    let pixels = pixmap
+        .pixels()
+        .iter()
+        .map(|p| {
+            let c = p.demultiply();
+            Rgba8([c.red(), c.green(), c.blue(), c.alpha()])
+        })
+        .collect();
+    Ok((pixmap.width() as usize, pixmap.height() as usize, pixels))
+}
