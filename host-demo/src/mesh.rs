@@ -212,8 +212,6 @@ pub fn load_obj_bytes(name: &str, bytes: &[u8]) -> Result<IndexedMesh, MeshError
         single_index: false,
         ignore_points: true,
         ignore_lines: true,
-        merge_identical_points: false,
-        reorder_data: false,
     };
     let mut reader: &mut dyn BufRead = &mut &bytes[..];
     let (models, _materials) = tobj::load_obj_buf(&mut reader, &options, |_| {
