@@ -245,7 +245,7 @@ mod tests {
     #[test]
     fn rgb565_round_trips_high_bits() {
         let p = Rgb565::from_rgb(0xFF, 0x80, 0x08);
-        assert_eq!(p.0, 0b11111_100000_00001);
+        assert_eq!(p.0, (0b11111 << 11) | (0b100000 << 5) | 0b00001);
         assert_eq!(p.to_rgb(), [0xFF, 0x82, 0x08]);
         assert_eq!(Rgb565::from_rgb(0, 0, 0).to_rgb(), [0, 0, 0]);
         assert_eq!(Rgb565::from_rgb(255, 255, 255).to_rgb(), [255, 255, 255]);
