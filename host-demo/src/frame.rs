@@ -107,22 +107,35 @@ impl Frame {
         result
     }
 
-    /// Encodes the frame as PNG.
-    pub fn to_png(&self) -> Result<Vec<u8>, FrameError> {
-        let size = tiny_skia::IntSize::from_wh(self.width as u32, self.height as u32)
-            .ok_or_else(|| FrameError::Png("empty frame".into()))?;
-        let bytes = self.color.iter().flat_map(|p| p.0).collect();
-        let pixmap = tiny_skia::Pixmap::from_vec(bytes, size)
-            .ok_or_else(|| FrameError::Png("buffer does not match the size".into()))?;
-        pixmap
-            .encode_png()
-            .map_err(|e| FrameError::Png(e.to_string()))
-    }
-
     /// Writes the frame as a PNG file.
     pub fn save_png(&self, path: &Path) -> Result<(), FrameError> {
-        std::fs::write(path, self.to_png()?).map_err(FrameError::Io)
+        save_png(path, self.width, self.height, &self.color)
     }
+}
+
+/// Encodes row-major RGBA8 pixels as PNG.
+pub fn encode_png(width: usize, height: usize, pixels: &[Rgba8]) -> Result<Vec<u8>, FrameError> {
+    let size = u32::try_from(width)
+        .ok()
+        .zip(u32::try_from(height).ok())
+        .and_then(|(w, h)| tiny_skia::IntSize::from_wh(w, h))
+        .ok_or_else(|| FrameError::Png(format!("cannot encode a {width}x{height} image")))?;
+    let bytes = pixels.iter().flat_map(|p| p.0).collect();
+    let pixmap = tiny_skia::Pixmap::from_vec(bytes, size)
+        .ok_or_else(|| FrameError::Png("pixel count does not match the size".into()))?;
+    pixmap
+        .encode_png()
+        .map_err(|e| FrameError::Png(e.to_string()))
+}
+
+/// Writes row-major RGBA8 pixels as a PNG file.
+pub fn save_png(
+    path: &Path,
+    width: usize,
+    height: usize,
+    pixels: &[Rgba8],
+) -> Result<(), FrameError> {
+    std::fs::write(path, encode_png(width, height, pixels)?).map_err(FrameError::Io)
 }
 
 /// Reads a PNG file as `(width, height, RGBA8 pixels)`.

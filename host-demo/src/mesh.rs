@@ -213,7 +213,8 @@ pub fn load_obj_bytes(name: &str, bytes: &[u8]) -> Result<IndexedMesh, MeshError
         ignore_points: true,
         ignore_lines: true,
     };
-    let mut reader: &mut dyn BufRead = &mut &bytes[..];
+    let text = without_polylines(bytes);
+    let mut reader: &mut dyn BufRead = &mut &text[..];
     let (models, _materials) = tobj::load_obj_buf(&mut reader, &options, |_| {
         Err(tobj::LoadError::OpenFileFailed)
     })
@@ -258,11 +259,16 @@ pub fn load_obj_bytes(name: &str, bytes: &[u8]) -> Result<IndexedMesh, MeshError
             mesh.triangles.push(tri);
         }
     }
-    if mesh.positions.is_empty() {
-        return Err(err(MeshProblem::NoVertices));
-    }
     if mesh.triangles.is_empty() {
-        return Err(err(MeshProblem::NoTriangles));
+        // tobj keeps only the vertices that faces use; look at the text to tell the two apart.
+        let declares_vertices = bytes
+            .split(|&b| b == b'\n')
+            .any(|line| line.trim_ascii_start().starts_with(b"v "));
+        return Err(err(if declares_vertices {
+            MeshProblem::NoTriangles
+        } else {
+            MeshProblem::NoVertices
+        }));
     }
     if u32::try_from(mesh.positions.len()).is_err() {
         return Err(err(MeshProblem::TooLarge));
@@ -272,6 +278,28 @@ pub fn load_obj_bytes(name: &str, bytes: &[u8]) -> Result<IndexedMesh, MeshError
     }
     mesh.normals = vertex_normals(&mesh.positions, &mesh.triangles);
     Ok(mesh)
+}
+
+/// Whether an OBJ line is a polyline (`l v1 v2 ...`).
+fn is_polyline(line: &[u8]) -> bool {
+    let line = line.trim_ascii_start();
+    line.first() == Some(&b'l') && line.get(1).is_none_or(|c| c.is_ascii_whitespace())
+}
+
+/// The text with polyline statements removed: tobj reads `l a b c` as a triangle, but a polyline
+/// has no surface.
+fn without_polylines(bytes: &[u8]) -> std::borrow::Cow<'_, [u8]> {
+    if !bytes.split(|&b| b == b'\n').any(is_polyline) {
+        return std::borrow::Cow::Borrowed(bytes);
+    }
+    let mut out = Vec::with_capacity(bytes.len());
+    for line in bytes.split(|&b| b == b'\n') {
+        if !is_polyline(line) {
+            out.extend_from_slice(line);
+        }
+        out.push(b'\n');
+    }
+    std::borrow::Cow::Owned(out)
 }
 
 /// Interleaves the low 10 bits of three coordinates.

@@ -119,6 +119,23 @@ impl Polygon {
     }
 }
 
+/// Puts a cut exactly on its plane. With huge coordinates (say 1e30 at one end of an edge and
+/// -1e30 at the other) the interpolated coordinate across the plane loses all precision to
+/// cancellation; the plane equation gives it back exactly.
+#[inline]
+fn snap_to_plane(plane: u8, p: &mut Vec4) {
+    let g = GUARD_BAND * p.w;
+    match plane {
+        LEFT => p.x = -g,
+        RIGHT => p.x = g,
+        BOTTOM => p.y = -g,
+        TOP => p.y = g,
+        NEAR => p.z = 0.0,
+        FAR => p.z = p.w,
+        _ => p.w = p.w.max(W_MIN),
+    }
+}
+
 /// Clips a triangle against the planes named in `planes` (the union of its vertices' outcodes).
 ///
 /// The result has fewer than three vertices when nothing is left. Triangles with an [`INVALID`]
@@ -154,11 +171,13 @@ pub fn clip_triangle(tri: &[ClipVertex; 3], planes: u8) -> Polygon {
             }
             if (dc >= 0.0) != (dn >= 0.0) {
                 // Always cut from the inside end, so both triangles of an edge agree.
-                next.push(if dc >= 0.0 {
+                let mut cut = if dc >= 0.0 {
                     ClipVertex::lerp(cur, nxt, dc / (dc - dn))
                 } else {
                     ClipVertex::lerp(nxt, cur, dn / (dn - dc))
-                });
+                };
+                snap_to_plane(plane, &mut cut.pos);
+                next.push(cut);
             }
         }
         poly = next;

@@ -126,7 +126,8 @@ struct Attrs {
 impl Attrs {
     /// Planes through the vertices' depth and colour, evaluated at the pixel centre `(px, py)`
     /// (in snapped units). `bary[i]` holds the change of vertex `i`'s barycentric weight per
-    /// pixel to the right and per pixel down.
+    /// pixel to the right and per pixel down. Values are biased by one half so that the pixel loop's
+    /// shift rounds to nearest.
     #[inline(always)]
     fn new(v: &[ScreenVertex; 3], bary: &[[f32; 2]; 3], px: i64, py: i64) -> Attrs {
         let a = v.map(|v| [v.z, v.rgb[0], v.rgb[1], v.rgb[2]]);
@@ -139,10 +140,14 @@ impl Attrs {
         };
         #[allow(clippy::needless_range_loop)] // k walks four parallel arrays
         for k in 0..4 {
-            let gx = bary[0][0] * a[0][k] + bary[1][0] * a[1][k] + bary[2][0] * a[2][k];
-            let gy = bary[0][1] * a[0][k] + bary[1][1] * a[1][k] + bary[2][1] * a[2][k];
+            // Relative to vertex 0 (its weight is 1 minus the others'), so that an attribute equal
+            // at all three vertices has gradients of exactly zero.
+            let (d1, d2) = (a[1][k] - a[0][k], a[2][k] - a[0][k]);
+            let gx = bary[1][0] * d1 + bary[2][0] * d2;
+            let gy = bary[1][1] * d1 + bary[2][1] * d2;
             let start = a[0][k] + gx * ox + gy * oy;
-            out.start[k] = fixed(start, ATTR_START_MAX);
+            // Half a unit added once here makes the per-pixel shift round to nearest.
+            out.start[k] = fixed(start + 0.5, ATTR_START_MAX);
             out.step_x[k] = fixed(gx, ATTR_STEP_MAX);
             out.step_y[k] = fixed(gy, ATTR_STEP_MAX);
         }

@@ -1,0 +1,141 @@
+//! Golden frames: the demo's renders compared bit for bit with PNGs under `fixtures/golden/`.
+//!
+//! After an intended change to what a frame looks like, regenerate them with
+//!
+//! ```text
+//! VDLOD_BLESS=1 cargo test --test golden
+//! ```
+//!
+//! and look at the new PNGs before committing them. A mismatch writes the frame actually rendered
+//! to `target/golden-actual/NAME.png` for comparison.
+
+use std::path::PathBuf;
+
+use vdlod_demo::frame::{load_png, save_png, Frame};
+use vdlod_demo::mesh::{load_obj_bytes, IndexedMesh, BUNNY_NAME, BUNNY_OBJ, COW_NAME, COW_OBJ};
+use vdlod_demo::render::{camera_params, render_orbit_frame, RenderOptions};
+use vdlod_raster::{
+    draw_indexed, Pixel, Rgb565, Rgba8, ShadedVertex, Shading, Target, DEPTH_CLEAR,
+};
+
+const W: usize = 320;
+const H: usize = 240;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn bunny() -> IndexedMesh {
+    let mut m = load_obj_bytes(BUNNY_NAME, BUNNY_OBJ).unwrap();
+    m.reorder_for_locality();
+    m
+}
+
+fn cow() -> IndexedMesh {
+    load_obj_bytes(COW_NAME, COW_OBJ).unwrap()
+}
+
+/// Compares `pixels` with `fixtures/golden/NAME.png`, or writes it when blessing.
+fn check(name: &str, pixels: &[Rgba8]) {
+    let path = root().join("fixtures/golden").join(format!("{name}.png"));
+    if std::env::var_os("VDLOD_BLESS").is_some() {
+        save_png(&path, W, H, pixels).unwrap();
+        return;
+    }
+    let (w, h, expected) = load_png(&path).unwrap_or_else(|e| {
+        panic!(
+            "{}: {e}; regenerate with VDLOD_BLESS=1 cargo test --test golden",
+            path.display()
+        )
+    });
+    assert_eq!((w, h), (W, H), "{name}: golden frame has another size");
+    let differing = expected.iter().zip(pixels).filter(|(a, b)| a != b).count();
+    if differing > 0 {
+        let dir = root().join("target/golden-actual");
+        std::fs::create_dir_all(&dir).unwrap();
+        save_png(&dir.join(format!("{name}.png")), W, H, pixels).unwrap();
+        panic!(
+            "{name}: {differing} of {} pixels differ from {} (actual frame in {})",
+            W * H,
+            path.display(),
+            dir.display()
+        );
+    }
+}
+
+fn orbit_frame(mesh: &IndexedMesh, index: u32, opts: &RenderOptions) -> Vec<Rgba8> {
+    let mut frame = Frame::new(W, H).unwrap();
+    render_orbit_frame(&mut frame, mesh, index, opts).unwrap();
+    frame.pixels().to_vec()
+}
+
+fn small(shading: Shading, wireframe: bool) -> RenderOptions {
+    RenderOptions {
+        width: W,
+        height: H,
+        frames: 36,
+        shading,
+        wireframe,
+    }
+}
+
+#[test]
+fn bunny_orbit_gouraud() {
+    let mesh = bunny();
+    for i in [0, 9, 22] {
+        check(
+            &format!("bunny_gouraud_{i:02}"),
+            &orbit_frame(&mesh, i, &small(Shading::Gouraud, false)),
+        );
+    }
+}
+
+#[test]
+fn cow_flat_with_wireframe() {
+    check(
+        "cow_flat_wire",
+        &orbit_frame(&cow(), 5, &small(Shading::Flat, true)),
+    );
+}
+
+/// Per-triangle colour override (what later shows hierarchy depth), into a 16-bit RGB565 target.
+#[test]
+fn cow_face_colors_rgb565() {
+    let mesh = cow();
+    let palette = [[230, 80, 60], [80, 170, 90], [70, 110, 220], [230, 200, 70]];
+    let face_colors: Vec<[u8; 3]> = (0..mesh.triangles.len())
+        .map(|t| palette[(t / 64) % palette.len()])
+        .collect();
+    let raster_mesh = vdlod_raster::Mesh {
+        face_colors: Some(&face_colors),
+        ..mesh.as_raster_mesh()
+    };
+    let orbit = vdlod_demo::camera::Orbit::merge_tree(&mesh.bounds(), 36);
+    let params = camera_params(
+        &orbit.camera(30),
+        W as f32 / H as f32,
+        Shading::Gouraud,
+        false,
+    );
+    let mut color = vec![Rgb565(0); W * H];
+    let mut depth = vec![DEPTH_CLEAR; W * H];
+    let mut target = Target::new(&mut color, &mut depth, W, H).unwrap();
+    target.clear(Rgb565::from_rgb(24, 26, 32));
+    let mut scratch = vec![ShadedVertex::default(); mesh.positions.len()];
+    draw_indexed(&mut target, &raster_mesh, &params, &mut scratch).unwrap();
+    let pixels: Vec<Rgba8> = color
+        .iter()
+        .map(|p| {
+            let [r, g, b] = p.to_rgb();
+            Rgba8([r, g, b, 255])
+        })
+        .collect();
+    check("cow_faces_rgb565", &pixels);
+}
+
+#[test]
+fn frames_are_identical_from_run_to_run() {
+    let mesh = cow();
+    let opts = small(Shading::Gouraud, true);
+    assert_eq!(orbit_frame(&mesh, 3, &opts), orbit_frame(&mesh, 3, &opts));
+}
