@@ -40,6 +40,8 @@ const PLANES: [u8; 7] = [NEAR, W_POSITIVE, FAR, LEFT, RIGHT, BOTTOM, TOP];
 /// At most one vertex per plane is added to a triangle.
 pub const MAX_POLYGON: usize = 3 + PLANES.len();
 
+/// Signed distance-like value of `p` to `plane`, negative outside; [`outcode`] computes the same
+/// expressions for all planes at once.
 #[inline(always)]
 fn distance(plane: u8, p: Vec4) -> f32 {
     let g = GUARD_BAND * p.w;
@@ -57,16 +59,21 @@ fn distance(plane: u8, p: Vec4) -> f32 {
 /// The planes `p` is outside of, or [`INVALID`].
 #[inline]
 pub fn outcode(p: Vec4) -> u8 {
-    if !(p.x.is_finite() && p.y.is_finite() && p.z.is_finite() && p.w.is_finite()) {
-        return INVALID;
+    // Branch-free, so the vertex stage's loop stays straight: bits by comparison, then a select.
+    let finite = p.x.is_finite() & p.y.is_finite() & p.z.is_finite() & p.w.is_finite();
+    let g = GUARD_BAND * p.w;
+    let code = ((p.x + g < 0.0) as u8 * LEFT)
+        | ((g - p.x < 0.0) as u8 * RIGHT)
+        | ((p.y + g < 0.0) as u8 * BOTTOM)
+        | ((g - p.y < 0.0) as u8 * TOP)
+        | ((p.z < 0.0) as u8 * NEAR)
+        | ((p.w - p.z < 0.0) as u8 * FAR)
+        | ((p.w - W_MIN < 0.0) as u8 * W_POSITIVE);
+    if finite {
+        code
+    } else {
+        INVALID
     }
-    let mut code = 0;
-    for plane in PLANES {
-        if distance(plane, p) < 0.0 {
-            code |= plane;
-        }
-    }
-    code
 }
 
 /// A clip-space vertex carrying its colour through clipping.

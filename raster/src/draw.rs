@@ -10,9 +10,11 @@ use core::fmt;
 use glam::{Mat3, Mat4, Vec3};
 
 use crate::clip::{self, clip_triangle, ClipVertex};
-use crate::edge::{fill_triangle, signed_area2, signed_area2_xy, Coverage, Facing, ScreenVertex};
+use crate::edge::{
+    fill_triangle, pixel_bounds, signed_area2, signed_area2_xy, Coverage, Facing, ScreenVertex,
+};
 use crate::target::{Pixel, Target};
-use crate::vertex::{light_normal, shade_vertex, to_clip, Light, ShadedVertex, Viewport};
+use crate::vertex::{light_normal, shade_vertices, to_clip, Light, ShadedVertex, Viewport};
 use crate::wire::draw_line;
 
 /// Borrowed mesh data: per-vertex arrays of equal length and triangles indexing them.
@@ -235,17 +237,19 @@ pub fn draw_indexed<P: Pixel>(
     let base = rgb_f32(params.base_color);
 
     // Vertex stage.
-    for (i, out) in scratch.iter_mut().enumerate() {
-        let rgb = mesh.colors.map_or(base, |c| rgb_f32(c[i]));
-        let light = vertex_light(mesh, params, i);
-        *out = shade_vertex(
-            &params.mvp,
-            &viewport,
-            Vec3::from(mesh.positions[i]),
-            light,
-            rgb,
-        );
-    }
+    let lighting = match (params.shading, mesh.normals) {
+        (Shading::Gouraud, Some(n)) => Some((&params.normal_matrix, &params.light, n)),
+        _ => None,
+    };
+    shade_vertices(
+        &params.mvp,
+        &viewport,
+        mesh.positions,
+        lighting,
+        mesh.colors,
+        base,
+        scratch,
+    );
 
     let facing = if params.cull_back_faces {
         Facing::Front
@@ -269,9 +273,15 @@ pub fn draw_indexed<P: Pixel>(
         }
         if union == 0 {
             // Cull before any colour work: half the triangles of a closed mesh face away.
-            let area = signed_area2_xy(v.map(|v| [v.x, v.y]));
+            let xy = v.map(|v| [v.x, v.y]);
+            let area = signed_area2_xy(xy);
             if area == 0 || (area > 0 && params.cull_back_faces) {
                 stats.culled += 1;
+                continue;
+            }
+            // Smaller than a pixel and between pixel centres: nothing to draw, no set-up to pay.
+            if pixel_bounds(xy, target.width, target.height).is_none() {
+                stats.rasterized += 1;
                 continue;
             }
         }

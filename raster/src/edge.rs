@@ -84,8 +84,24 @@ pub fn signed_area2(v: &[ScreenVertex; 3]) -> i64 {
 /// [`signed_area2`] of three snapped points.
 #[inline(always)]
 pub fn signed_area2_xy(p: [[i32; 2]; 3]) -> i64 {
-    let [[x0, y0], [x1, y1], [x2, y2]] = p.map(|p| p.map(|c| c as i64));
-    (x1 - x0) * (y2 - y0) - (y1 - y0) * (x2 - x0)
+    let (x0, y0) = (p[0][0] as i64, p[0][1] as i64);
+    (p[1][0] as i64 - x0) * (p[2][1] as i64 - y0) - (p[1][1] as i64 - y0) * (p[2][0] as i64 - x0)
+}
+
+/// The pixels whose centres the bounding box of three snapped points can contain, clipped to a
+/// `width` by `height` viewport, as inclusive `(x0, x1, y0, y1)`; `None` when there are none.
+#[inline(always)]
+pub fn pixel_bounds(p: [[i32; 2]; 3], width: usize, height: usize) -> Option<[i64; 4]> {
+    let min_x = p[0][0].min(p[1][0]).min(p[2][0]) as i64;
+    let max_x = p[0][0].max(p[1][0]).max(p[2][0]) as i64;
+    let min_y = p[0][1].min(p[1][1]).min(p[2][1]) as i64;
+    let max_y = p[0][1].max(p[1][1]).max(p[2][1]) as i64;
+    // First and last pixel whose centre (i + 1/2) can lie inside [min, max].
+    let x0 = ((min_x - HALF + SUBPIXEL_ONE as i64 - 1) >> SUBPIXEL_BITS).max(0);
+    let x1 = ((max_x - HALF) >> SUBPIXEL_BITS).min(width as i64 - 1);
+    let y0 = ((min_y - HALF + SUBPIXEL_ONE as i64 - 1) >> SUBPIXEL_BITS).max(0);
+    let y1 = ((max_y - HALF) >> SUBPIXEL_BITS).min(height as i64 - 1);
+    (x0 <= x1 && y0 <= y1).then_some([x0, x1, y0, y1])
 }
 
 /// One edge function `E(p) = dx * (p.y - a.y) - dy * (p.x - a.x)` for the edge `a -> b`.
@@ -203,20 +219,10 @@ where
     };
     let area = area.abs();
 
-    // Pixel bounding box, clipped to the viewport.
-    let (w, h) = (target.width as i64, target.height as i64);
-    let min_x = v[0].x.min(v[1].x).min(v[2].x) as i64;
-    let max_x = v[0].x.max(v[1].x).max(v[2].x) as i64;
-    let min_y = v[0].y.min(v[1].y).min(v[2].y) as i64;
-    let max_y = v[0].y.max(v[1].y).max(v[2].y) as i64;
-    // First and last pixel whose centre (i + 1/2) can lie inside [min, max].
-    let x0 = ((min_x - HALF + SUBPIXEL_ONE as i64 - 1) >> SUBPIXEL_BITS).max(0);
-    let x1 = ((max_x - HALF) >> SUBPIXEL_BITS).min(w - 1);
-    let y0 = ((min_y - HALF + SUBPIXEL_ONE as i64 - 1) >> SUBPIXEL_BITS).max(0);
-    let y1 = ((max_y - HALF) >> SUBPIXEL_BITS).min(h - 1);
-    if x0 > x1 || y0 > y1 {
+    let Some([x0, x1, y0, y1]) = pixel_bounds(v.map(|v| [v.x, v.y]), target.width, target.height)
+    else {
         return Coverage::Scanned;
-    }
+    };
     let px = (x0 << SUBPIXEL_BITS) + HALF;
     let mut py = (y0 << SUBPIXEL_BITS) + HALF;
     let e = [

@@ -106,16 +106,7 @@ impl Viewport {
         let limit = GUARD_BAND + 1.0;
         let nx = clamp_sym(clip.x * inv_w, limit);
         let ny = clamp_sym(clip.y * inv_w, limit);
-        let nz = clip.z * inv_w;
-        let nz = if nz > 0.0 {
-            if nz < 1.0 {
-                nz
-            } else {
-                1.0
-            }
-        } else {
-            0.0
-        };
+        let nz = (clip.z * inv_w).max(0.0).min(1.0);
         let sub = SUBPIXEL_ONE as f32;
         ScreenVertex {
             x: round((nx + 1.0) * self.half_w * sub),
@@ -126,14 +117,14 @@ impl Viewport {
     }
 }
 
-/// Rounds to the nearest integer, ties to even, for `|v| < 2^22`: adding and subtracting 1.5 * 2^23
-/// leaves no fraction bits, a basic IEEE operation pair that rounds the same on every target and
-/// is several times cheaper than `libm::roundf`. Snapped coordinates stay below 2^22 (see
-/// [`crate::edge`]).
+/// Rounds to the nearest integer, ties to even, for `|v| < 2^22`: adding 1.5 * 2^23 leaves the
+/// integer in the low mantissa bits, read off by a bit cast. One IEEE addition, the same on every
+/// target, several times cheaper than `libm::roundf` and, unlike a saturating `as` conversion, it
+/// vectorizes. Callers clamp first: snapped coordinates stay below 2^22 (see [`crate::edge`]).
 #[inline(always)]
 fn round(v: f32) -> i32 {
     const MAGIC: f32 = 12_582_912.0;
-    ((v + MAGIC) - MAGIC) as i32
+    (v + MAGIC).to_bits() as i32 - MAGIC.to_bits() as i32
 }
 
 /// Clamps to `[-limit, limit]`; NaN becomes `-limit` (it cannot occur for a vertex that passed
@@ -146,7 +137,7 @@ fn clamp_sym(v: f32, limit: f32) -> f32 {
 /// Object space to clip space, the one way both the vertex stage and clipping compute it.
 #[inline(always)]
 pub fn to_clip(mvp: &Mat4, position: Vec3) -> Vec4 {
-    *mvp * position.extend(1.0)
+    mvp.x_axis * position.x + mvp.y_axis * position.y + mvp.z_axis * position.z + mvp.w_axis
 }
 
 /// Transforms, lights and classifies one vertex.
@@ -162,29 +153,131 @@ pub fn shade_vertex(
 ) -> ShadedVertex {
     let clip = to_clip(mvp, position);
     let outcode = clip::outcode(clip);
-    let rgb = rgb.map(|c| saturate_u8(c * light));
-    if outcode == 0 {
-        let s = viewport.project(clip, [0.0; 3]);
-        ShadedVertex {
-            x: s.x,
-            y: s.y,
-            z: s.z,
-            rgb,
-            outcode,
+    // Projected whatever the outcode (the result is then unused but harmless): no branch.
+    let s = viewport.project(clip, [0.0; 3]);
+    ShadedVertex {
+        x: s.x,
+        y: s.y,
+        z: s.z,
+        rgb: rgb.map(|c| saturate_u8(c * light)),
+        outcode,
+    }
+}
+
+/// Vertices per batch of [`shade_vertices`]: two AVX or four SSE/NEON registers per attribute.
+const LANES: usize = 8;
+
+/// Runs the vertex stage over a whole mesh.
+///
+/// Vertices go through in batches of eight, attribute by attribute (structure of arrays), so that
+/// the compiler can use SIMD registers: each lane does exactly the operations [`shade_vertex`]
+/// does, in the same order, so the results are bit-identical to it (and across targets: a SIMD
+/// lane rounds as a scalar operation does). `lighting` gives the normal matrix, the light and the
+/// vertex normals for lit shading; `colors` the vertex colours, else `base` is used.
+///
+/// `out` must be exactly as long as `positions`, as must `normals` and `colors` when given
+/// ([`crate::draw_indexed`] checks this).
+pub fn shade_vertices(
+    mvp: &Mat4,
+    viewport: &Viewport,
+    positions: &[[f32; 3]],
+    lighting: Option<(&Mat3, &Light, &[[f32; 3]])>,
+    colors: Option<&[[u8; 3]]>,
+    base: [f32; 3],
+    out: &mut [ShadedVertex],
+) {
+    let m = mvp.to_cols_array_2d();
+    let nm = lighting.map(|(nm, _, _)| nm.to_cols_array_2d());
+    let sub = SUBPIXEL_ONE as f32;
+    let limit = GUARD_BAND + 1.0;
+    for (first, out) in (0..).step_by(LANES).zip(out.chunks_mut(LANES)) {
+        let len = out.len();
+        // Gather the batch; lanes past the end of the mesh hold zeros and are not stored.
+        let mut p = [[0.0f32; LANES]; 3];
+        let mut n = [[0.0f32; LANES]; 3];
+        let mut rgb = [[0.0f32; LANES]; 3];
+        for (k, q) in positions[first..first + len].iter().enumerate() {
+            for a in 0..3 {
+                p[a][k] = q[a];
+            }
         }
-    } else {
-        ShadedVertex {
-            rgb,
-            outcode,
-            ..ShadedVertex::default()
+        match colors {
+            Some(colors) => {
+                for (k, c) in colors[first..first + len].iter().enumerate() {
+                    for a in 0..3 {
+                        rgb[a][k] = c[a] as f32;
+                    }
+                }
+            }
+            None => {
+                for a in 0..3 {
+                    rgb[a] = [base[a]; LANES];
+                }
+            }
+        }
+        if let Some((_, _, normals)) = lighting {
+            for (k, q) in normals[first..first + len].iter().enumerate() {
+                for a in 0..3 {
+                    n[a][k] = q[a];
+                }
+            }
+        }
+
+        // Clip space, in the order of `to_clip`: x, y, z columns, then the translation.
+        let mut clip = [[0.0f32; LANES]; 4];
+        for (r, row) in clip.iter_mut().enumerate() {
+            for k in 0..LANES {
+                row[k] = m[0][r] * p[0][k] + m[1][r] * p[1][k] + m[2][r] * p[2][k] + m[3][r];
+            }
+        }
+        let mut light = [1.0f32; LANES];
+        if let (Some((_, l, _)), Some(nm)) = (lighting, nm) {
+            for k in 0..LANES {
+                let t = Vec3::new(
+                    nm[0][0] * n[0][k] + nm[1][0] * n[1][k] + nm[2][0] * n[2][k],
+                    nm[0][1] * n[0][k] + nm[1][1] * n[1][k] + nm[2][1] * n[2][k],
+                    nm[0][2] * n[0][k] + nm[1][2] * n[1][k] + nm[2][2] * n[2][k],
+                );
+                light[k] = l.intensity(t);
+            }
+        }
+        // Projection, as in `Viewport::project`.
+        let (mut sx, mut sy, mut sz) = ([0i32; LANES], [0i32; LANES], [0.0f32; LANES]);
+        for k in 0..LANES {
+            let inv_w = 1.0 / clip[3][k];
+            let nx = clamp_sym(clip[0][k] * inv_w, limit);
+            let ny = clamp_sym(clip[1][k] * inv_w, limit);
+            let nz = (clip[2][k] * inv_w).max(0.0).min(1.0);
+            sx[k] = round((nx + 1.0) * viewport.half_w * sub);
+            sy[k] = round((1.0 - ny) * viewport.half_h * sub);
+            sz[k] = nz * DEPTH_MAX as f32;
+        }
+        let mut lit = [[0u8; LANES]; 3];
+        for a in 0..3 {
+            for k in 0..LANES {
+                lit[a][k] = saturate_u8(rgb[a][k] * light[k]);
+            }
+        }
+        let mut code = [0u8; LANES];
+        for (k, code) in code.iter_mut().enumerate() {
+            *code = clip::outcode(Vec4::new(clip[0][k], clip[1][k], clip[2][k], clip[3][k]));
+        }
+        for (k, v) in out.iter_mut().enumerate() {
+            *v = ShadedVertex {
+                x: sx[k],
+                y: sy[k],
+                z: sz[k],
+                rgb: [lit[0][k], lit[1][k], lit[2][k]],
+                outcode: code[k],
+            };
         }
     }
 }
 
-/// Rounds a colour channel to `0..=255` (NaN becomes 0).
+/// Rounds a colour channel to `0..=255`, ties to even (NaN becomes 0).
 #[inline(always)]
 pub fn saturate_u8(c: f32) -> u8 {
-    (c + 0.5) as u8
+    round(c.max(0.0).min(255.0)) as u8
 }
 
 /// Intensity of `light` on `normal` after `normal_matrix`.
@@ -267,5 +360,7 @@ mod tests {
         assert_eq!(saturate_u8(-3.0), 0);
         assert_eq!(saturate_u8(f32::NAN), 0);
         assert_eq!(saturate_u8(127.6), 128);
+        assert_eq!(saturate_u8(0.5), 0);
+        assert_eq!(saturate_u8(1.5), 2);
     }
 }
