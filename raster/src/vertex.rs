@@ -102,18 +102,26 @@ impl Viewport {
     /// the edge stage is proven for.
     #[inline]
     pub fn project(&self, clip: Vec4, rgb: [f32; 3]) -> ScreenVertex {
-        let inv_w = 1.0 / clip.w;
+        let (x, y, z) = self.project_xyz(clip.x, clip.y, clip.z, clip.w);
+        ScreenVertex { x, y, z, rgb }
+    }
+
+    /// [`Viewport::project`] on loose coordinates, branch-free so that [`shade_vertices`] can run
+    /// it on eight vertices at once.
+    #[inline(always)]
+    #[allow(clippy::manual_clamp)] // `f32::clamp` keeps NaN; `max` then `min` maps it into range
+    fn project_xyz(&self, x: f32, y: f32, z: f32, w: f32) -> (i32, i32, f32) {
+        let inv_w = 1.0 / w;
         let limit = GUARD_BAND + 1.0;
-        let nx = clamp_sym(clip.x * inv_w, limit);
-        let ny = clamp_sym(clip.y * inv_w, limit);
-        let nz = (clip.z * inv_w).max(0.0).min(1.0);
+        let nx = clamp_sym(x * inv_w, limit);
+        let ny = clamp_sym(y * inv_w, limit);
+        let nz = (z * inv_w).max(0.0).min(1.0);
         let sub = SUBPIXEL_ONE as f32;
-        ScreenVertex {
-            x: round((nx + 1.0) * self.half_w * sub),
-            y: round((1.0 - ny) * self.half_h * sub),
-            z: nz * DEPTH_MAX as f32,
-            rgb,
-        }
+        (
+            round((nx + 1.0) * self.half_w * sub),
+            round((1.0 - ny) * self.half_h * sub),
+            nz * DEPTH_MAX as f32,
+        )
     }
 }
 
@@ -188,8 +196,6 @@ pub fn shade_vertices(
 ) {
     let m = mvp.to_cols_array_2d();
     let nm = lighting.map(|(nm, _, _)| nm.to_cols_array_2d());
-    let sub = SUBPIXEL_ONE as f32;
-    let limit = GUARD_BAND + 1.0;
     for (first, out) in (0..).step_by(LANES).zip(out.chunks_mut(LANES)) {
         let len = out.len();
         // Gather the batch; lanes past the end of the mesh hold zeros and are not stored.
@@ -241,16 +247,9 @@ pub fn shade_vertices(
                 light[k] = l.intensity(t);
             }
         }
-        // Projection, as in `Viewport::project`.
-        let (mut sx, mut sy, mut sz) = ([0i32; LANES], [0i32; LANES], [0.0f32; LANES]);
-        for k in 0..LANES {
-            let inv_w = 1.0 / clip[3][k];
-            let nx = clamp_sym(clip[0][k] * inv_w, limit);
-            let ny = clamp_sym(clip[1][k] * inv_w, limit);
-            let nz = (clip[2][k] * inv_w).max(0.0).min(1.0);
-            sx[k] = round((nx + 1.0) * viewport.half_w * sub);
-            sy[k] = round((1.0 - ny) * viewport.half_h * sub);
-            sz[k] = nz * DEPTH_MAX as f32;
+        let mut screen = [(0, 0, 0.0f32); LANES];
+        for (k, s) in screen.iter_mut().enumerate() {
+            *s = viewport.project_xyz(clip[0][k], clip[1][k], clip[2][k], clip[3][k]);
         }
         let mut lit = [[0u8; LANES]; 3];
         for a in 0..3 {
@@ -264,9 +263,9 @@ pub fn shade_vertices(
         }
         for (k, v) in out.iter_mut().enumerate() {
             *v = ShadedVertex {
-                x: sx[k],
-                y: sy[k],
-                z: sz[k],
+                x: screen[k].0,
+                y: screen[k].1,
+                z: screen[k].2,
                 rgb: [lit[0][k], lit[1][k], lit[2][k]],
                 outcode: code[k],
             };
@@ -276,6 +275,7 @@ pub fn shade_vertices(
 
 /// Rounds a colour channel to `0..=255`, ties to even (NaN becomes 0).
 #[inline(always)]
+#[allow(clippy::manual_clamp)] // NaN must map into range
 pub fn saturate_u8(c: f32) -> u8 {
     round(c.max(0.0).min(255.0)) as u8
 }
