@@ -260,17 +260,21 @@ pub fn draw_indexed<P: Pixel>(
         submitted: mesh.triangles.len() as u32,
         ..DrawStats::default()
     };
+    let mut fill = |target: &mut Target<'_, P>, stats: &mut DrawStats, tri: &[ScreenVertex; 3]| {
+        let coverage = fill_triangle(target, tri, facing, |c, d, f| {
+            if f.z < *d {
+                *d = f.z;
+                *c = P::from_rgb(f.rgb[0], f.rgb[1], f.rgb[2]);
+            }
+        });
+        match coverage {
+            Coverage::Scanned => stats.rasterized += 1,
+            Coverage::Culled => stats.culled += 1,
+        }
+    };
     for (t, tri) in mesh.triangles.iter().enumerate() {
         let v = tri.map(|i| scratch[i as usize]);
         let union = v[0].outcode | v[1].outcode | v[2].outcode;
-        if union & clip::INVALID != 0 {
-            stats.invalid += 1;
-            continue;
-        }
-        if v[0].outcode & v[1].outcode & v[2].outcode != 0 {
-            stats.outside += 1;
-            continue;
-        }
         if union == 0 {
             // Cull before any colour work: half the triangles of a closed mesh face away.
             let xy = v.map(|v| [v.x, v.y]);
@@ -284,29 +288,24 @@ pub fn draw_indexed<P: Pixel>(
                 stats.rasterized += 1;
                 continue;
             }
-        }
-        let colors = triangle_colors(mesh, params, t, tri, &v);
-        let mut plot = |tri: &[ScreenVertex; 3]| {
-            let coverage = fill_triangle(target, tri, facing, |c, d, f| {
-                if f.z < *d {
-                    *d = f.z;
-                    *c = P::from_rgb(f.rgb[0], f.rgb[1], f.rgb[2]);
-                }
+            let colors = triangle_colors(mesh, params, t, tri, &v);
+            let s = core::array::from_fn(|k| ScreenVertex {
+                x: v[k].x,
+                y: v[k].y,
+                z: v[k].z,
+                rgb: colors[k],
             });
-            match coverage {
-                Coverage::Scanned => stats.rasterized += 1,
-                Coverage::Culled => stats.culled += 1,
-            }
-        };
-        if union == 0 {
-            let mut s = v.map(|v| v.screen());
-            for (s, c) in s.iter_mut().zip(colors) {
-                s.rgb = c;
-            }
-            plot(&s);
+            fill(target, &mut stats, &s);
+        } else if union & clip::INVALID != 0 {
+            stats.invalid += 1;
+        } else if v[0].outcode & v[1].outcode & v[2].outcode != 0 {
+            stats.outside += 1;
         } else {
             stats.clipped += 1;
-            for_each_clipped(&viewport, params, mesh, tri, colors, union, |s| plot(s));
+            let colors = triangle_colors(mesh, params, t, tri, &v);
+            for_each_clipped(&viewport, params, mesh, tri, colors, union, |s| {
+                fill(target, &mut stats, s)
+            });
         }
     }
 

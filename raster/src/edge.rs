@@ -12,24 +12,20 @@
 //! triangles sharing an edge therefore never both cover, nor both miss, a pixel on it: meshes are
 //! watertight with no double blending.
 //!
-//! Attributes (depth and colour) are affine in screen space. Their gradients are set up once per
-//! triangle in `f32` (IEEE basic operations only, so deterministic) and then stepped in 48.16 fixed
-//! point: the pixel loop has no division and no float operation.
+//! Attributes (depth and colour) are affine in screen space. At each covered pixel they are
+//! evaluated from the two barycentric weights the edge functions already hold, against per-triangle
+//! differences pre-divided by the area: four multiply-adds on four lanes, no division in the pixel
+//! loop, and no set-up at all for the many triangles of a detailed mesh that cover no pixel
+//! centre. Only IEEE basic operations are used, so the result is the same on every target.
 
 use crate::target::{Pixel, Target};
+use crate::vertex::saturate_u8;
 
 /// Fractional bits of snapped screen coordinates.
 pub const SUBPIXEL_BITS: u32 = 8;
 /// One pixel in snapped units.
 pub const SUBPIXEL_ONE: i32 = 1 << SUBPIXEL_BITS;
 const HALF: i64 = (SUBPIXEL_ONE / 2) as i64;
-/// Fractional bits of stepped attributes.
-const ATTR_BITS: u32 = 16;
-const ATTR_ONE: f32 = (1u32 << ATTR_BITS) as f32;
-/// Bounds that keep stepped attributes from overflowing: at most 2^14 steps of at most 2^40 per
-/// axis from a start of at most 2^46 stays below 2^56.
-const ATTR_STEP_MAX: f32 = (1u64 << 40) as f32;
-const ATTR_START_MAX: f32 = (1u64 << 46) as f32;
 /// Largest depth value written; [`crate::DEPTH_CLEAR`] is larger, so any fragment passes on an
 /// empty pixel.
 pub const DEPTH_MAX: u32 = (1 << 24) - 1;
@@ -131,55 +127,49 @@ impl Edge {
     }
 }
 
-/// Depth and the three colour channels, stepped together in 48.16 fixed point.
+/// Depth and colour of a triangle, as functions of two barycentric weights.
 #[derive(Clone, Copy)]
 struct Attrs {
-    start: [i64; 4],
-    step_x: [i64; 4],
-    step_y: [i64; 4],
+    /// Depth and colour at vertex 0.
+    base: [f32; 4],
+    /// Change per unit of the edge function opposite vertex 1 (vertex 1's weight times the area).
+    d1: [f32; 4],
+    /// Change per unit of the edge function opposite vertex 2.
+    d2: [f32; 4],
 }
 
 impl Attrs {
-    /// Planes through the vertices' depth and colour, evaluated at the pixel centre `(px, py)`
-    /// (in snapped units). `bary[i]` holds the change of vertex `i`'s barycentric weight per
-    /// pixel to the right and per pixel down. Values are biased by one half so that the pixel loop's
-    /// shift rounds to nearest.
+    /// Relative to vertex 0 (its weight is 1 minus the others'), so that an attribute equal at all
+    /// three vertices comes out exactly equal everywhere.
     #[inline(always)]
-    fn new(v: &[ScreenVertex; 3], bary: &[[f32; 2]; 3], px: i64, py: i64) -> Attrs {
+    fn new(v: &[ScreenVertex; 3], area: i64) -> Attrs {
+        let inv = 1.0 / area as f32;
         let a = v.map(|v| [v.z, v.rgb[0], v.rgb[1], v.rgb[2]]);
-        let ox = (px - v[0].x as i64) as f32 * (1.0 / SUBPIXEL_ONE as f32);
-        let oy = (py - v[0].y as i64) as f32 * (1.0 / SUBPIXEL_ONE as f32);
-        let mut out = Attrs {
-            start: [0; 4],
-            step_x: [0; 4],
-            step_y: [0; 4],
-        };
-        #[allow(clippy::needless_range_loop)] // k walks four parallel arrays
-        for k in 0..4 {
-            // Relative to vertex 0 (its weight is 1 minus the others'), so that an attribute equal
-            // at all three vertices has gradients of exactly zero.
-            let (d1, d2) = (a[1][k] - a[0][k], a[2][k] - a[0][k]);
-            let gx = bary[1][0] * d1 + bary[2][0] * d2;
-            let gy = bary[1][1] * d1 + bary[2][1] * d2;
-            let start = a[0][k] + gx * ox + gy * oy;
-            // Half a unit added once here makes the per-pixel shift round to nearest.
-            out.start[k] = fixed(start + 0.5, ATTR_START_MAX);
-            out.step_x[k] = fixed(gx, ATTR_STEP_MAX);
-            out.step_y[k] = fixed(gy, ATTR_STEP_MAX);
+        Attrs {
+            base: a[0],
+            d1: core::array::from_fn(|k| (a[1][k] - a[0][k]) * inv),
+            d2: core::array::from_fn(|k| (a[2][k] - a[0][k]) * inv),
         }
-        out
+    }
+
+    /// The fragment where the edge functions opposite vertices 1 and 2 are `e1` and `e2`.
+    #[inline(always)]
+    fn at(&self, e1: i64, e2: i64) -> Fragment {
+        let (w1, w2) = (e1 as f32, e2 as f32);
+        let a: [f32; 4] =
+            core::array::from_fn(|k| self.base[k] + w1 * self.d1[k] + w2 * self.d2[k]);
+        Fragment {
+            z: depth(a[0]),
+            rgb: [saturate_u8(a[1]), saturate_u8(a[2]), saturate_u8(a[3])],
+        }
     }
 }
 
-/// `v` in 48.16 fixed point, clamped to `[-max, max]`; NaN becomes `-max`.
+/// Depth value in `0..=DEPTH_MAX` (NaN becomes 0).
 #[inline(always)]
-fn fixed(v: f32, max: f32) -> i64 {
-    (v * ATTR_ONE).max(-max).min(max) as i64
-}
-
-#[inline(always)]
-fn channel(v: i64) -> u8 {
-    (v >> ATTR_BITS).clamp(0, 255) as u8
+#[allow(clippy::manual_clamp)] // NaN must map into range
+fn depth(z: f32) -> u32 {
+    z.max(0.0).min(DEPTH_MAX as f32) as u32
 }
 
 /// Scans one triangle and calls `plot` for every pixel whose centre it covers.
@@ -199,7 +189,7 @@ fn channel(v: i64) -> u8 {
 /// fill_triangle(&mut target, &[v(0, 0), v(0, 8), v(8, 0)], Facing::Both, |_, _, _| covered += 1);
 /// assert_eq!(covered, 28); // centres on the hypotenuse (a right edge) stay out
 /// ```
-#[inline]
+#[inline(always)]
 pub fn fill_triangle<P: Pixel, F>(
     target: &mut Target<'_, P>,
     tri: &[ScreenVertex; 3],
@@ -224,77 +214,35 @@ where
         return Coverage::Scanned;
     };
     let px = (x0 << SUBPIXEL_BITS) + HALF;
-    let mut py = (y0 << SUBPIXEL_BITS) + HALF;
+    let py = (y0 << SUBPIXEL_BITS) + HALF;
     let e = [
         Edge::new(&v[1], &v[2], px, py),
         Edge::new(&v[2], &v[0], px, py),
         Edge::new(&v[0], &v[1], px, py),
     ];
+    let attrs = Attrs::new(&v, area);
     let (x0, x1) = (x0 as usize, x1 as usize);
-    let span = x1 - x0 + 1;
-
-    // Most triangles of a detailed mesh cover no pixel centre or only a few: find the first covered
-    // row with the integer edge functions alone before paying for the attribute set-up.
-    let mut row_e = [e[0].start, e[1].start, e[2].start];
-    let mut y = y0 as usize;
-    loop {
-        let [mut e0, mut e1, mut e2] = row_e;
-        let mut covered = false;
-        for _ in 0..span {
-            covered |= (e0 | e1 | e2) >= 0;
-            e0 += e[0].step_x;
-            e1 += e[1].step_x;
-            e2 += e[2].step_x;
-        }
-        if covered {
-            break;
-        }
-        if y as i64 >= y1 {
-            return Coverage::Scanned;
-        }
-        y += 1;
-        py += SUBPIXEL_ONE as i64;
-        for (r, e) in row_e.iter_mut().zip(&e) {
-            *r += e.step_y;
-        }
-    }
-
-    let inv = 1.0 / area as f32;
-    let bary = e.map(|e| [e.step_x as f32 * inv, e.step_y as f32 * inv]);
-    let attrs = Attrs::new(&v, &bary, px, py);
-    let mut row_a = attrs.start;
     let width = target.width;
-    for y in y..=y1 as usize {
+    let mut row = [e[0].start, e[1].start, e[2].start];
+    for y in y0 as usize..=y1 as usize {
         let base = y * width;
         let crow = &mut target.color[base + x0..=base + x1];
         let drow = &mut target.depth[base + x0..=base + x1];
-        let [mut e0, mut e1, mut e2] = row_e;
-        let [mut z, mut r, mut g, mut b] = row_a;
+        let [mut e0, mut e1, mut e2] = row;
         let mut entered = false;
         for (c, d) in crow.iter_mut().zip(drow.iter_mut()) {
             if (e0 | e1 | e2) >= 0 {
                 entered = true;
-                let frag = Fragment {
-                    z: (z >> ATTR_BITS).clamp(0, DEPTH_MAX as i64) as u32,
-                    rgb: [channel(r), channel(g), channel(b)],
-                };
-                plot(c, d, frag);
+                plot(c, d, attrs.at(e1, e2));
             } else if entered {
                 break; // a triangle meets each row in one span
             }
             e0 += e[0].step_x;
             e1 += e[1].step_x;
             e2 += e[2].step_x;
-            z += attrs.step_x[0];
-            r += attrs.step_x[1];
-            g += attrs.step_x[2];
-            b += attrs.step_x[3];
         }
-        for (r, e) in row_e.iter_mut().zip(&e) {
+        for (r, e) in row.iter_mut().zip(&e) {
             *r += e.step_y;
-        }
-        for (r, s) in row_a.iter_mut().zip(&attrs.step_y) {
-            *r += s;
         }
     }
     Coverage::Scanned
@@ -393,11 +341,10 @@ mod tests {
     }
 
     #[test]
-    fn fixed_point_conversion_saturates() {
-        let max = ATTR_STEP_MAX;
-        assert_eq!(fixed(f32::NAN, max), -(max as i64));
-        assert_eq!(fixed(f32::INFINITY, max), max as i64);
-        assert_eq!(fixed(-1e30, max), -(max as i64));
-        assert_eq!(fixed(1.5, max), 3 << (ATTR_BITS - 1));
+    fn depth_saturates() {
+        assert_eq!(depth(f32::NAN), 0);
+        assert_eq!(depth(-5.0), 0);
+        assert_eq!(depth(1e30), DEPTH_MAX);
+        assert_eq!(depth(1234.75), 1234);
     }
 }
