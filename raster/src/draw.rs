@@ -260,7 +260,7 @@ pub fn draw_indexed<P: Pixel>(
         submitted: mesh.triangles.len() as u32,
         ..DrawStats::default()
     };
-    let mut fill = |target: &mut Target<'_, P>, stats: &mut DrawStats, tri: &[ScreenVertex; 3]| {
+    let fill = |target: &mut Target<'_, P>, stats: &mut DrawStats, tri: &[ScreenVertex; 3]| {
         let coverage = fill_triangle(target, tri, facing, |c, d, f| {
             if f.z < *d {
                 *d = f.z;
