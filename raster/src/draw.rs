@@ -11,7 +11,8 @@ use glam::{Mat3, Mat4, Vec3};
 
 use crate::clip::{self, clip_triangle, ClipVertex};
 use crate::edge::{
-    fill_triangle, pixel_bounds, signed_area2, signed_area2_xy, Coverage, Facing, ScreenVertex,
+    fill_triangle, pixel_bounds, scan, signed_area2, signed_area2_xy, Coverage, Facing, Fragment,
+    ScreenVertex,
 };
 use crate::target::{Pixel, Target};
 use crate::vertex::{light_normal, shade_vertices, to_clip, Light, ShadedVertex, Viewport};
@@ -261,12 +262,7 @@ pub fn draw_indexed<P: Pixel>(
         ..DrawStats::default()
     };
     let fill = |target: &mut Target<'_, P>, stats: &mut DrawStats, tri: &[ScreenVertex; 3]| {
-        let coverage = fill_triangle(target, tri, facing, |c, d, f| {
-            if f.z < *d {
-                *d = f.z;
-                *c = P::from_rgb(f.rgb[0], f.rgb[1], f.rgb[2]);
-            }
-        });
+        let coverage = fill_triangle(target, tri, facing, depth_test::<P>);
         match coverage {
             Coverage::Scanned => stats.rasterized += 1,
             Coverage::Culled => stats.culled += 1,
@@ -283,19 +279,21 @@ pub fn draw_indexed<P: Pixel>(
                 stats.culled += 1;
                 continue;
             }
+            stats.rasterized += 1;
             // Smaller than a pixel and between pixel centres: nothing to draw, no set-up to pay.
-            if pixel_bounds(xy, target.width, target.height).is_none() {
-                stats.rasterized += 1;
+            let Some(bounds) = pixel_bounds(xy, target.width, target.height) else {
                 continue;
-            }
+            };
             let colors = triangle_colors(mesh, params, t, tri, &v);
-            let s = core::array::from_fn(|k| ScreenVertex {
+            // Clockwise on screen, as the pixel loop wants it.
+            let order = if area < 0 { [0, 2, 1] } else { [0, 1, 2] };
+            let s = order.map(|k| ScreenVertex {
                 x: v[k].x,
                 y: v[k].y,
                 z: v[k].z,
                 rgb: colors[k],
             });
-            fill(target, &mut stats, &s);
+            scan(target, &s, area.abs(), bounds, depth_test::<P>);
         } else if union & clip::INVALID != 0 {
             stats.invalid += 1;
         } else if v[0].outcode & v[1].outcode & v[2].outcode != 0 {
@@ -335,6 +333,15 @@ pub fn draw_indexed<P: Pixel>(
         }
     }
     Ok(stats)
+}
+
+/// Writes a fragment nearer than what the pixel holds (strict less: the first of equal depths wins).
+#[inline(always)]
+fn depth_test<P: Pixel>(c: &mut P, d: &mut u32, f: Fragment) {
+    if f.z < *d {
+        *d = f.z;
+        *c = P::from_rgb(f.rgb[0], f.rgb[1], f.rgb[2]);
+    }
 }
 
 /// Light intensity at vertex `i` for per-vertex shading (1 when unlit).

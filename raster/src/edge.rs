@@ -194,7 +194,7 @@ pub fn fill_triangle<P: Pixel, F>(
     target: &mut Target<'_, P>,
     tri: &[ScreenVertex; 3],
     facing: Facing,
-    mut plot: F,
+    plot: F,
 ) -> Coverage
 where
     F: FnMut(&mut P, &mut u32, Fragment),
@@ -207,12 +207,25 @@ where
     } else {
         return Coverage::Culled;
     };
-    let area = area.abs();
+    if let Some(bounds) = pixel_bounds(v.map(|v| [v.x, v.y]), target.width, target.height) {
+        scan(target, &v, area.abs(), bounds, plot);
+    }
+    Coverage::Scanned
+}
 
-    let Some([x0, x1, y0, y1]) = pixel_bounds(v.map(|v| [v.x, v.y]), target.width, target.height)
-    else {
-        return Coverage::Scanned;
-    };
+/// The pixel loop of [`fill_triangle`], for a triangle already oriented clockwise on screen (positive
+/// [`signed_area2`] `area`) and its non-empty [`pixel_bounds`]: for callers that computed those
+/// anyway.
+#[inline(always)]
+pub(crate) fn scan<P: Pixel, F>(
+    target: &mut Target<'_, P>,
+    v: &[ScreenVertex; 3],
+    area: i64,
+    [x0, x1, y0, y1]: [i64; 4],
+    mut plot: F,
+) where
+    F: FnMut(&mut P, &mut u32, Fragment),
+{
     let px = (x0 << SUBPIXEL_BITS) + HALF;
     let py = (y0 << SUBPIXEL_BITS) + HALF;
     let e = [
@@ -220,7 +233,7 @@ where
         Edge::new(&v[2], &v[0], px, py),
         Edge::new(&v[0], &v[1], px, py),
     ];
-    let attrs = Attrs::new(&v, area);
+    let attrs = Attrs::new(v, area);
     let (x0, x1) = (x0 as usize, x1 as usize);
     let width = target.width;
     let mut row = [e[0].start, e[1].start, e[2].start];
@@ -245,7 +258,6 @@ where
             *r += e.step_y;
         }
     }
-    Coverage::Scanned
 }
 
 #[cfg(test)]

@@ -195,7 +195,9 @@ pub fn shade_vertices(
     out: &mut [ShadedVertex],
 ) {
     let m = mvp.to_cols_array_2d();
-    let nm = lighting.map(|(nm, _, _)| nm.to_cols_array_2d());
+    let nm = lighting
+        .filter(|(nm, _, _)| **nm != Mat3::IDENTITY)
+        .map(|(nm, _, _)| nm.to_cols_array_2d());
     for (first, out) in (0..).step_by(LANES).zip(out.chunks_mut(LANES)) {
         let len = out.len();
         // Gather the batch; lanes past the end of the mesh hold zeros and are not stored.
@@ -237,15 +239,24 @@ pub fn shade_vertices(
             }
         }
         let mut light = [1.0f32; LANES];
-        if let (Some((_, l, _)), Some(nm)) = (lighting, nm) {
-            for k in 0..LANES {
-                let t = Vec3::new(
-                    nm[0][0] * n[0][k] + nm[1][0] * n[1][k] + nm[2][0] * n[2][k],
-                    nm[0][1] * n[0][k] + nm[1][1] * n[1][k] + nm[2][1] * n[2][k],
-                    nm[0][2] * n[0][k] + nm[1][2] * n[1][k] + nm[2][2] * n[2][k],
-                );
-                light[k] = l.intensity(t);
+        match (lighting, nm) {
+            // Lighting in object space, the common case: skip the identity product.
+            (Some((_, l, _)), None) => {
+                for k in 0..LANES {
+                    light[k] = l.intensity(Vec3::new(n[0][k], n[1][k], n[2][k]));
+                }
             }
+            (Some((_, l, _)), Some(nm)) => {
+                for k in 0..LANES {
+                    let t = Vec3::new(
+                        nm[0][0] * n[0][k] + nm[1][0] * n[1][k] + nm[2][0] * n[2][k],
+                        nm[0][1] * n[0][k] + nm[1][1] * n[1][k] + nm[2][1] * n[2][k],
+                        nm[0][2] * n[0][k] + nm[1][2] * n[1][k] + nm[2][2] * n[2][k],
+                    );
+                    light[k] = l.intensity(t);
+                }
+            }
+            (None, _) => {}
         }
         let mut screen = [(0, 0, 0.0f32); LANES];
         for (k, s) in screen.iter_mut().enumerate() {
