@@ -269,7 +269,8 @@ pub fn draw_indexed<P: Pixel>(
         }
     };
     for (t, tri) in mesh.triangles.iter().enumerate() {
-        let v = tri.map(|i| scratch[i as usize]);
+        // References, not copies: a culled triangle reads only positions and outcodes.
+        let v = tri.map(|i| &scratch[i as usize]);
         let union = v[0].outcode | v[1].outcode | v[2].outcode;
         if union == 0 {
             // Cull before any colour work: half the triangles of a closed mesh face away.
@@ -337,10 +338,11 @@ pub fn draw_indexed<P: Pixel>(
 
 /// Writes a fragment nearer than what the pixel holds (strict less: the first of equal depths wins).
 #[inline(always)]
-fn depth_test<P: Pixel>(c: &mut P, d: &mut u32, f: Fragment) {
+fn depth_test<P: Pixel>(c: &mut P, d: &mut u32, f: Fragment<'_>) {
     if f.z < *d {
         *d = f.z;
-        *c = P::from_rgb(f.rgb[0], f.rgb[1], f.rgb[2]);
+        let [r, g, b] = f.rgb();
+        *c = P::from_rgb(r, g, b);
     }
 }
 
@@ -362,7 +364,7 @@ fn triangle_colors(
     params: &DrawParams,
     t: usize,
     tri: &[u32; 3],
-    v: &[ShadedVertex; 3],
+    v: &[&ShadedVertex; 3],
 ) -> [[f32; 3]; 3] {
     let face = mesh.face_colors.map(|f| rgb_f32(f[t]));
     match params.shading {

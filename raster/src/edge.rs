@@ -43,13 +43,25 @@ pub struct ScreenVertex {
     pub rgb: [f32; 3],
 }
 
-/// What one fragment carries to the pixel.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Fragment {
+/// One covered pixel: its depth, and its colour on demand, so that a fragment failing the depth
+/// test never pays for its colour.
+#[derive(Clone, Copy)]
+pub struct Fragment<'a> {
     /// Depth in `0..=DEPTH_MAX`.
     pub z: u32,
-    /// Colour, saturated to 8 bits per channel.
-    pub rgb: [u8; 3],
+    w1: f32,
+    w2: f32,
+    attrs: &'a Attrs,
+}
+
+impl Fragment<'_> {
+    /// Colour, rounded and saturated to 8 bits per channel.
+    #[inline(always)]
+    pub fn rgb(&self) -> [u8; 3] {
+        let a = self.attrs;
+        let c = |k: usize| saturate_u8(a.base[k] + self.w1 * a.d1[k] + self.w2 * a.d2[k]);
+        [c(1), c(2), c(3)]
+    }
 }
 
 /// Which triangles [`fill_triangle`] draws.
@@ -154,13 +166,13 @@ impl Attrs {
 
     /// The fragment where the edge functions opposite vertices 1 and 2 are `e1` and `e2`.
     #[inline(always)]
-    fn at(&self, e1: i64, e2: i64) -> Fragment {
+    fn at(&self, e1: i64, e2: i64) -> Fragment<'_> {
         let (w1, w2) = (e1 as f32, e2 as f32);
-        let a: [f32; 4] =
-            core::array::from_fn(|k| self.base[k] + w1 * self.d1[k] + w2 * self.d2[k]);
         Fragment {
-            z: depth(a[0]),
-            rgb: [saturate_u8(a[1]), saturate_u8(a[2]), saturate_u8(a[3])],
+            z: depth(self.base[0] + w1 * self.d1[0] + w2 * self.d2[0]),
+            w1,
+            w2,
+            attrs: self,
         }
     }
 }
@@ -197,7 +209,7 @@ pub fn fill_triangle<P: Pixel, F>(
     plot: F,
 ) -> Coverage
 where
-    F: FnMut(&mut P, &mut u32, Fragment),
+    F: FnMut(&mut P, &mut u32, Fragment<'_>),
 {
     let area = signed_area2(tri);
     let v = if area < 0 {
@@ -224,7 +236,7 @@ pub(crate) fn scan<P: Pixel, F>(
     [x0, x1, y0, y1]: [i64; 4],
     mut plot: F,
 ) where
-    F: FnMut(&mut P, &mut u32, Fragment),
+    F: FnMut(&mut P, &mut u32, Fragment<'_>),
 {
     let px = (x0 << SUBPIXEL_BITS) + HALF;
     let py = (y0 << SUBPIXEL_BITS) + HALF;
@@ -345,7 +357,7 @@ mod tests {
         let tri = [sv(0, 0), sv(0, 8 * s), sv(8 * s, 0)];
         let mut seen = 0;
         fill_triangle(&mut t, &tri, Facing::Both, |_, _, f| {
-            assert_eq!(f.rgb, [10, 20, 30]);
+            assert_eq!(f.rgb(), [10, 20, 30]);
             assert_eq!(f.z, 100);
             seen += 1;
         });
