@@ -13,13 +13,17 @@
 //! Both renderers always get the same index buffer.
 //!
 //! Run: `cargo bench --bench raster`. Criterion prints the time per frame and, as throughput,
-//! triangles per second (Melem/s); the ratio of the two is the speed-up.
+//! triangles per second (Melem/s); then a second pass alternates the two renderers frame by frame
+//! and prints minimum and median times and their ratios, which are the figures to quote.
 
-use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use std::hint::black_box;
+use std::time::Instant;
+
+use criterion::{criterion_group, Criterion, Throughput};
 use euc::{buffer::Buffer2d, rasterizer, Pipeline};
 use vdlod_demo::camera::Orbit;
 use vdlod_demo::frame::Frame;
-use vdlod_demo::mesh::{load_obj_bytes, BUNNY_NAME, BUNNY_OBJ};
+use vdlod_demo::mesh::{load_obj_bytes, IndexedMesh, BUNNY_NAME, BUNNY_OBJ};
 use vdlod_demo::render::camera_params;
 use vdlod_raster::{Light, Shading};
 
@@ -52,48 +56,117 @@ impl Pipeline for Gouraud<'_> {
     }
 }
 
-fn bunny(c: &mut Criterion) {
+/// One scene drawn by both renderers, each with buffers of its own.
+struct Scene<'a> {
+    name: String,
+    triangles: usize,
+    mesh: vdlod_raster::Mesh<'a>,
+    params: vdlod_raster::DrawParams,
+    frame: Frame,
+    pipe: Gouraud<'a>,
+    indices: Vec<u32>,
+    color: Buffer2d<u32>,
+    depth: Buffer2d<f32>,
+}
+
+impl<'a> Scene<'a> {
+    fn new(name: &str, mesh: &'a IndexedMesh, w: usize, h: usize) -> Scene<'a> {
+        let camera = Orbit::peer(&mesh.bounds(), 12).camera(1); // azimuth 30 degrees
+        let params = camera_params(&camera, w as f32 / h as f32, Shading::Gouraud, false);
+        Scene {
+            name: format!("{name}_{w}x{h}"),
+            triangles: mesh.triangles.len(),
+            mesh: mesh.as_raster_mesh(),
+            params,
+            frame: Frame::new(w, h).expect("frame"),
+            pipe: Gouraud {
+                mvp: vek::Mat4::from_col_array(params.mvp.to_cols_array()),
+                positions: &mesh.positions,
+                normals: &mesh.normals,
+                light: params.light,
+                base: params.base_color.map(|c| c as f32),
+            },
+            indices: mesh.triangles.iter().flatten().copied().collect(),
+            color: Buffer2d::new([w, h], 0u32),
+            depth: Buffer2d::new([w, h], 1.0f32),
+        }
+    }
+
+    fn vdlod(&mut self) {
+        black_box(self.frame.draw(&self.mesh, &self.params).expect("draw"));
+    }
+
+    fn euc(&mut self) {
+        euc::Target::clear(&mut self.color, 0);
+        euc::Target::clear(&mut self.depth, 1.0);
+        self.pipe.draw::<rasterizer::Triangles<_>, _>(
+            &self.indices,
+            &mut self.color,
+            Some(&mut self.depth),
+        );
+        black_box(&self.color);
+    }
+}
+
+fn meshes() -> (IndexedMesh, IndexedMesh) {
     let file_order = load_obj_bytes(BUNNY_NAME, BUNNY_OBJ).expect("bundled bunny");
     let mut reordered = file_order.clone();
     reordered.reorder_for_locality();
-    let runs = [
-        ("bunny", &reordered, 640usize, 480usize),
-        ("bunny", &reordered, 320, 240),
-        ("bunny_file_order", &file_order, 640, 480),
-    ];
-    for (name, mesh, w, h) in runs {
-        let camera = Orbit::peer(&mesh.bounds(), 12).camera(1); // azimuth 30 degrees
-        let indices: Vec<u32> = mesh.triangles.iter().flatten().copied().collect();
-        let mut group = c.benchmark_group(format!("{name}_{w}x{h}"));
-        group.throughput(Throughput::Elements(mesh.triangles.len() as u64));
+    (reordered, file_order)
+}
+
+fn scenes<'a>(reordered: &'a IndexedMesh, file_order: &'a IndexedMesh) -> Vec<Scene<'a>> {
+    vec![
+        Scene::new("bunny", reordered, 640, 480),
+        Scene::new("bunny", reordered, 320, 240),
+        Scene::new("bunny_file_order", file_order, 640, 480),
+    ]
+}
+
+fn bunny(c: &mut Criterion) {
+    let (reordered, file_order) = meshes();
+    for mut scene in scenes(&reordered, &file_order) {
+        let mut group = c.benchmark_group(scene.name.clone());
+        group.throughput(Throughput::Elements(scene.triangles as u64));
         group.sample_size(40);
-
-        let params = camera_params(&camera, w as f32 / h as f32, Shading::Gouraud, false);
-        let mut frame = Frame::new(w, h).expect("frame");
-        let raster_mesh = mesh.as_raster_mesh();
-        group.bench_function("vdlod", |b| {
-            b.iter(|| frame.draw(&raster_mesh, &params).expect("draw"))
-        });
-
-        let pipe = Gouraud {
-            mvp: vek::Mat4::from_col_array(params.mvp.to_cols_array()),
-            positions: &mesh.positions,
-            normals: &mesh.normals,
-            light: params.light,
-            base: params.base_color.map(|c| c as f32),
-        };
-        let mut color = Buffer2d::new([w, h], 0u32);
-        let mut depth = Buffer2d::new([w, h], 1.0f32);
-        group.bench_function("euc", |b| {
-            b.iter(|| {
-                euc::Target::clear(&mut color, 0);
-                euc::Target::clear(&mut depth, 1.0);
-                pipe.draw::<rasterizer::Triangles<_>, _>(&indices, &mut color, Some(&mut depth));
-            })
-        });
+        group.bench_function("vdlod", |b| b.iter(|| scene.vdlod()));
+        group.bench_function("euc", |b| b.iter(|| scene.euc()));
         group.finish();
     }
 }
 
+/// Frames of the two renderers alternated, so that both see the same machine: this shared machine
+/// changes speed by tens of percent from one second to the next, which criterion's back-to-back
+/// groups cannot separate from the renderers' own difference.
+fn interleaved() {
+    const ROUNDS: usize = 200;
+    let (reordered, file_order) = meshes();
+    println!("\ninterleaved, {ROUNDS} rounds of one frame each (milliseconds):");
+    for mut scene in scenes(&reordered, &file_order) {
+        let (mut ours, mut theirs) = (Vec::new(), Vec::new());
+        for _ in 0..ROUNDS {
+            let t = Instant::now();
+            scene.vdlod();
+            ours.push(t.elapsed().as_secs_f64() * 1e3);
+            let t = Instant::now();
+            scene.euc();
+            theirs.push(t.elapsed().as_secs_f64() * 1e3);
+        }
+        ours.sort_by(f64::total_cmp);
+        theirs.sort_by(f64::total_cmp);
+        let (om, tm) = (ours[ROUNDS / 2], theirs[ROUNDS / 2]);
+        println!(
+            "{:<26} vdlod min {:.3} median {:.3} | euc min {:.3} median {:.3} | euc/vdlod min {:.2}x median {:.2}x | vdlod {:.1} Mtri/s",
+            scene.name, ours[0], om, theirs[0], tm, theirs[0] / ours[0], tm / om,
+            scene.triangles as f64 / om / 1e3
+        );
+    }
+}
+
 criterion_group!(benches, bunny);
-criterion_main!(benches);
+
+fn main() {
+    benches();
+    Criterion::default().configure_from_args().final_summary();
+    interleaved();
+}
