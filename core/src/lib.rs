@@ -1,8 +1,15 @@
 //! View-dependent level of detail for memory-scarce renderers.
 //!
-//! This crate will hold the read side of the vertex-hierarchy format, the runtime cut, the
-//! refinement policies, the triangle budget and geomorphs, all `no_std` and allocation-free, with
-//! the offline hierarchy builder behind a feature that enables `alloc`. It is empty today: the
-//! rasterizer (`vdlod-raster`) and the host demo come first.
+//! This crate holds the parts of vdlod that run on the device, `no_std` and allocation-free (the
+//! read side of the hierarchy format, the runtime cut, the refinement policies, the triangle budget
+//! and geomorphs: still to come), and, behind the `build` feature, the offline [`build`]er that
+//! turns a triangle mesh into a vertex hierarchy (it needs `alloc`).
 #![no_std]
 #![forbid(unsafe_code)]
+#![warn(missing_docs)]
+
+#[cfg(feature = "build")]
+extern crate alloc;
+
+#[cfg(feature = "build")]
+pub mod build;

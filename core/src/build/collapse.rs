@@ -1,0 +1,372 @@
+//! The edge-collapse engine: a mutable triangle mesh, legality tests, and a heap of costs.
+//!
+//! Each collapse of an edge `a-b` creates a *new* vertex `p` (the merge-tree paper's renaming,
+//! §3.2), so every vertex id names one position for ever and the collapses form a forest. Costs
+//! live in a binary heap with lazy deletion: an entry whose endpoint has since been merged is
+//! skipped when popped, and the edges around a collapse are pushed again with fresh costs, which
+//! keeps the whole build at O(n log n) for meshes of bounded vertex degree.
+
+use alloc::collections::BinaryHeap;
+use alloc::vec;
+use alloc::vec::Vec;
+use core::cmp::Reverse;
+
+use super::quadric::{place, Quadric};
+use super::vec3::{add, cross, dot, from_f32, len, normalize, scale, sub, Vec3d};
+use super::{BuildOptions, Cost, InputMesh, NONE};
+
+/// What one collapse did, enough to undo it by a vertex split.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Collapse {
+    /// The new vertex.
+    pub parent: u32,
+    /// The merged vertices; triangle `(children[0], children[1], wings[0])` was removed.
+    pub children: [u32; 2],
+    /// Third corners of the removed triangles; `wings[1]` is `NONE` on a boundary edge.
+    pub wings: [u32; 2],
+}
+
+pub(crate) struct Engine<'o> {
+    opts: &'o BuildOptions,
+    pub pos: Vec<Vec3d>,
+    pub quadric: Vec<Quadric>,
+    pub area: Vec<f64>,
+    pub color: Vec<[f64; 3]>,
+    pub faces: Vec<[u32; 3]>,
+    pub face_alive: Vec<bool>,
+    marked: Vec<bool>,
+    /// Live faces around each live vertex.
+    pub vfaces: Vec<Vec<u32>>,
+    pub alive: Vec<bool>,
+    pub alive_count: usize,
+    heap: BinaryHeap<Reverse<(u64, u32, u32)>>,
+    deferred: Vec<(u32, u32)>,
+    pub collapses: Vec<Collapse>,
+    /// Neighbours of each parent when it formed (the merge-tree paper's dependencies, §3.2).
+    pub deps: Vec<Vec<u32>>,
+}
+
+fn face_normal(p: &[Vec3d], f: [u32; 3]) -> Vec3d {
+    let [a, b, c] = f.map(|i| p[i as usize]);
+    cross(sub(b, a), sub(c, a))
+}
+
+impl<'o> Engine<'o> {
+    pub fn new(mesh: &InputMesh<'_>, opts: &'o BuildOptions) -> Engine<'o> {
+        let n = mesh.positions.len();
+        let pos: Vec<Vec3d> = mesh.positions.iter().map(|&p| from_f32(p)).collect();
+        let faces = mesh.triangles.to_vec();
+        let mut vfaces = vec![Vec::new(); n];
+        for (f, tri) in faces.iter().enumerate() {
+            for &v in tri {
+                vfaces[v as usize].push(f as u32);
+            }
+        }
+        let mut quadric = vec![Quadric::default(); n];
+        let mut area = vec![0.0; n];
+        for tri in &faces {
+            let [a, b, c] = tri.map(|i| pos[i as usize]);
+            let q = Quadric::triangle(a, b, c);
+            let ar = 0.5 * len(cross(sub(b, a), sub(c, a)));
+            for &v in tri {
+                quadric[v as usize] = quadric[v as usize].add(&q);
+                area[v as usize] += ar / 3.0;
+            }
+        }
+        let color = (0..n)
+            .map(|i| {
+                mesh.colors
+                    .map_or([0.0; 3], |c| c[i].map(|v| v as f64 / 255.0))
+            })
+            .collect();
+        let mut e = Engine {
+            opts,
+            pos,
+            quadric,
+            area,
+            color,
+            face_alive: vec![true; faces.len()],
+            marked: vec![false; faces.len()],
+            faces,
+            alive: vfaces.iter().map(|f| !f.is_empty()).collect(),
+            alive_count: 0,
+            vfaces,
+            heap: BinaryHeap::new(),
+            deferred: Vec::new(),
+            collapses: Vec::new(),
+            deps: Vec::new(),
+        };
+        e.alive_count = e.alive.iter().filter(|&&a| a).count();
+        // Boundary quadrics keep open borders in place.
+        for f in 0..e.faces.len() {
+            let tri = e.faces[f];
+            for k in 0..3 {
+                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                if e.edge_faces(a, b).1 == 0 {
+                    let n = normalize(face_normal(&e.pos, tri)).unwrap_or([0.0; 3]);
+                    let q = Quadric::boundary(e.pos[a as usize], e.pos[b as usize], n, 16.0);
+                    for v in [a, b] {
+                        e.quadric[v as usize] = e.quadric[v as usize].add(&q);
+                    }
+                }
+            }
+        }
+        for v in 0..n as u32 {
+            for x in e.neighbours(v) {
+                if v < x {
+                    e.push(v, x);
+                }
+            }
+        }
+        e
+    }
+
+    /// Sorted distinct neighbours of a live vertex.
+    pub fn neighbours(&self, v: u32) -> Vec<u32> {
+        let mut out: Vec<u32> = self.vfaces[v as usize]
+            .iter()
+            .flat_map(|&f| self.faces[f as usize])
+            .filter(|&x| x != v)
+            .collect();
+        out.sort_unstable();
+        out.dedup();
+        out
+    }
+
+    /// The faces with directed edge `a -> b` and `b -> a`, as (third corner of the first or NONE,
+    /// number of faces on the edge).
+    fn edge_faces(&self, a: u32, b: u32) -> ([u32; 2], usize) {
+        let mut wings = [NONE; 2];
+        let mut count = 0;
+        for &f in &self.vfaces[a as usize] {
+            let t = self.faces[f as usize];
+            for k in 0..3 {
+                if t[k] == a && t[(k + 1) % 3] == b {
+                    wings[0] = t[(k + 2) % 3];
+                    count += 1;
+                } else if t[k] == b && t[(k + 1) % 3] == a {
+                    wings[1] = t[(k + 2) % 3];
+                    count += 1;
+                }
+            }
+        }
+        (wings, count)
+    }
+
+    fn is_boundary_vertex(&self, v: u32) -> bool {
+        self.neighbours(v)
+            .into_iter()
+            .any(|x| self.edge_faces(v, x).1 == 1)
+    }
+
+    fn boundary_neighbours(&self, v: u32) -> Vec<u32> {
+        self.neighbours(v)
+            .into_iter()
+            .filter(|&x| self.edge_faces(v, x).1 == 1)
+            .collect()
+    }
+
+    /// Where the merged vertex goes and what the collapse costs.
+    fn evaluate(&self, a: u32, b: u32) -> (Vec3d, f64) {
+        let (pa, pb) = (self.pos[a as usize], self.pos[b as usize]);
+        let q = self.quadric[a as usize].add(&self.quadric[b as usize]);
+        let len2 = dot(sub(pa, pb), sub(pa, pb));
+        match self.opts.cost {
+            Cost::Quadric => {
+                let v = place(&q, pa, pb);
+                (v, q.error(v))
+            }
+            Cost::ShortestEdge => (scale(add(pa, pb), 0.5), len2),
+            Cost::Color => {
+                // The importance paper's Gerr^2 + length^2 + sqrt(length * dcolor), with Gerr the
+                // area-weighted RMS distance of the new vertex to the planes it replaces.
+                let v = place(&q, pa, pb);
+                let area = (self.area[a as usize] + self.area[b as usize]).max(f64::MIN_POSITIVE);
+                let gerr2 = q.error(v) / area;
+                let dc = len(sub(self.color[a as usize], self.color[b as usize]));
+                (v, gerr2 + len2 + libm::sqrt(libm::sqrt(len2) * dc))
+            }
+        }
+    }
+
+    fn push(&mut self, a: u32, b: u32) {
+        let (a, b) = (a.min(b), a.max(b));
+        let (_, cost) = self.evaluate(a, b);
+        // Non-negative doubles order like their bit patterns.
+        let key = if cost.is_finite() { cost.max(0.0) } else { f64::MAX };
+        self.heap.push(Reverse((key.to_bits(), a, b)));
+    }
+
+    /// Whether collapsing `a-b` into `v` keeps the mesh a manifold of the same topology with no
+    /// flipped or degenerate triangle. `Err(())` means legal but for region-of-influence marks.
+    fn legal(&self, a: u32, b: u32, v: Vec3d) -> Result<bool, ()> {
+        let (wings, count) = self.edge_faces(a, b);
+        if count == 0 {
+            return Ok(false);
+        }
+        let (na, nb) = (self.neighbours(a), self.neighbours(b));
+        // Link condition: the common neighbours are exactly the wings.
+        let common: Vec<u32> = na.iter().copied().filter(|x| nb.binary_search(x).is_ok()).collect();
+        let mut w: Vec<u32> = wings.iter().copied().filter(|&x| x != NONE).collect();
+        w.sort_unstable();
+        if common != w {
+            return Ok(false);
+        }
+        let edge_on_border = count == 1;
+        let (ba, bb) = (self.is_boundary_vertex(a), self.is_boundary_vertex(b));
+        if ba && bb && !edge_on_border {
+            return Ok(false); // would pinch two borders (or a border and itself) together
+        }
+        if edge_on_border {
+            // A border loop of three edges would close up.
+            let oa: Vec<u32> = self.boundary_neighbours(a).into_iter().filter(|&x| x != b).collect();
+            let ob: Vec<u32> = self.boundary_neighbours(b).into_iter().filter(|&x| x != a).collect();
+            if oa.iter().any(|x| ob.contains(x)) {
+                return Ok(false);
+            }
+        }
+        // Degrees: the merged vertex and the wings keep enough neighbours (this also stops a
+        // closed component from shrinking below a tetrahedron).
+        let degree_p = na.len() + nb.len() - 2 - common.len();
+        let border_p = ba || bb;
+        if degree_p < if border_p { 2 } else { 3 } {
+            return Ok(false);
+        }
+        for &x in &w {
+            let min = if self.is_boundary_vertex(x) { 3 } else { 4 };
+            if self.neighbours(x).len() < min {
+                return Ok(false);
+            }
+        }
+        // No flipped or collapsed triangle.
+        for &s in &[a, b] {
+            for &f in &self.vfaces[s as usize] {
+                let t = self.faces[f as usize];
+                if t.contains(&a) && t.contains(&b) {
+                    continue;
+                }
+                let before = face_normal(&self.pos, t);
+                let moved = t.map(|i| if i == s { v } else { self.pos[i as usize] });
+                let after = cross(sub(moved[1], moved[0]), sub(moved[2], moved[0]));
+                let (lb, la) = (len(before), len(after));
+                if !(la > 1e-12 * lb) || dot(before, after) <= 0.0 {
+                    return Ok(false);
+                }
+            }
+        }
+        if self.opts.balanced {
+            let touched = self.vfaces[a as usize]
+                .iter()
+                .chain(&self.vfaces[b as usize])
+                .any(|&f| self.marked[f as usize]);
+            if touched {
+                return Err(());
+            }
+        }
+        Ok(true)
+    }
+
+    /// Collapses the cheapest legal edge; `false` when none is left.
+    pub fn step(&mut self) -> bool {
+        loop {
+            let Some(Reverse((_, a, b))) = self.heap.pop() else {
+                if self.deferred.is_empty() {
+                    return false;
+                }
+                // Region-of-influence pass over (merge-tree paper §3.1): unmark and retry.
+                self.marked.iter_mut().for_each(|m| *m = false);
+                for (a, b) in core::mem::take(&mut self.deferred) {
+                    if self.alive[a as usize] && self.alive[b as usize] {
+                        self.push(a, b);
+                    }
+                }
+                continue;
+            };
+            if !self.alive[a as usize] || !self.alive[b as usize] {
+                continue;
+            }
+            let (v, _) = self.evaluate(a, b);
+            match self.legal(a, b, v) {
+                Ok(true) => {
+                    self.collapse(a, b, v);
+                    return true;
+                }
+                Ok(false) => {}
+                Err(()) => self.deferred.push((a, b)),
+            }
+        }
+    }
+
+    fn collapse(&mut self, a: u32, b: u32, v: Vec3d) {
+        let (wings, _) = self.edge_faces(a, b);
+        // Orient so that triangle (children[0], children[1], wings[0]) exists.
+        let (children, wings) = if wings[0] != NONE {
+            ([a, b], wings)
+        } else {
+            ([b, a], [wings[1], wings[0]])
+        };
+        let p = self.pos.len() as u32;
+        let (ia, ib) = (a as usize, b as usize);
+        self.pos.push(v);
+        let q = self.quadric[ia].add(&self.quadric[ib]);
+        self.quadric.push(q);
+        self.area.push(self.area[ia] + self.area[ib]);
+        let (wa, wb) = (self.area[ia].max(1e-30), self.area[ib].max(1e-30));
+        let c = scale(
+            add(scale(self.color[ia], wa), scale(self.color[ib], wb)),
+            1.0 / (wa + wb),
+        );
+        self.color.push(c);
+
+        let mut pf = Vec::new();
+        for s in [a, b] {
+            for f in core::mem::take(&mut self.vfaces[s as usize]) {
+                let t = &mut self.faces[f as usize];
+                if t.contains(&a) && t.contains(&b) {
+                    if self.face_alive[f as usize] {
+                        self.face_alive[f as usize] = false;
+                        let third = t.iter().copied().find(|&x| x != a && x != b).unwrap_or(NONE);
+                        if let Some(list) = self.vfaces.get_mut(third as usize) {
+                            list.retain(|&g| g != f);
+                        }
+                    }
+                    continue;
+                }
+                for x in t.iter_mut() {
+                    if *x == s {
+                        *x = p;
+                    }
+                }
+                pf.push(f);
+            }
+        }
+        pf.sort_unstable();
+        pf.dedup();
+        if self.opts.balanced {
+            for &f in &pf {
+                self.marked[f as usize] = true;
+            }
+        }
+        self.vfaces.push(pf);
+        self.alive[ia] = false;
+        self.alive[ib] = false;
+        self.alive.push(true);
+        self.alive_count -= 1;
+        self.collapses.push(Collapse {
+            parent: p,
+            children,
+            wings,
+        });
+        let ring = self.neighbours(p);
+        self.deps.push(ring.clone());
+        // Fresh costs around p; the neighbours' other edges may have become legal.
+        for &x in &ring {
+            self.push(p, x);
+            for y in self.neighbours(x) {
+                if y != p && x < y {
+                    self.push(x, y);
+                }
+            }
+        }
+    }
+}

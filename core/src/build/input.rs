@@ -1,0 +1,320 @@
+//! Checking a mesh before it is simplified.
+//!
+//! The builder needs an oriented 2-manifold, possibly with boundaries: every edge in one or two
+//! triangles (in opposite directions when two), every vertex's triangles forming one fan, no NaN
+//! or infinite coordinate, no triangle repeating a vertex, no triangle listed twice. Anything else
+//! is reported as a [`BuildError`] naming the first offender. Vertices used by no triangle are
+//! accepted (documented repair): they become roots of their own and never collapse.
+
+use alloc::vec::Vec;
+use core::fmt;
+
+/// An indexed triangle mesh to build a hierarchy from.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct InputMesh<'a> {
+    /// Vertex positions.
+    pub positions: &'a [[f32; 3]],
+    /// Optional per-vertex colours (needed by the colour-aware cost).
+    pub colors: Option<&'a [[u8; 3]]>,
+    /// Triangles, counter-clockwise seen from the front.
+    pub triangles: &'a [[u32; 3]],
+}
+
+/// Why a mesh cannot be built into a hierarchy.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BuildError {
+    /// No triangles.
+    Empty,
+    /// More vertices or triangles than the format can address (2^31).
+    TooLarge,
+    /// A coordinate is NaN or infinite.
+    NonFinite {
+        /// The vertex.
+        vertex: u32,
+    },
+    /// A triangle refers to a vertex that does not exist.
+    IndexOutOfRange {
+        /// The triangle.
+        triangle: u32,
+        /// Its offending index.
+        index: u32,
+    },
+    /// A triangle uses the same vertex twice.
+    DegenerateTriangle {
+        /// The triangle.
+        triangle: u32,
+    },
+    /// A triangle has the same three vertices as an earlier one.
+    DuplicateTriangle {
+        /// The later triangle.
+        triangle: u32,
+        /// The earlier one.
+        first: u32,
+    },
+    /// An edge belongs to more than two triangles.
+    NonManifoldEdge {
+        /// One end.
+        a: u32,
+        /// The other end.
+        b: u32,
+    },
+    /// Two triangles share an edge in the same direction: their orientations disagree.
+    InconsistentOrientation {
+        /// One end.
+        a: u32,
+        /// The other end.
+        b: u32,
+    },
+    /// A vertex's triangles form more than one fan (two surfaces touching at a point).
+    NonManifoldVertex {
+        /// The vertex.
+        vertex: u32,
+    },
+    /// The colour array's length differs from the vertex count.
+    ColorLength {
+        /// Vertex count.
+        expected: u32,
+        /// Colour count.
+        actual: u32,
+    },
+}
+
+impl fmt::Display for BuildError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            BuildError::Empty => write!(f, "the mesh has no triangles"),
+            BuildError::TooLarge => write!(f, "the mesh has more than 2^31 vertices or triangles"),
+            BuildError::NonFinite { vertex } => {
+                write!(f, "vertex {vertex} has a NaN or infinite coordinate")
+            }
+            BuildError::IndexOutOfRange { triangle, index } => {
+                write!(f, "triangle {triangle} uses vertex {index}, which does not exist")
+            }
+            BuildError::DegenerateTriangle { triangle } => {
+                write!(f, "triangle {triangle} uses a vertex twice")
+            }
+            BuildError::DuplicateTriangle { triangle, first } => {
+                write!(f, "triangle {triangle} repeats triangle {first}")
+            }
+            BuildError::NonManifoldEdge { a, b } => {
+                write!(f, "edge {a}-{b} belongs to more than two triangles (non-manifold)")
+            }
+            BuildError::InconsistentOrientation { a, b } => write!(
+                f,
+                "the two triangles on edge {a}-{b} are oriented inconsistently"
+            ),
+            BuildError::NonManifoldVertex { vertex } => write!(
+                f,
+                "vertex {vertex} joins surfaces that touch only there (non-manifold)"
+            ),
+            BuildError::ColorLength { expected, actual } => {
+                write!(f, "{actual} colours for {expected} vertices")
+            }
+        }
+    }
+}
+
+impl core::error::Error for BuildError {}
+
+/// Checks `mesh`; on success every edge is in one or two consistently oriented triangles and every
+/// vertex's triangles form a single fan.
+pub fn validate(mesh: &InputMesh<'_>) -> Result<(), BuildError> {
+    let n = mesh.positions.len();
+    if mesh.triangles.is_empty() {
+        return Err(BuildError::Empty);
+    }
+    if n >= 1 << 31 || mesh.triangles.len() >= 1 << 30 {
+        return Err(BuildError::TooLarge);
+    }
+    if let Some(c) = mesh.colors {
+        if c.len() != n {
+            return Err(BuildError::ColorLength {
+                expected: n as u32,
+                actual: c.len().min(u32::MAX as usize) as u32,
+            });
+        }
+    }
+    if let Some(v) = mesh
+        .positions
+        .iter()
+        .position(|p| !p.iter().all(|c| c.is_finite()))
+    {
+        return Err(BuildError::NonFinite { vertex: v as u32 });
+    }
+    for (t, tri) in mesh.triangles.iter().enumerate() {
+        if let Some(&index) = tri.iter().find(|&&i| i as usize >= n) {
+            return Err(BuildError::IndexOutOfRange {
+                triangle: t as u32,
+                index,
+            });
+        }
+        if tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2] {
+            return Err(BuildError::DegenerateTriangle { triangle: t as u32 });
+        }
+    }
+
+    // Duplicates: sort triangles by their sorted corners.
+    let mut keyed: Vec<([u32; 3], u32)> = mesh
+        .triangles
+        .iter()
+        .enumerate()
+        .map(|(t, tri)| {
+            let mut k = *tri;
+            k.sort_unstable();
+            (k, t as u32)
+        })
+        .collect();
+    keyed.sort_unstable();
+    for w in keyed.windows(2) {
+        if w[0].0 == w[1].0 {
+            return Err(BuildError::DuplicateTriangle {
+                triangle: w[0].1.max(w[1].1),
+                first: w[0].1.min(w[1].1),
+            });
+        }
+    }
+
+    // Edges: (low, high, forward?) for each directed edge; equal undirected edges are adjacent.
+    let mut edges: Vec<(u32, u32, bool)> = Vec::with_capacity(mesh.triangles.len() * 3);
+    for tri in mesh.triangles {
+        for k in 0..3 {
+            let (a, b) = (tri[k], tri[(k + 1) % 3]);
+            edges.push((a.min(b), a.max(b), a < b));
+        }
+    }
+    edges.sort_unstable();
+    let mut i = 0;
+    while i < edges.len() {
+        let mut j = i + 1;
+        while j < edges.len() && edges[j].0 == edges[i].0 && edges[j].1 == edges[i].1 {
+            j += 1;
+        }
+        let (a, b) = (edges[i].0, edges[i].1);
+        match j - i {
+            1 => {}
+            2 if edges[i].2 != edges[i + 1].2 => {}
+            2 => return Err(BuildError::InconsistentOrientation { a, b }),
+            _ => return Err(BuildError::NonManifoldEdge { a, b }),
+        }
+        i = j;
+    }
+
+    // Fans: around each vertex, the link edges (x -> y for triangle v, x, y) must form one chain.
+    let mut around: Vec<(u32, u32, u32)> = Vec::with_capacity(mesh.triangles.len() * 3);
+    for tri in mesh.triangles {
+        for k in 0..3 {
+            around.push((tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3]));
+        }
+    }
+    around.sort_unstable();
+    let mut i = 0;
+    while i < around.len() {
+        let v = around[i].0;
+        let mut j = i;
+        while j < around.len() && around[j].0 == v {
+            j += 1;
+        }
+        if !single_fan(&around[i..j]) {
+            return Err(BuildError::NonManifoldVertex { vertex: v });
+        }
+        i = j;
+    }
+    Ok(())
+}
+
+/// Whether the link edges `x -> y` (sorted by `x`) of one vertex form a single path or cycle.
+fn single_fan(link: &[(u32, u32, u32)]) -> bool {
+    // With manifold edges each x starts at most one link edge. Walk from a start that no edge ends
+    // at (an open fan) or from any edge (a closed one) and count the steps.
+    let next = |x: u32| {
+        link.binary_search_by_key(&x, |e| e.1)
+            .ok()
+            .map(|k| link[k].2)
+    };
+    let start = link
+        .iter()
+        .map(|e| e.1)
+        .find(|&x| !link.iter().any(|e| e.2 == x))
+        .unwrap_or(link[0].1);
+    let mut x = start;
+    let mut steps = 0;
+    while let Some(y) = next(x) {
+        steps += 1;
+        if y == start || steps > link.len() {
+            break;
+        }
+        x = y;
+    }
+    steps == link.len()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn check(positions: &[[f32; 3]], triangles: &[[u32; 3]]) -> Result<(), BuildError> {
+        validate(&InputMesh {
+            positions,
+            colors: None,
+            triangles,
+        })
+    }
+
+    const P: [[f32; 3]; 7] = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [-1.0, 0.0, 0.0],
+        [0.0, -1.0, 0.0],
+    ];
+
+    #[test]
+    fn accepts_open_and_closed_surfaces() {
+        assert_eq!(check(&P, &[[0, 1, 2], [1, 3, 2]]), Ok(()));
+        let tetra = [[0, 2, 1], [0, 1, 4], [1, 2, 4], [2, 0, 4]];
+        assert_eq!(check(&P, &tetra), Ok(()));
+    }
+
+    #[test]
+    fn rejects_bad_meshes() {
+        assert_eq!(check(&P, &[]), Err(BuildError::Empty));
+        assert_eq!(
+            check(&P, &[[0, 1, 9]]),
+            Err(BuildError::IndexOutOfRange {
+                triangle: 0,
+                index: 9
+            })
+        );
+        assert_eq!(
+            check(&P, &[[0, 1, 1]]),
+            Err(BuildError::DegenerateTriangle { triangle: 0 })
+        );
+        assert_eq!(
+            check(&P, &[[0, 1, 2], [1, 2, 0]]),
+            Err(BuildError::DuplicateTriangle {
+                triangle: 1,
+                first: 0
+            })
+        );
+        assert_eq!(
+            check(&P, &[[0, 1, 2], [1, 0, 3], [0, 1, 4]]),
+            Err(BuildError::NonManifoldEdge { a: 0, b: 1 })
+        );
+        assert_eq!(
+            check(&P, &[[0, 1, 2], [0, 1, 3]]),
+            Err(BuildError::InconsistentOrientation { a: 0, b: 1 })
+        );
+        // Two triangles touching at vertex 0 only.
+        assert_eq!(
+            check(&P, &[[0, 1, 3], [0, 5, 6]]),
+            Err(BuildError::NonManifoldVertex { vertex: 0 })
+        );
+        let nan = [[f32::NAN, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+        assert_eq!(
+            check(&nan, &[[0, 1, 2]]),
+            Err(BuildError::NonFinite { vertex: 0 })
+        );
+    }
+}

@@ -1,0 +1,255 @@
+//! The offline hierarchy builder (feature `build`, needs `alloc`).
+//!
+//! From an indexed triangle mesh to a vertex forest by repeated legal edge collapse (the
+//! merge-tree paper §3.1, with Hoppe-style renaming, §3.2): each collapse of `a-b` makes a new
+//! vertex, the parent of `a` and `b`, until no legal collapse is left or the mesh is down to
+//! [`BuildOptions::base_vertices`]. Unlike the paper's implementation the builder accepts open
+//! meshes (borders are kept in place by boundary quadrics and never pinched or closed), runs in
+//! O(n log n) with a heap of costs, and keeps genus and border loops.
+//!
+//! Costs ([`Cost`]): the quadric error metric with optimal placement (the LOD lecture; default),
+//! the shortest edge (merge-tree paper), and the importance paper's colour-aware
+//! `Gerr^2 + length^2 + sqrt(length * dcolor)`. With [`BuildOptions::balanced`], the merge-tree
+//! paper's region-of-influence marking keeps the forest shallow: a triangle touched by a collapse
+//! blocks further collapses around it until no unblocked collapse is left.
+//!
+//! Each node then gets what the run-time tests need ([`Node`]): a bounding-sphere radius over its
+//! subtree's region (merge-tree §3.3), a cone of normals, Hoppe-style uniform and normal deviation
+//! and the wavelet paper's normal-aligned spheroid (equation 3), colour, depth, and its
+//! dependencies. [`Hierarchy::refine_all`] replays every split from the base mesh with nothing but
+//! the nodes' records.
+//!
+//! ```
+//! use vdlod_core::build::{build, rotate_to_min, BuildOptions, InputMesh};
+//! // An octahedron collapses to a tetrahedron, the smallest closed surface.
+//! let positions = [[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0],
+//!                  [0.0, -1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]];
+//! let triangles = [[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4],
+//!                  [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]];
+//! let mesh = InputMesh { positions: &positions, colors: None, triangles: &triangles };
+//! let h = build(&mesh, &BuildOptions::default(), &mut |_| {}).unwrap();
+//! assert_eq!(h.base_triangles.len(), 4);
+//! // Every split replayed from the base mesh gives back the octahedron.
+//! let mut full = h.refine_all();
+//! full.sort();
+//! let mut expected: Vec<[u32; 3]> = triangles.iter().map(|&t| rotate_to_min(t)).collect();
+//! expected.sort();
+//! assert_eq!(full, expected);
+//! ```
+
+mod attributes;
+mod collapse;
+mod input;
+mod quadric;
+mod vec3;
+
+use alloc::vec::Vec;
+
+pub use collapse::Collapse;
+pub use input::{validate, BuildError, InputMesh};
+
+/// "No vertex": a missing wing (border edge) or parent (root).
+pub const NONE: u32 = u32::MAX;
+
+/// How the next edge to collapse is chosen.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Cost {
+    /// Quadric error metric with optimal placement.
+    #[default]
+    Quadric,
+    /// Shortest edge first, merged at its midpoint (merge-tree paper §3.1).
+    ShortestEdge,
+    /// The importance paper's colour-aware cost `Gerr^2 + length^2 + sqrt(length * dcolor)`.
+    Color,
+}
+
+/// Settings of [`build`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct BuildOptions {
+    /// Collapse cost.
+    pub cost: Cost,
+    /// Region-of-influence marking (merge-tree paper §3.1) for a balanced, shallow forest.
+    pub balanced: bool,
+    /// Stop when this many vertices are left (0: collapse while any collapse is legal).
+    pub base_vertices: u32,
+}
+
+/// Progress of a build, for a progress bar.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Progress {
+    /// Collapses done.
+    pub done: u32,
+    /// Collapses the build can do at most (vertices minus the base size).
+    pub total: u32,
+}
+
+/// One vertex of the forest.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Node {
+    /// Position.
+    pub position: [f32; 3],
+    /// Parent, or [`NONE`] for a root (a vertex of the base mesh).
+    pub parent: u32,
+    /// Children, `[NONE; 2]` for a leaf (a vertex of the input mesh). The split of this node adds
+    /// triangles `(children[0], children[1], wings[0])` and `(children[1], children[0], wings[1])`.
+    pub children: [u32; 2],
+    /// Third corners of the triangles the split adds; `wings[1]` is [`NONE`] on a border.
+    pub wings: [u32; 2],
+    /// Neighbours when the node was formed: all must be present for it to split or to form
+    /// (merge-tree paper §3.2). Empty for leaves.
+    pub dependencies: Vec<u32>,
+    /// Radius of a sphere around `position` holding the node's region and all its descendants'.
+    pub radius: f32,
+    /// Axis of the cone of normals of the node's region (unit length).
+    pub normal: [f32; 3],
+    /// Sine of the cone's half-angle (`1.0` or more: the cone is not a useful bound).
+    pub cone_sin: f32,
+    /// Largest distance of a descendant leaf from `position` across the normal (Hoppe's `mu`).
+    pub mu: f32,
+    /// Largest distance of a descendant leaf from `position` along the normal (Hoppe's `delta`).
+    pub delta: f32,
+    /// Normal-aligned spheroid `[a, b]` bounding the descendant leaves' error vectors (wavelet
+    /// paper, equation 3): `a` along the normal, `b` across it.
+    pub spheroid: [f32; 2],
+    /// Colour (area-weighted mean of the region's vertex colours).
+    pub color: [u8; 3],
+    /// Depth in the forest: 0 for roots.
+    pub depth: u16,
+}
+
+/// A built vertex forest.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Hierarchy {
+    /// The input's vertex count: nodes `0..leaves` are the input vertices, in input order.
+    pub leaves: u32,
+    /// All nodes: the leaves, then the parents in the order they were formed.
+    pub nodes: Vec<Node>,
+    /// The triangles left after the last collapse, over root nodes.
+    pub base_triangles: Vec<[u32; 3]>,
+}
+
+impl Hierarchy {
+    /// The roots: the vertices of the base mesh (including input vertices no triangle used).
+    pub fn roots(&self) -> impl Iterator<Item = u32> + '_ {
+        (0..self.nodes.len() as u32).filter(|&i| self.nodes[i as usize].parent == NONE)
+    }
+
+    /// Deepest leaf and mean leaf depth.
+    pub fn depth_stats(&self) -> (u32, f64) {
+        let leaves = &self.nodes[..self.leaves as usize];
+        let max = leaves.iter().map(|n| n.depth as u32).max().unwrap_or(0);
+        let mean = leaves.iter().map(|n| n.depth as f64).sum::<f64>() / leaves.len().max(1) as f64;
+        (max, mean)
+    }
+
+    /// Replays every vertex split, last collapse first, from the base mesh, using only the nodes'
+    /// children and wings; returns the triangles with each rotated to start at its smallest index.
+    /// For a hierarchy from [`build`], these are exactly the input's triangles.
+    pub fn refine_all(&self) -> Vec<[u32; 3]> {
+        let mut faces: Vec<[u32; 3]> = self.base_triangles.clone();
+        // Faces around each vertex, kept up to date.
+        let mut around: Vec<Vec<u32>> = alloc::vec![Vec::new(); self.nodes.len()];
+        for (f, t) in faces.iter().enumerate() {
+            for &v in t {
+                around[v as usize].push(f as u32);
+            }
+        }
+        for p in (self.leaves..self.nodes.len() as u32).rev() {
+            let node = &self.nodes[p as usize];
+            let [c0, c1] = node.children;
+            let [w0, w1] = node.wings;
+            // Walk the fan around p counter-clockwise from the triangle (p, w0, .) until the
+            // triangle (p, ., w1): those triangles belonged to c0, the rest to c1. If c0 was on a
+            // border, the walk meets it first; c0's other triangles then lie clockwise of w1.
+            let find = |faces: &[[u32; 3]], around: &[Vec<u32>], x: u32, ccw: bool| {
+                around[p as usize].iter().copied().find_map(|f| {
+                    let t = faces[f as usize];
+                    let k = (0..3).find(|&k| t[k] == p)?;
+                    let (next, prev) = (t[(k + 1) % 3], t[(k + 2) % 3]);
+                    match ccw {
+                        true if next == x => Some((f, prev)),
+                        false if prev == x => Some((f, next)),
+                        _ => None,
+                    }
+                })
+            };
+            let mut to_c0 = Vec::new();
+            let guard = around[p as usize].len();
+            let mut x = w0;
+            let mut reached_w1 = false;
+            while let Some((f, y)) = find(&faces, &around, x, true) {
+                if to_c0.contains(&f) || to_c0.len() > guard {
+                    break;
+                }
+                to_c0.push(f);
+                if y == w1 {
+                    reached_w1 = true;
+                    break;
+                }
+                x = y;
+            }
+            if !reached_w1 && w1 != NONE {
+                let mut x = w1;
+                while let Some((f, y)) = find(&faces, &around, x, false) {
+                    if to_c0.contains(&f) || to_c0.len() > guard {
+                        break;
+                    }
+                    to_c0.push(f);
+                    x = y;
+                }
+            }
+            for f in core::mem::take(&mut around[p as usize]) {
+                let child = if to_c0.contains(&f) { c0 } else { c1 };
+                for v in faces[f as usize].iter_mut() {
+                    if *v == p {
+                        *v = child;
+                    }
+                }
+                around[child as usize].push(f);
+            }
+            for t in [[c0, c1, w0], [c1, c0, w1]] {
+                if t.contains(&NONE) {
+                    continue;
+                }
+                let f = faces.len() as u32;
+                faces.push(t);
+                for v in t {
+                    around[v as usize].push(f);
+                }
+            }
+        }
+        faces.iter().map(|&t| rotate_to_min(t)).collect()
+    }
+}
+
+/// The same oriented triangle, starting at its smallest index.
+pub fn rotate_to_min(t: [u32; 3]) -> [u32; 3] {
+    let k = (0..3).min_by_key(|&k| t[k]).unwrap_or(0);
+    [t[k], t[(k + 1) % 3], t[(k + 2) % 3]]
+}
+
+/// Builds the vertex forest of `mesh`; `progress` is called now and then.
+pub fn build(
+    mesh: &InputMesh<'_>,
+    opts: &BuildOptions,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<Hierarchy, BuildError> {
+    validate(mesh)?;
+    let mut engine = collapse::Engine::new(mesh, opts);
+    let target = (opts.base_vertices as usize).max(1);
+    let total = engine.alive_count.saturating_sub(target) as u32;
+    let step = (total / 200).max(1);
+    let mut done = 0u32;
+    progress(Progress { done, total });
+    while engine.alive_count > target && engine.step() {
+        done += 1;
+        if done % step == 0 {
+            progress(Progress { done, total });
+        }
+    }
+    progress(Progress { done, total });
+    Ok(attributes::finish(mesh, engine))
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,267 @@
+//! Builder tests on generated meshes (the fixtures are tested from the workspace's `tests/`).
+
+use alloc::vec::Vec;
+
+use super::*;
+
+/// Euler characteristic `V - E + F` and the number of border loops of a triangle list.
+pub fn topology(triangles: &[[u32; 3]]) -> (i64, usize) {
+    let mut verts: Vec<u32> = triangles.iter().flatten().copied().collect();
+    verts.sort_unstable();
+    verts.dedup();
+    let mut edges: Vec<(u32, u32)> = triangles
+        .iter()
+        .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
+        .collect();
+    let mut undirected: Vec<(u32, u32)> = edges.iter().map(|&(a, b)| (a.min(b), a.max(b))).collect();
+    undirected.sort_unstable();
+    undirected.dedup();
+    edges.sort_unstable();
+    // Border edges: directed edges whose reverse is missing. Follow them into loops.
+    let border: Vec<(u32, u32)> = edges
+        .iter()
+        .copied()
+        .filter(|&(a, b)| edges.binary_search(&(b, a)).is_err())
+        .collect();
+    let mut used = alloc::vec![false; border.len()];
+    let mut loops = 0;
+    for start in 0..border.len() {
+        if used[start] {
+            continue;
+        }
+        loops += 1;
+        let mut k = start;
+        while !used[k] {
+            used[k] = true;
+            let next = border[k].1;
+            match border.iter().position(|&(a, _)| a == next) {
+                Some(j) => k = j,
+                None => break,
+            }
+        }
+    }
+    (
+        verts.len() as i64 - undirected.len() as i64 + triangles.len() as i64,
+        loops,
+    )
+}
+
+fn sorted(mut t: Vec<[u32; 3]>) -> Vec<[u32; 3]> {
+    for x in t.iter_mut() {
+        *x = rotate_to_min(*x);
+    }
+    t.sort_unstable();
+    t
+}
+
+/// An `n` by `n` grid of quads, split in two, gently curved so collapses have costs that differ.
+fn grid(n: u32) -> (Vec<[f32; 3]>, Vec<[u32; 3]>) {
+    let mut p = Vec::new();
+    for j in 0..=n {
+        for i in 0..=n {
+            let (x, y) = (i as f32 / n as f32, j as f32 / n as f32);
+            p.push([x, y, 0.3 * libm::sinf(3.0 * x) * libm::cosf(2.0 * y)]);
+        }
+    }
+    let v = |i: u32, j: u32| j * (n + 1) + i;
+    let mut t = Vec::new();
+    for j in 0..n {
+        for i in 0..n {
+            t.push([v(i, j), v(i + 1, j), v(i + 1, j + 1)]);
+            t.push([v(i, j), v(i + 1, j + 1), v(i, j + 1)]);
+        }
+    }
+    (p, t)
+}
+
+/// A unit sphere: an octahedron subdivided `levels` times (4-to-1), vertices pushed outwards.
+fn sphere(levels: u32) -> (Vec<[f32; 3]>, Vec<[u32; 3]>) {
+    let mut p: Vec<[f32; 3]> = alloc::vec![
+        [1.0, 0.0, 0.0],
+        [-1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, -1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [0.0, 0.0, -1.0],
+    ];
+    let mut t: Vec<[u32; 3]> = alloc::vec![
+        [0, 2, 4],
+        [2, 1, 4],
+        [1, 3, 4],
+        [3, 0, 4],
+        [2, 0, 5],
+        [1, 2, 5],
+        [3, 1, 5],
+        [0, 3, 5]
+    ];
+    for _ in 0..levels {
+        let mut mids: Vec<((u32, u32), u32)> = Vec::new();
+        let mut mid = |a: u32, b: u32, p: &mut Vec<[f32; 3]>| {
+            let key = (a.min(b), a.max(b));
+            if let Some(&(_, m)) = mids.iter().find(|(k, _)| *k == key) {
+                return m;
+            }
+            let (pa, pb) = (p[a as usize], p[b as usize]);
+            let m = [0, 1, 2].map(|k| (pa[k] + pb[k]) * 0.5);
+            let l = libm::sqrtf(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
+            p.push(m.map(|c| c / l));
+            let id = p.len() as u32 - 1;
+            mids.push((key, id));
+            id
+        };
+        let mut next = Vec::new();
+        for &[a, b, c] in &t {
+            let (ab, bc, ca) = (mid(a, b, &mut p), mid(b, c, &mut p), mid(c, a, &mut p));
+            next.extend_from_slice(&[[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]]);
+        }
+        t = next;
+    }
+    (p, t)
+}
+
+fn build_it(p: &[[f32; 3]], t: &[[u32; 3]], opts: BuildOptions) -> Hierarchy {
+    let mesh = InputMesh {
+        positions: p,
+        colors: None,
+        triangles: t,
+    };
+    build(&mesh, &opts, &mut |_| {}).expect("valid mesh")
+}
+
+#[test]
+fn open_grid_round_trips_and_keeps_its_border() {
+    let (p, t) = grid(12);
+    for cost in [Cost::Quadric, Cost::ShortestEdge, Cost::Color] {
+        for balanced in [false, true] {
+            let h = build_it(&p, &t, BuildOptions { cost, balanced, base_vertices: 0 });
+            assert_eq!(sorted(h.refine_all()), sorted(t.clone()), "{cost:?} {balanced}");
+            assert_eq!(topology(&h.base_triangles), topology(&t));
+            assert_eq!(topology(&t), (1, 1)); // a disk
+            // The grid (169 vertices) collapses to a handful.
+            assert!(h.base_triangles.len() <= 8, "{}", h.base_triangles.len());
+        }
+    }
+}
+
+#[test]
+fn sphere_round_trips_keeps_genus_and_stays_shallow_when_balanced() {
+    let (p, t) = sphere(4); // 1026 vertices, 2048 triangles
+    let plain = build_it(&p, &t, BuildOptions::default());
+    assert_eq!(sorted(plain.refine_all()), sorted(t.clone()));
+    assert_eq!(topology(&plain.base_triangles), (2, 0));
+    assert_eq!(plain.base_triangles.len(), 4); // down to a tetrahedron
+
+    let balanced = build_it(
+        &p,
+        &t,
+        BuildOptions {
+            balanced: true,
+            ..BuildOptions::default()
+        },
+    );
+    assert_eq!(sorted(balanced.refine_all()), sorted(t.clone()));
+    let (max, _) = balanced.depth_stats();
+    let bound = 3 * libm::ceil(libm::log2(p.len() as f64)) as u32;
+    assert!(max <= bound, "depth {max} > 3 log2 n = {bound}");
+}
+
+#[test]
+fn base_size_is_respected() {
+    let (p, t) = sphere(3);
+    let h = build_it(
+        &p,
+        &t,
+        BuildOptions {
+            base_vertices: 100,
+            ..BuildOptions::default()
+        },
+    );
+    assert_eq!(h.roots().count(), 100);
+    assert_eq!(sorted(h.refine_all()), sorted(t));
+}
+
+#[test]
+fn bounds_are_monotonic_and_hold_the_leaves() {
+    let (p, t) = sphere(3);
+    let h = build_it(&p, &t, BuildOptions::default());
+    for (i, node) in h.nodes.iter().enumerate() {
+        if node.parent == NONE {
+            continue;
+        }
+        let parent = &h.nodes[node.parent as usize];
+        assert!(parent.mu >= node.mu && parent.delta >= node.delta);
+        assert!(parent.spheroid[0] >= node.spheroid[0] && parent.spheroid[1] >= node.spheroid[1]);
+        assert!(parent.depth + 1 == node.depth);
+        // The parent's sphere holds the child's.
+        let d = vec3::len(vec3::sub(
+            vec3::from_f32(node.position),
+            vec3::from_f32(parent.position),
+        ));
+        assert!(d + node.radius as f64 <= parent.radius as f64 * (1.0 + 1e-6), "node {i}");
+    }
+    // Every leaf lies inside each ancestor's spheroid.
+    for leaf in 0..h.leaves {
+        let lp = vec3::from_f32(h.nodes[leaf as usize].position);
+        let mut a = h.nodes[leaf as usize].parent;
+        while a != NONE {
+            let n = &h.nodes[a as usize];
+            let d = vec3::sub(lp, vec3::from_f32(n.position));
+            let axis = vec3::from_f32(n.normal);
+            let (u, w) = (vec3::dot(d, axis), vec3::len(vec3::cross(d, axis)));
+            let [sa, sb] = n.spheroid.map(|v| v as f64);
+            let term = |x: f64, r: f64| {
+                if r > 0.0 {
+                    (x / r) * (x / r)
+                } else if x.abs() < 1e-6 {
+                    0.0
+                } else {
+                    f64::INFINITY
+                }
+            };
+            assert!(
+                term(u, sa) + term(w, sb) <= 1.0 + 1e-4,
+                "leaf {leaf} outside the spheroid of {a}"
+            );
+            a = n.parent;
+        }
+    }
+}
+
+#[test]
+fn tetrahedron_does_not_collapse() {
+    let p = [
+        [1.0, 1.0, 1.0],
+        [1.0, -1.0, -1.0],
+        [-1.0, 1.0, -1.0],
+        [-1.0, -1.0, 1.0],
+    ];
+    let t = [[0, 2, 3], [0, 3, 1], [0, 1, 2], [1, 3, 2]];
+    let h = build_it(&p, &t, BuildOptions::default());
+    assert_eq!(h.nodes.len(), 4);
+    assert_eq!(sorted(h.base_triangles.clone()), sorted(t.to_vec()));
+}
+
+#[test]
+fn isolated_vertices_become_roots() {
+    let (mut p, t) = grid(3);
+    p.push([5.0, 5.0, 5.0]);
+    let h = build_it(&p, &t, BuildOptions::default());
+    let lonely = p.len() as u32 - 1;
+    assert_eq!(h.nodes[lonely as usize].parent, NONE);
+    assert!(h.roots().any(|r| r == lonely));
+    assert_eq!(sorted(h.refine_all()), sorted(t));
+}
+
+#[test]
+fn errors_are_reported() {
+    let p = [[0.0; 3]; 3];
+    let mesh = InputMesh {
+        positions: &p,
+        colors: None,
+        triangles: &[[0, 1, 1]],
+    };
+    assert_eq!(
+        build(&mesh, &BuildOptions::default(), &mut |_| {}),
+        Err(BuildError::DegenerateTriangle { triangle: 0 })
+    );
+}
