@@ -85,8 +85,8 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, e: Engine<'_>) -> Hierarchy {
             }
         }
     }
-    for v in 0..leaves {
-        axis[v] = normalize(axis[v]).unwrap_or([0.0, 0.0, 1.0]);
+    for a in axis.iter_mut().take(leaves) {
+        *a = normalize(*a).unwrap_or([0.0, 0.0, 1.0]);
     }
     for (t, n) in mesh.triangles.iter().zip(&face_normals) {
         for &v in t {
@@ -98,9 +98,13 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, e: Engine<'_>) -> Hierarchy {
     for c in &e.collapses {
         let p = c.parent as usize;
         let [a, b] = c.children.map(|x| x as usize);
-        radius[p] = (len(sub(pos[a], pos[p])) + radius[a]).max(len(sub(pos[b], pos[p])) + radius[b]);
+        radius[p] =
+            (len(sub(pos[a], pos[p])) + radius[a]).max(len(sub(pos[b], pos[p])) + radius[b]);
         weight[p] = weight[a] + weight[b];
-        let sum = add(scale(axis[a], weight[a].max(1e-30)), scale(axis[b], weight[b].max(1e-30)));
+        let sum = add(
+            scale(axis[a], weight[a].max(1e-30)),
+            scale(axis[b], weight[b].max(1e-30)),
+        );
         axis[p] = normalize(sum).unwrap_or(axis[a]);
         half[p] = (angle(axis[p], axis[a]) + half[a]).max(angle(axis[p], axis[b]) + half[b]);
     }

@@ -41,6 +41,8 @@ pub(crate) struct Engine<'o> {
     pub alive_count: usize,
     heap: BinaryHeap<Reverse<(u64, u32, u32)>>,
     deferred: Vec<(u32, u32)>,
+    /// Edges found illegal, by endpoint: retried when a collapse changes that endpoint's ring.
+    rejected: Vec<Vec<u32>>,
     pub collapses: Vec<Collapse>,
     /// Neighbours of each parent when it formed (the merge-tree paper's dependencies, §3.2).
     pub deps: Vec<Vec<u32>>,
@@ -93,6 +95,7 @@ impl<'o> Engine<'o> {
             vfaces,
             heap: BinaryHeap::new(),
             deferred: Vec::new(),
+            rejected: vec![Vec::new(); n],
             collapses: Vec::new(),
             deps: Vec::new(),
         };
@@ -153,10 +156,10 @@ impl<'o> Engine<'o> {
         (wings, count)
     }
 
+    /// In a manifold fan an inner vertex has as many triangles as neighbours, a border vertex one
+    /// fewer.
     fn is_boundary_vertex(&self, v: u32) -> bool {
-        self.neighbours(v)
-            .into_iter()
-            .any(|x| self.edge_faces(v, x).1 == 1)
+        self.vfaces[v as usize].len() < self.neighbours(v).len()
     }
 
     fn boundary_neighbours(&self, v: u32) -> Vec<u32> {
@@ -193,7 +196,11 @@ impl<'o> Engine<'o> {
         let (a, b) = (a.min(b), a.max(b));
         let (_, cost) = self.evaluate(a, b);
         // Non-negative doubles order like their bit patterns.
-        let key = if cost.is_finite() { cost.max(0.0) } else { f64::MAX };
+        let key = if cost.is_finite() {
+            cost.max(0.0)
+        } else {
+            f64::MAX
+        };
         self.heap.push(Reverse((key.to_bits(), a, b)));
     }
 
@@ -204,9 +211,23 @@ impl<'o> Engine<'o> {
         if count == 0 {
             return Ok(false);
         }
+        if self.opts.balanced {
+            // Cheapest test first: blocked edges wait for the next pass anyway.
+            let touched = self.vfaces[a as usize]
+                .iter()
+                .chain(&self.vfaces[b as usize])
+                .any(|&f| self.marked[f as usize]);
+            if touched {
+                return Err(());
+            }
+        }
         let (na, nb) = (self.neighbours(a), self.neighbours(b));
         // Link condition: the common neighbours are exactly the wings.
-        let common: Vec<u32> = na.iter().copied().filter(|x| nb.binary_search(x).is_ok()).collect();
+        let common: Vec<u32> = na
+            .iter()
+            .copied()
+            .filter(|x| nb.binary_search(x).is_ok())
+            .collect();
         let mut w: Vec<u32> = wings.iter().copied().filter(|&x| x != NONE).collect();
         w.sort_unstable();
         if common != w {
@@ -219,8 +240,16 @@ impl<'o> Engine<'o> {
         }
         if edge_on_border {
             // A border loop of three edges would close up.
-            let oa: Vec<u32> = self.boundary_neighbours(a).into_iter().filter(|&x| x != b).collect();
-            let ob: Vec<u32> = self.boundary_neighbours(b).into_iter().filter(|&x| x != a).collect();
+            let oa: Vec<u32> = self
+                .boundary_neighbours(a)
+                .into_iter()
+                .filter(|&x| x != b)
+                .collect();
+            let ob: Vec<u32> = self
+                .boundary_neighbours(b)
+                .into_iter()
+                .filter(|&x| x != a)
+                .collect();
             if oa.iter().any(|x| ob.contains(x)) {
                 return Ok(false);
             }
@@ -249,18 +278,10 @@ impl<'o> Engine<'o> {
                 let moved = t.map(|i| if i == s { v } else { self.pos[i as usize] });
                 let after = cross(sub(moved[1], moved[0]), sub(moved[2], moved[0]));
                 let (lb, la) = (len(before), len(after));
-                if !(la > 1e-12 * lb) || dot(before, after) <= 0.0 {
+                let kept = la > 1e-12 * lb && dot(before, after) > 0.0;
+                if !kept {
                     return Ok(false);
                 }
-            }
-        }
-        if self.opts.balanced {
-            let touched = self.vfaces[a as usize]
-                .iter()
-                .chain(&self.vfaces[b as usize])
-                .any(|&f| self.marked[f as usize]);
-            if touched {
-                return Err(());
             }
         }
         Ok(true)
@@ -291,7 +312,10 @@ impl<'o> Engine<'o> {
                     self.collapse(a, b, v);
                     return true;
                 }
-                Ok(false) => {}
+                Ok(false) => {
+                    self.rejected[a as usize].push(b);
+                    self.rejected[b as usize].push(a);
+                }
                 Err(()) => self.deferred.push((a, b)),
             }
         }
@@ -325,7 +349,11 @@ impl<'o> Engine<'o> {
                 if t.contains(&a) && t.contains(&b) {
                     if self.face_alive[f as usize] {
                         self.face_alive[f as usize] = false;
-                        let third = t.iter().copied().find(|&x| x != a && x != b).unwrap_or(NONE);
+                        let third = t
+                            .iter()
+                            .copied()
+                            .find(|&x| x != a && x != b)
+                            .unwrap_or(NONE);
                         if let Some(list) = self.vfaces.get_mut(third as usize) {
                             list.retain(|&g| g != f);
                         }
@@ -357,13 +385,17 @@ impl<'o> Engine<'o> {
             children,
             wings,
         });
+        self.rejected.push(Vec::new());
+        self.rejected[ia].clear();
+        self.rejected[ib].clear();
         let ring = self.neighbours(p);
         self.deps.push(ring.clone());
-        // Fresh costs around p; the neighbours' other edges may have become legal.
+        // Fresh costs for the edges of p (no other edge's cost changed); edges around it that were
+        // illegal may have become legal.
         for &x in &ring {
             self.push(p, x);
-            for y in self.neighbours(x) {
-                if y != p && x < y {
+            for y in core::mem::take(&mut self.rejected[x as usize]) {
+                if self.alive[y as usize] {
                     self.push(x, y);
                 }
             }

@@ -88,7 +88,10 @@ impl fmt::Display for BuildError {
                 write!(f, "vertex {vertex} has a NaN or infinite coordinate")
             }
             BuildError::IndexOutOfRange { triangle, index } => {
-                write!(f, "triangle {triangle} uses vertex {index}, which does not exist")
+                write!(
+                    f,
+                    "triangle {triangle} uses vertex {index}, which does not exist"
+                )
             }
             BuildError::DegenerateTriangle { triangle } => {
                 write!(f, "triangle {triangle} uses a vertex twice")
@@ -97,7 +100,10 @@ impl fmt::Display for BuildError {
                 write!(f, "triangle {triangle} repeats triangle {first}")
             }
             BuildError::NonManifoldEdge { a, b } => {
-                write!(f, "edge {a}-{b} belongs to more than two triangles (non-manifold)")
+                write!(
+                    f,
+                    "edge {a}-{b} belongs to more than two triangles (non-manifold)"
+                )
             }
             BuildError::InconsistentOrientation { a, b } => write!(
                 f,

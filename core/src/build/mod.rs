@@ -243,7 +243,7 @@ pub fn build(
     progress(Progress { done, total });
     while engine.alive_count > target && engine.step() {
         done += 1;
-        if done % step == 0 {
+        if done.is_multiple_of(step) {
             progress(Progress { done, total });
         }
     }

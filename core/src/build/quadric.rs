@@ -91,7 +91,8 @@ impl Quadric {
         let rhs = [-q[3], -q[6], -q[8]];
         let det = dot(m[0], cross(m[1], m[2]));
         let scale_ = (q[0] + q[4] + q[7]).abs();
-        if !(det.abs() > 1e-12 * scale_ * scale_ * scale_) || !det.is_finite() {
+        let conditioned = det.abs() > 1e-12 * scale_ * scale_ * scale_ && det.is_finite();
+        if !conditioned {
             return None;
         }
         // Cramer's rule.
@@ -150,6 +151,9 @@ mod tests {
         // One plane only: no unique optimum; placement falls back to the best candidate.
         let flat = Quadric::plane([0.0, 0.0, 1.0], 0.0, 1.0);
         assert!(flat.optimum().is_none());
-        assert_eq!(place(&flat, [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]), [0.0, 0.0, 0.0]);
+        assert_eq!(
+            place(&flat, [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]),
+            [0.0, 0.0, 0.0]
+        );
     }
 }

@@ -13,7 +13,8 @@ pub fn topology(triangles: &[[u32; 3]]) -> (i64, usize) {
         .iter()
         .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
         .collect();
-    let mut undirected: Vec<(u32, u32)> = edges.iter().map(|&(a, b)| (a.min(b), a.max(b))).collect();
+    let mut undirected: Vec<(u32, u32)> =
+        edges.iter().map(|&(a, b)| (a.min(b), a.max(b))).collect();
     undirected.sort_unstable();
     undirected.dedup();
     edges.sort_unstable();
@@ -133,11 +134,23 @@ fn open_grid_round_trips_and_keeps_its_border() {
     let (p, t) = grid(12);
     for cost in [Cost::Quadric, Cost::ShortestEdge, Cost::Color] {
         for balanced in [false, true] {
-            let h = build_it(&p, &t, BuildOptions { cost, balanced, base_vertices: 0 });
-            assert_eq!(sorted(h.refine_all()), sorted(t.clone()), "{cost:?} {balanced}");
+            let h = build_it(
+                &p,
+                &t,
+                BuildOptions {
+                    cost,
+                    balanced,
+                    base_vertices: 0,
+                },
+            );
+            assert_eq!(
+                sorted(h.refine_all()),
+                sorted(t.clone()),
+                "{cost:?} {balanced}"
+            );
             assert_eq!(topology(&h.base_triangles), topology(&t));
             assert_eq!(topology(&t), (1, 1)); // a disk
-            // The grid (169 vertices) collapses to a handful.
+                                              // The grid (169 vertices) collapses to a handful.
             assert!(h.base_triangles.len() <= 8, "{}", h.base_triangles.len());
         }
     }
@@ -197,7 +210,10 @@ fn bounds_are_monotonic_and_hold_the_leaves() {
             vec3::from_f32(node.position),
             vec3::from_f32(parent.position),
         ));
-        assert!(d + node.radius as f64 <= parent.radius as f64 * (1.0 + 1e-6), "node {i}");
+        assert!(
+            d + node.radius as f64 <= parent.radius as f64 * (1.0 + 1e-6),
+            "node {i}"
+        );
     }
     // Every leaf lies inside each ancestor's spheroid.
     for leaf in 0..h.leaves {

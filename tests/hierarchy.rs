@@ -1,0 +1,136 @@
+//! The hierarchy builder on the fixtures: exact round trips, topology kept, forest depth.
+
+use vdlod_core::build::{build, rotate_to_min, BuildOptions, Cost, Hierarchy, InputMesh, NONE};
+use vdlod_demo::mesh::{
+    load_obj, load_obj_bytes, IndexedMesh, BUNNY_NAME, BUNNY_OBJ, COW_NAME, COW_OBJ,
+};
+
+fn fixture(name: &str) -> IndexedMesh {
+    load_obj(
+        &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("fixtures")
+            .join(name),
+    )
+    .unwrap()
+}
+
+fn sorted(t: &[[u32; 3]]) -> Vec<[u32; 3]> {
+    let mut t: Vec<[u32; 3]> = t.iter().map(|&t| rotate_to_min(t)).collect();
+    t.sort_unstable();
+    t
+}
+
+/// Euler characteristic and number of border loops.
+fn topology(triangles: &[[u32; 3]]) -> (i64, usize) {
+    use std::collections::{BTreeMap, BTreeSet};
+    let verts: BTreeSet<u32> = triangles.iter().flatten().copied().collect();
+    let directed: BTreeSet<(u32, u32)> = triangles
+        .iter()
+        .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
+        .collect();
+    let undirected: BTreeSet<(u32, u32)> = directed
+        .iter()
+        .map(|&(a, b)| (a.min(b), a.max(b)))
+        .collect();
+    let border: BTreeMap<u32, u32> = directed
+        .iter()
+        .filter(|&&(a, b)| !directed.contains(&(b, a)))
+        .map(|&(a, b)| (a, b))
+        .collect();
+    let mut seen = BTreeSet::new();
+    let mut loops = 0;
+    for &start in border.keys() {
+        if seen.contains(&start) {
+            continue;
+        }
+        loops += 1;
+        let mut v = start;
+        while seen.insert(v) {
+            v = border[&v];
+        }
+    }
+    let chi = verts.len() as i64 - undirected.len() as i64 + triangles.len() as i64;
+    (chi, loops)
+}
+
+fn hierarchy(mesh: &IndexedMesh, opts: BuildOptions) -> Hierarchy {
+    let input = InputMesh {
+        positions: &mesh.positions,
+        colors: mesh.colors.as_deref(),
+        triangles: &mesh.triangles,
+    };
+    build(&input, &opts, &mut |_| {}).expect("fixture builds")
+}
+
+fn check_round_trip(mesh: &IndexedMesh, opts: BuildOptions) -> Hierarchy {
+    let h = hierarchy(mesh, opts);
+    assert_eq!(sorted(&h.refine_all()), sorted(&mesh.triangles), "{opts:?}");
+    assert_eq!(
+        topology(&h.base_triangles),
+        topology(&mesh.triangles),
+        "{opts:?}"
+    );
+    h
+}
+
+#[test]
+fn cow_round_trips_with_every_cost() {
+    let cow = load_obj_bytes(COW_NAME, COW_OBJ).unwrap();
+    for cost in [Cost::Quadric, Cost::ShortestEdge, Cost::Color] {
+        let h = check_round_trip(
+            &cow,
+            BuildOptions {
+                cost,
+                ..BuildOptions::default()
+            },
+        );
+        assert!(
+            h.base_triangles.len() < 100,
+            "{cost:?}: {}",
+            h.base_triangles.len()
+        );
+    }
+}
+
+#[test]
+fn open_and_higher_genus_meshes_keep_their_topology() {
+    let head = fixture("head.obj");
+    assert_eq!(topology(&head.triangles), (-1, 3)); // genus 0 with three holes
+    let elk = fixture("elk.obj");
+    assert_eq!(topology(&elk.triangles), (0, 0)); // genus 1
+    for mesh in [&head, &elk] {
+        for cost in [Cost::Quadric, Cost::ShortestEdge] {
+            for balanced in [false, true] {
+                check_round_trip(
+                    mesh,
+                    BuildOptions {
+                        cost,
+                        balanced,
+                        base_vertices: 0,
+                    },
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn bunny_round_trips_keeps_topology_and_is_shallow_when_balanced() {
+    let bunny = load_obj_bytes(BUNNY_NAME, BUNNY_OBJ).unwrap();
+    assert_eq!(topology(&bunny.triangles), (2, 0)); // closed, genus 0
+    let h = check_round_trip(
+        &bunny,
+        BuildOptions {
+            balanced: true,
+            ..BuildOptions::default()
+        },
+    );
+    let (max, mean) = h.depth_stats();
+    let log2n = (bunny.positions.len() as f64).log2();
+    // Balanced forests: depth within a small multiple of log2(n) (15.2 for the bunny).
+    assert!(
+        f64::from(max) <= 3.0 * log2n,
+        "max depth {max}, mean {mean:.1}"
+    );
+    assert!(h.roots().all(|r| h.nodes[r as usize].parent == NONE));
+}
