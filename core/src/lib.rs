@@ -13,3 +13,4 @@ extern crate alloc;
 
 #[cfg(feature = "build")]
 pub mod build;
+pub mod format;

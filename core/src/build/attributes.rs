@@ -17,6 +17,7 @@ use alloc::vec::Vec;
 use super::collapse::Engine;
 use super::vec3::{add, cross, dot, from_f32, len, normalize, scale, sub, Vec3d};
 use super::{Hierarchy, InputMesh, Node, NONE};
+use crate::format::{oct_decode, oct_encode};
 
 fn to_f32(v: Vec3d) -> [f32; 3] {
     v.map(|c| c as f32)
@@ -30,6 +31,13 @@ fn up(v: f64) -> f32 {
     } else {
         f
     }
+}
+
+/// The axis as the file stores it (8-bit octahedral), so that bounds measured against it hold for
+/// what a device reads.
+fn quantized_axis(a: Vec3d) -> Vec3d {
+    let (x, y) = oct_encode(to_f32(a));
+    from_f32(oct_decode(x, y))
 }
 
 /// Angle between two unit vectors.
@@ -86,7 +94,7 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, e: Engine<'_>) -> Hierarchy {
         }
     }
     for a in axis.iter_mut().take(leaves) {
-        *a = normalize(*a).unwrap_or([0.0, 0.0, 1.0]);
+        *a = quantized_axis(normalize(*a).unwrap_or([0.0, 0.0, 1.0]));
     }
     for (t, n) in mesh.triangles.iter().zip(&face_normals) {
         for &v in t {
@@ -105,7 +113,7 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, e: Engine<'_>) -> Hierarchy {
             scale(axis[a], weight[a].max(1e-30)),
             scale(axis[b], weight[b].max(1e-30)),
         );
-        axis[p] = normalize(sum).unwrap_or(axis[a]);
+        axis[p] = quantized_axis(normalize(sum).unwrap_or(axis[a]));
         half[p] = (angle(axis[p], axis[a]) + half[a]).max(angle(axis[p], axis[b]) + half[b]);
     }
 

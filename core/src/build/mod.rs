@@ -42,6 +42,7 @@ mod collapse;
 mod input;
 mod quadric;
 mod vec3;
+mod write;
 
 use alloc::vec::Vec;
 

@@ -281,3 +281,60 @@ fn errors_are_reported() {
         Err(BuildError::DegenerateTriangle { triangle: 0 })
     );
 }
+
+#[test]
+fn bytes_round_trip_through_the_format() {
+    use crate::format::{FormatError, HierarchyView};
+    let (p, t) = grid(6);
+    let h = build_it(&p, &t, BuildOptions::default());
+    let bytes = h.to_bytes(false);
+    let view = HierarchyView::parse(&bytes).expect("valid");
+    assert_eq!(view.leaves(), h.leaves);
+    assert_eq!(view.nodes() as usize, h.nodes.len());
+    for (i, n) in h.nodes.iter().enumerate() {
+        let v = view.node(i as u32);
+        assert_eq!(v.position, n.position);
+        assert_eq!(v.parent, n.parent);
+        assert_eq!(v.depth, n.depth);
+        // Bounds are rounded up, never down.
+        assert!(v.radius >= n.radius && v.mu >= n.mu && v.delta >= n.delta);
+        assert!(v.spheroid[0] >= n.spheroid[0] && v.spheroid[1] >= n.spheroid[1]);
+        assert!(v.cone_sin >= n.cone_sin.min(1.0));
+        if n.parent != NONE {
+            let s = view.split(n.parent);
+            assert!(s.children.contains(&(i as u32)));
+        }
+    }
+    for p in h.leaves..h.nodes.len() as u32 {
+        let s = view.split(p);
+        let n = &h.nodes[p as usize];
+        assert_eq!((s.children, s.wings), (n.children, n.wings));
+        let deps: Vec<u32> = (s.dependencies.0..s.dependencies.1)
+            .map(|d| view.dependency(d))
+            .collect();
+        assert_eq!(deps, n.dependencies);
+    }
+    let base: Vec<[u32; 3]> = (0..view.base_triangles())
+        .map(|k| view.base_triangle(k))
+        .collect();
+    assert_eq!(base, h.base_triangles);
+
+    // One flipped bit anywhere after the header breaks the checksum.
+    let mut bad = bytes.clone();
+    bad[bytes.len() / 2] ^= 0x10;
+    assert!(matches!(
+        HierarchyView::parse(&bad),
+        Err(FormatError::Checksum { .. })
+    ));
+    // Truncation and trailing bytes are caught before anything is read.
+    assert!(matches!(
+        HierarchyView::parse(&bytes[..bytes.len() - 1]),
+        Err(FormatError::Truncated { .. })
+    ));
+    let mut long = bytes.clone();
+    long.push(0);
+    assert!(matches!(
+        HierarchyView::parse(&long),
+        Err(FormatError::TrailingBytes { .. })
+    ));
+}

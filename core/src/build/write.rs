@@ -1,0 +1,73 @@
+//! Writing a [`Hierarchy`] in the format [`crate::format`] reads.
+
+use alloc::vec::Vec;
+
+use super::Hierarchy;
+use crate::format::{
+    crc32, f32_to_f16_up, oct_encode, FLAG_COLORS, HEADER_SIZE, MAGIC, NODE_SIZE, SPLIT_SIZE,
+    VERSION,
+};
+
+impl Hierarchy {
+    /// The hierarchy as bytes for [`crate::format::HierarchyView::parse`]. `colors` sets the
+    /// header flag saying the nodes' colours mean something.
+    pub fn to_bytes(&self, colors: bool) -> Vec<u8> {
+        let parents = self.nodes.len() - self.leaves as usize;
+        let deps: usize = self.nodes.iter().map(|n| n.dependencies.len()).sum();
+        let size = HEADER_SIZE
+            + self.nodes.len() * NODE_SIZE
+            + parents * SPLIT_SIZE
+            + 4
+            + deps * 4
+            + self.base_triangles.len() * 12;
+        let mut out = Vec::with_capacity(size);
+        out.extend_from_slice(&MAGIC);
+        out.extend_from_slice(&VERSION.to_le_bytes());
+        out.extend_from_slice(&(if colors { FLAG_COLORS } else { 0 }).to_le_bytes());
+        for count in [
+            self.leaves,
+            self.nodes.len() as u32,
+            self.base_triangles.len() as u32,
+            deps as u32,
+        ] {
+            out.extend_from_slice(&count.to_le_bytes());
+        }
+        out.extend_from_slice(&[0u8; 16]); // checksum, then reserved
+        for n in &self.nodes {
+            for c in n.position {
+                out.extend_from_slice(&c.to_le_bytes());
+            }
+            for b in [n.radius, n.mu, n.delta, n.spheroid[0], n.spheroid[1]] {
+                out.extend_from_slice(&f32_to_f16_up(b).to_le_bytes());
+            }
+            let (x, y) = oct_encode(n.normal);
+            out.extend_from_slice(&[x as u8, y as u8]);
+            out.push(libm::ceilf(n.cone_sin.clamp(0.0, 1.0) * 255.0) as u8);
+            out.extend_from_slice(&n.color);
+            out.extend_from_slice(&n.depth.to_le_bytes());
+            out.extend_from_slice(&n.parent.to_le_bytes());
+        }
+        let mut first = 0u32;
+        for n in &self.nodes[self.leaves as usize..] {
+            for v in [n.children[0], n.children[1], n.wings[0], n.wings[1], first] {
+                out.extend_from_slice(&v.to_le_bytes());
+            }
+            first += n.dependencies.len() as u32;
+        }
+        out.extend_from_slice(&first.to_le_bytes());
+        for n in &self.nodes[self.leaves as usize..] {
+            for d in &n.dependencies {
+                out.extend_from_slice(&d.to_le_bytes());
+            }
+        }
+        for t in &self.base_triangles {
+            for v in t {
+                out.extend_from_slice(&v.to_le_bytes());
+            }
+        }
+        debug_assert_eq!(out.len(), size);
+        let crc = crc32(&out[HEADER_SIZE..]);
+        out[24..28].copy_from_slice(&crc.to_le_bytes());
+        out
+    }
+}

@@ -1,0 +1,590 @@
+//! The hierarchy file format, read in place from `&[u8]` without allocating.
+//!
+//! A device keeps the bytes in flash (`include_bytes!`) and reads them through a [`HierarchyView`]:
+//! [`HierarchyView::parse`] checks everything once (sizes, magic, version, checksum, every index in
+//! range, parent links acyclic and consistent with the children, floats finite) so that hostile or
+//! corrupted bytes give a [`FormatError`], never a panic; afterwards every accessor is a bounds-safe
+//! little-endian read.
+//!
+//! Layout, all little-endian, sections back to back in this order (`docs` in the module source
+//! gives each field's offset):
+//!
+//! | section | size | content |
+//! |---|---|---|
+//! | header | 40 | magic `VDLH`, version `u16` = 1, flags `u16` (bit 0: colours present), `leaves`, `nodes`, `base_triangles`, `dependencies` (`u32` each), CRC-32 of everything after the header (`u32`), 12 reserved zero bytes |
+//! | nodes | 34 per node | position `3 x f32`; radius, `mu`, `delta`, spheroid `a`, `b` as `f16` rounded up; normal octahedral `2 x i8`; cone sine `u8` (`ceil(255 sin)`, 255: no useful cone); colour `3 x u8`; depth `u16`; parent `u32` (`0xFFFF_FFFF` for a root) |
+//! | splits | 20 per parent | children `2 x u32`, wings `2 x u32` (second `0xFFFF_FFFF` on a border), first dependency `u32` |
+//! | dependency end | 4 | one past the last parent's dependencies |
+//! | dependencies | 4 each | node ids |
+//! | base triangles | 12 each | `3 x u32` root ids, counter-clockwise |
+//!
+//! Nodes `0..leaves` are the input vertices; nodes `leaves..nodes` are parents, each with a larger
+//! id than its children, so parent links can never form a cycle.
+
+use core::fmt;
+
+/// First four bytes of a hierarchy file.
+pub const MAGIC: [u8; 4] = *b"VDLH";
+/// The version this crate reads and writes.
+pub const VERSION: u16 = 1;
+/// Header size in bytes.
+pub const HEADER_SIZE: usize = 40;
+/// Bytes per node record.
+pub const NODE_SIZE: usize = 34;
+/// Bytes per split record.
+pub const SPLIT_SIZE: usize = 20;
+/// "No node" in parent and wing fields.
+pub const NONE: u32 = u32::MAX;
+/// Header flag: the nodes carry meaningful colours.
+pub const FLAG_COLORS: u16 = 1;
+
+/// Why bytes are not a valid hierarchy.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FormatError {
+    /// Shorter than the header, or than the header says the sections need.
+    Truncated {
+        /// Bytes needed.
+        needed: u64,
+        /// Bytes given.
+        actual: u64,
+    },
+    /// Longer than the sections need.
+    TrailingBytes {
+        /// Bytes needed.
+        needed: u64,
+        /// Bytes given.
+        actual: u64,
+    },
+    /// Not a hierarchy file.
+    BadMagic,
+    /// A version this crate does not read.
+    UnsupportedVersion(u16),
+    /// The counts in the header contradict each other.
+    BadCounts,
+    /// The checksum does not match: the bytes were corrupted.
+    Checksum {
+        /// Stored CRC-32.
+        stored: u32,
+        /// Computed CRC-32.
+        computed: u32,
+    },
+    /// A node's field is out of range or inconsistent.
+    BadNode {
+        /// The node.
+        node: u32,
+        /// What is wrong.
+        what: &'static str,
+    },
+    /// A dependency or base triangle refers to a missing or non-root node.
+    BadReference {
+        /// The section.
+        section: &'static str,
+        /// The entry.
+        index: u32,
+    },
+}
+
+impl fmt::Display for FormatError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            FormatError::Truncated { needed, actual } => {
+                write!(f, "truncated: {actual} bytes, {needed} needed")
+            }
+            FormatError::TrailingBytes { needed, actual } => {
+                write!(f, "{actual} bytes, but the header describes {needed}")
+            }
+            FormatError::BadMagic => write!(f, "not a vdlod hierarchy (bad magic)"),
+            FormatError::UnsupportedVersion(v) => {
+                write!(f, "format version {v}, this build reads version {VERSION}")
+            }
+            FormatError::BadCounts => write!(f, "inconsistent counts in the header"),
+            FormatError::Checksum { stored, computed } => write!(
+                f,
+                "checksum mismatch (stored {stored:08x}, computed {computed:08x}): corrupted"
+            ),
+            FormatError::BadNode { node, what } => write!(f, "node {node}: {what}"),
+            FormatError::BadReference { section, index } => {
+                write!(f, "{section} entry {index} refers to an invalid node")
+            }
+        }
+    }
+}
+
+impl core::error::Error for FormatError {}
+
+const CRC_TABLE: [u32; 256] = {
+    let mut table = [0u32; 256];
+    let mut i = 0;
+    while i < 256 {
+        let mut c = i as u32;
+        let mut k = 0;
+        while k < 8 {
+            c = if c & 1 != 0 {
+                0xEDB8_8320 ^ (c >> 1)
+            } else {
+                c >> 1
+            };
+            k += 1;
+        }
+        table[i] = c;
+        i += 1;
+    }
+    table
+};
+
+/// CRC-32 (IEEE 802.3, as in zip and PNG).
+pub fn crc32(bytes: &[u8]) -> u32 {
+    !bytes.iter().fold(!0u32, |c, &b| {
+        CRC_TABLE[((c ^ b as u32) & 0xFF) as usize] ^ (c >> 8)
+    })
+}
+
+/// Decodes an IEEE half-precision float.
+pub fn f16_to_f32(h: u16) -> f32 {
+    let sign = ((h >> 15) as u32) << 31;
+    let exp = ((h >> 10) & 0x1F) as u32;
+    let man = (h & 0x3FF) as u32;
+    let bits = match exp {
+        0 => {
+            // Zero or subnormal: man * 2^-24.
+            let v = man as f32 * (1.0 / 16_777_216.0);
+            return if sign != 0 { -v } else { v };
+        }
+        31 => sign | 0x7F80_0000 | (man << 13),
+        _ => sign | ((exp + 112) << 23) | (man << 13),
+    };
+    f32::from_bits(bits)
+}
+
+/// The smallest half-precision value not below `v` (for non-negative finite `v`; NaN and negative
+/// values give 0, values beyond the half range give infinity, which [`HierarchyView::parse`]
+/// rejects).
+pub fn f32_to_f16_up(v: f32) -> u16 {
+    if v.is_nan() || v <= 0.0 {
+        return 0;
+    }
+    if v > 65504.0 {
+        return 0x7C00;
+    }
+    // Start from truncation, then step up while below.
+    let bits = v.to_bits();
+    let exp = ((bits >> 23) & 0xFF) as i32 - 127;
+    let mut h: u16 = if exp < -14 {
+        // Subnormal half: units of 2^-24.
+        (v * 16_777_216.0) as u16
+    } else {
+        (((exp + 15) as u16) << 10) | ((bits >> 13) & 0x3FF) as u16
+    };
+    while f16_to_f32(h) < v {
+        h += 1;
+    }
+    h
+}
+
+/// A validated hierarchy, borrowed in place.
+#[derive(Clone, Copy, Debug)]
+pub struct HierarchyView<'a> {
+    bytes: &'a [u8],
+    flags: u16,
+    leaves: u32,
+    nodes: u32,
+    base_triangles: u32,
+    dependencies: u32,
+}
+
+/// One node, read from a [`HierarchyView`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NodeView {
+    /// Position.
+    pub position: [f32; 3],
+    /// Bounding-sphere radius of the node's region and all its descendants'.
+    pub radius: f32,
+    /// Hoppe's uniform deviation (across the normal).
+    pub mu: f32,
+    /// Hoppe's normal deviation (along the normal).
+    pub delta: f32,
+    /// The wavelet paper's spheroid `[a, b]`.
+    pub spheroid: [f32; 2],
+    /// Cone axis (unit length, decoded from 8-bit octahedral coordinates).
+    pub normal: [f32; 3],
+    /// Sine of the cone's half-angle, rounded up; 1 when the cone bounds nothing.
+    pub cone_sin: f32,
+    /// Colour.
+    pub color: [u8; 3],
+    /// Depth in the forest (0 for roots).
+    pub depth: u16,
+    /// Parent, or [`NONE`].
+    pub parent: u32,
+}
+
+/// One parent's split record.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SplitView {
+    /// The two children.
+    pub children: [u32; 2],
+    /// The wings; the second is [`NONE`] on a border.
+    pub wings: [u32; 2],
+    /// Range of this parent's dependencies in [`HierarchyView::dependency`].
+    pub dependencies: (u32, u32),
+}
+
+#[inline]
+fn u16_at(b: &[u8], o: usize) -> u16 {
+    match b.get(o..o + 2) {
+        Some(s) => u16::from_le_bytes([s[0], s[1]]),
+        None => 0,
+    }
+}
+
+#[inline]
+fn u32_at(b: &[u8], o: usize) -> u32 {
+    match b.get(o..o + 4) {
+        Some(s) => u32::from_le_bytes([s[0], s[1], s[2], s[3]]),
+        None => NONE,
+    }
+}
+
+#[inline]
+fn f32_at(b: &[u8], o: usize) -> f32 {
+    f32::from_bits(u32_at(b, o))
+}
+
+/// Encodes a unit vector as octahedral coordinates in `[-127, 127]` (nearest).
+pub fn oct_encode(n: [f32; 3]) -> (i8, i8) {
+    let l1 = n[0].abs() + n[1].abs() + n[2].abs();
+    if !(l1 > 0.0) || !l1.is_finite() {
+        return (0, 0);
+    }
+    let (mut u, mut v) = (n[0] / l1, n[1] / l1);
+    if n[2] < 0.0 {
+        let (ou, ov) = (u, v);
+        u = (1.0 - ov.abs()) * if ou >= 0.0 { 1.0 } else { -1.0 };
+        v = (1.0 - ou.abs()) * if ov >= 0.0 { 1.0 } else { -1.0 };
+    }
+    let q = |x: f32| libm::roundf(x.clamp(-1.0, 1.0) * 127.0) as i8;
+    (q(u), q(v))
+}
+
+/// Decodes octahedral coordinates in `[-127, 127]` to a unit vector.
+pub fn oct_decode(x: i8, y: i8) -> [f32; 3] {
+    let (mut u, mut v) = (x as f32 / 127.0, y as f32 / 127.0);
+    let z = 1.0 - u.abs() - v.abs();
+    if z < 0.0 {
+        let (ou, ov) = (u, v);
+        u = (1.0 - ov.abs()) * if ou >= 0.0 { 1.0 } else { -1.0 };
+        v = (1.0 - ou.abs()) * if ov >= 0.0 { 1.0 } else { -1.0 };
+    }
+    let l = libm::sqrtf(u * u + v * v + z * z);
+    if l > 0.0 {
+        [u / l, v / l, z / l]
+    } else {
+        [0.0, 0.0, 1.0]
+    }
+}
+
+impl<'a> HierarchyView<'a> {
+    /// Byte offsets of the sections: nodes, splits, dependency end, dependencies, base, total.
+    fn layout(leaves: u32, nodes: u32, deps: u32, base: u32) -> [u64; 6] {
+        let n = HEADER_SIZE as u64;
+        let s = n + nodes as u64 * NODE_SIZE as u64;
+        let de = s + (nodes as u64 - leaves as u64) * SPLIT_SIZE as u64;
+        let d = de + 4;
+        let b = d + deps as u64 * 4;
+        let end = b + base as u64 * 12;
+        [n, s, de, d, b, end]
+    }
+
+    fn offsets(&self) -> [usize; 6] {
+        Self::layout(
+            self.leaves,
+            self.nodes,
+            self.dependencies,
+            self.base_triangles,
+        )
+        .map(|o| o as usize)
+    }
+
+    /// Validates `bytes` and returns a view of them.
+    pub fn parse(bytes: &'a [u8]) -> Result<HierarchyView<'a>, FormatError> {
+        if bytes.len() < HEADER_SIZE {
+            return Err(FormatError::Truncated {
+                needed: HEADER_SIZE as u64,
+                actual: bytes.len() as u64,
+            });
+        }
+        if bytes[0..4] != MAGIC {
+            return Err(FormatError::BadMagic);
+        }
+        let version = u16_at(bytes, 4);
+        if version != VERSION {
+            return Err(FormatError::UnsupportedVersion(version));
+        }
+        let view = HierarchyView {
+            bytes,
+            flags: u16_at(bytes, 6),
+            leaves: u32_at(bytes, 8),
+            nodes: u32_at(bytes, 12),
+            base_triangles: u32_at(bytes, 16),
+            dependencies: u32_at(bytes, 20),
+        };
+        if view.nodes < view.leaves
+            || view.nodes - view.leaves > view.leaves
+            || view.nodes == NONE
+            || view.flags & !FLAG_COLORS != 0
+            || bytes[28..40].iter().any(|&b| b != 0)
+        {
+            return Err(FormatError::BadCounts);
+        }
+        let end = Self::layout(
+            view.leaves,
+            view.nodes,
+            view.dependencies,
+            view.base_triangles,
+        )[5];
+        let actual = bytes.len() as u64;
+        if actual < end {
+            return Err(FormatError::Truncated {
+                needed: end,
+                actual,
+            });
+        }
+        if actual > end {
+            return Err(FormatError::TrailingBytes {
+                needed: end,
+                actual,
+            });
+        }
+        let stored = u32_at(bytes, 24);
+        let computed = crc32(&bytes[HEADER_SIZE..]);
+        if stored != computed {
+            return Err(FormatError::Checksum { stored, computed });
+        }
+        view.check_nodes()?;
+        view.check_splits()?;
+        view.check_base()?;
+        Ok(view)
+    }
+
+    fn check_nodes(&self) -> Result<(), FormatError> {
+        for i in 0..self.nodes {
+            let bad = |what| Err(FormatError::BadNode { node: i, what });
+            let n = self.node(i);
+            if !n.position.iter().all(|c| c.is_finite()) {
+                return bad("position is not finite");
+            }
+            let bounds = [n.radius, n.mu, n.delta, n.spheroid[0], n.spheroid[1]];
+            if !bounds.iter().all(|b| b.is_finite() && *b >= 0.0) {
+                return bad("a bound is negative or not finite");
+            }
+            if n.parent != NONE {
+                if n.parent <= i || n.parent >= self.nodes || n.parent < self.leaves {
+                    return bad("parent out of range");
+                }
+                if !self.split(n.parent).children.contains(&i) {
+                    return bad("parent does not list it as a child");
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn check_splits(&self) -> Result<(), FormatError> {
+        let mut previous_end = 0;
+        for p in self.leaves..self.nodes {
+            let bad = |what| Err(FormatError::BadNode { node: p, what });
+            let s = self.split(p);
+            let [a, b] = s.children;
+            if a >= p || b >= p || a == b {
+                return bad("children out of range");
+            }
+            if self.node(a).parent != p || self.node(b).parent != p {
+                return bad("children do not point back");
+            }
+            let [w0, w1] = s.wings;
+            if w0 >= self.nodes || (w1 != NONE && w1 >= self.nodes) {
+                return bad("wing out of range");
+            }
+            if s.children.contains(&w0) || s.children.contains(&w1) {
+                return bad("wing equals a child");
+            }
+            let (start, end) = s.dependencies;
+            if start != previous_end || end < start || end > self.dependencies {
+                return bad("dependency range out of order");
+            }
+            previous_end = end;
+        }
+        if previous_end != self.dependencies {
+            return Err(FormatError::BadCounts);
+        }
+        for d in 0..self.dependencies {
+            if self.dependency(d) >= self.nodes {
+                return Err(FormatError::BadReference {
+                    section: "dependencies",
+                    index: d,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    fn check_base(&self) -> Result<(), FormatError> {
+        for t in 0..self.base_triangles {
+            let tri = self.base_triangle(t);
+            let ok = tri
+                .iter()
+                .all(|&v| v < self.nodes && self.node(v).parent == NONE)
+                && tri[0] != tri[1]
+                && tri[1] != tri[2]
+                && tri[0] != tri[2];
+            if !ok {
+                return Err(FormatError::BadReference {
+                    section: "base triangles",
+                    index: t,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Input vertices: nodes `0..leaves()`.
+    pub fn leaves(&self) -> u32 {
+        self.leaves
+    }
+
+    /// All nodes.
+    pub fn nodes(&self) -> u32 {
+        self.nodes
+    }
+
+    /// Triangles of the base mesh.
+    pub fn base_triangles(&self) -> u32 {
+        self.base_triangles
+    }
+
+    /// Total dependency entries.
+    pub fn dependencies(&self) -> u32 {
+        self.dependencies
+    }
+
+    /// Whether the nodes carry meaningful colours.
+    pub fn has_colors(&self) -> bool {
+        self.flags & FLAG_COLORS != 0
+    }
+
+    /// Size of the file in bytes.
+    pub fn size(&self) -> usize {
+        self.bytes.len()
+    }
+
+    /// Node `i` (`i < nodes()`; out-of-range ids read as zeros, never panic).
+    pub fn node(&self, i: u32) -> NodeView {
+        let o = self.offsets()[0] + i as usize * NODE_SIZE;
+        let b = self.bytes;
+        let h = |k: usize| f16_to_f32(u16_at(b, o + 12 + 2 * k));
+        let byte = |k: usize| b.get(o + k).copied().unwrap_or(0);
+        NodeView {
+            position: [f32_at(b, o), f32_at(b, o + 4), f32_at(b, o + 8)],
+            radius: h(0),
+            mu: h(1),
+            delta: h(2),
+            spheroid: [h(3), h(4)],
+            normal: oct_decode(byte(22) as i8, byte(23) as i8),
+            cone_sin: byte(24) as f32 / 255.0,
+            color: [byte(25), byte(26), byte(27)],
+            depth: u16_at(b, o + 28),
+            parent: u32_at(b, o + 30),
+        }
+    }
+
+    /// The split record of parent `p` (`leaves() <= p < nodes()`).
+    pub fn split(&self, p: u32) -> SplitView {
+        let [_, s, de, ..] = self.offsets();
+        let k = p.wrapping_sub(self.leaves) as usize;
+        let o = s + k * SPLIT_SIZE;
+        let b = self.bytes;
+        let start = u32_at(b, o + 16);
+        let end = if p + 1 < self.nodes {
+            u32_at(b, o + SPLIT_SIZE + 16)
+        } else {
+            u32_at(b, de)
+        };
+        SplitView {
+            children: [u32_at(b, o), u32_at(b, o + 4)],
+            wings: [u32_at(b, o + 8), u32_at(b, o + 12)],
+            dependencies: (start, end),
+        }
+    }
+
+    /// Dependency entry `d`.
+    pub fn dependency(&self, d: u32) -> u32 {
+        u32_at(self.bytes, self.offsets()[3] + d as usize * 4)
+    }
+
+    /// Base triangle `t`.
+    pub fn base_triangle(&self, t: u32) -> [u32; 3] {
+        let o = self.offsets()[4] + t as usize * 12;
+        [0, 4, 8].map(|k| u32_at(self.bytes, o + k))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn crc_matches_the_standard_check_value() {
+        assert_eq!(crc32(b"123456789"), 0xCBF4_3926);
+    }
+
+    #[test]
+    fn half_floats_round_up() {
+        for v in [0.0f32, 1.0, 0.1, 3.14159, 1e-7, 6.0e-5, 65504.0, 1234.567] {
+            let h = f32_to_f16_up(v);
+            let back = f16_to_f32(h);
+            assert!(back >= v, "{v} -> {back}");
+            if h > 0 {
+                assert!(f16_to_f32(h - 1) < v, "{v}: not the smallest");
+            }
+        }
+        assert_eq!(f16_to_f32(f32_to_f16_up(1e6)), f32::INFINITY);
+        assert_eq!(f32_to_f16_up(f32::NAN), 0);
+    }
+
+    #[test]
+    fn octahedral_round_trip_is_close() {
+        for n in [
+            [0.0f32, 0.0, -1.0],
+            [0.6, 0.0, 0.8],
+            [0.0, -0.8, -0.6],
+            [0.577, 0.577, -0.577],
+        ] {
+            let (x, y) = oct_encode(n);
+            let d = oct_decode(x, y);
+            let dot = n[0] * d[0] + n[1] * d[1] + n[2] * d[2];
+            assert!(dot > 0.999, "{n:?} -> {d:?}");
+        }
+    }
+
+    #[test]
+    fn octahedral_axes() {
+        assert_eq!(oct_decode(0, 0), [0.0, 0.0, 1.0]);
+        assert_eq!(oct_decode(127, 0), [1.0, 0.0, 0.0]);
+        let n = oct_decode(-127, 0);
+        assert_eq!(n, [-1.0, 0.0, 0.0]);
+    }
+
+    #[test]
+    fn rejects_short_and_foreign_bytes() {
+        assert_eq!(
+            HierarchyView::parse(b"VDLH").err(),
+            Some(FormatError::Truncated {
+                needed: 40,
+                actual: 4
+            })
+        );
+        assert_eq!(
+            HierarchyView::parse(&[0u8; 64]).err(),
+            Some(FormatError::BadMagic)
+        );
+    }
+}

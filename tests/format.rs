@@ -1,0 +1,109 @@
+//! The hierarchy format against hostile bytes: corrupted, truncated or forged files give an error,
+//! never a panic, and whatever parses is internally consistent.
+
+use std::sync::OnceLock;
+
+use proptest::prelude::*;
+use vdlod_core::build::{build, BuildOptions, InputMesh};
+use vdlod_core::format::{crc32, HierarchyView, HEADER_SIZE, NONE};
+use vdlod_demo::mesh::{load_obj_bytes, COW_NAME, COW_OBJ};
+
+fn cow_bytes() -> &'static [u8] {
+    static BYTES: OnceLock<Vec<u8>> = OnceLock::new();
+    BYTES.get_or_init(|| {
+        let cow = load_obj_bytes(COW_NAME, COW_OBJ).unwrap();
+        let input = InputMesh {
+            positions: &cow.positions,
+            colors: None,
+            triangles: &cow.triangles,
+        };
+        build(&input, &BuildOptions::default(), &mut |_| {})
+            .unwrap()
+            .to_bytes(false)
+    })
+}
+
+/// Reads everything a valid view offers and checks the promises `parse` makes.
+fn walk(view: &HierarchyView<'_>) {
+    for i in 0..view.nodes() {
+        let n = view.node(i);
+        assert!(n.parent == NONE || (n.parent > i && n.parent < view.nodes()));
+        assert!(n.radius >= 0.0 && n.position.iter().all(|c| c.is_finite()));
+    }
+    for p in view.leaves()..view.nodes() {
+        let s = view.split(p);
+        assert!(s
+            .children
+            .iter()
+            .all(|&c| c < p && view.node(c).parent == p));
+        for d in s.dependencies.0..s.dependencies.1 {
+            assert!(view.dependency(d) < view.nodes());
+        }
+    }
+    for t in 0..view.base_triangles() {
+        assert!(view
+            .base_triangle(t)
+            .iter()
+            .all(|&v| view.node(v).parent == NONE));
+    }
+}
+
+/// Forges the checksum so that corruption reaches the structural checks.
+fn reseal(bytes: &mut [u8]) {
+    if bytes.len() >= HEADER_SIZE {
+        let crc = crc32(&bytes[HEADER_SIZE..]);
+        bytes[24..28].copy_from_slice(&crc.to_le_bytes());
+    }
+}
+
+#[test]
+fn the_valid_file_parses() {
+    let view = HierarchyView::parse(cow_bytes()).unwrap();
+    assert_eq!(view.leaves(), 2904);
+    walk(&view);
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(400))]
+
+    #[test]
+    fn corrupted_files_are_rejected_or_consistent(
+        edits in prop::collection::vec((any::<prop::sample::Index>(), any::<u8>()), 1..8),
+        resealed in any::<bool>(),
+    ) {
+        let mut bytes = cow_bytes().to_vec();
+        for (at, value) in &edits {
+            let i = at.index(bytes.len());
+            bytes[i] = *value;
+        }
+        if resealed {
+            reseal(&mut bytes);
+        }
+        if let Ok(view) = HierarchyView::parse(&bytes) {
+            walk(&view);
+        }
+    }
+
+    #[test]
+    fn truncated_files_are_rejected(cut in any::<prop::sample::Index>()) {
+        let bytes = cow_bytes();
+        let n = cut.index(bytes.len());
+        prop_assert!(HierarchyView::parse(&bytes[..n]).is_err());
+    }
+
+    #[test]
+    fn random_bytes_behind_a_valid_header_are_rejected_or_consistent(
+        body in prop::collection::vec(any::<u8>(), 0..2048),
+        counts in [0u32..64, 0u32..64, 0u32..64, 0u32..64],
+    ) {
+        let mut bytes = cow_bytes()[..HEADER_SIZE].to_vec();
+        for (k, c) in counts.iter().enumerate() {
+            bytes[8 + 4 * k..12 + 4 * k].copy_from_slice(&c.to_le_bytes());
+        }
+        bytes.extend_from_slice(&body);
+        reseal(&mut bytes);
+        if let Ok(view) = HierarchyView::parse(&bytes) {
+            walk(&view);
+        }
+    }
+}
