@@ -252,7 +252,8 @@ fn f32_at(b: &[u8], o: usize) -> f32 {
 /// Encodes a unit vector as octahedral coordinates in `[-127, 127]` (nearest).
 pub fn oct_encode(n: [f32; 3]) -> (i8, i8) {
     let l1 = n[0].abs() + n[1].abs() + n[2].abs();
-    if !(l1 > 0.0) || !l1.is_finite() {
+    let usable = l1 > 0.0 && l1.is_finite();
+    if !usable {
         return (0, 0);
     }
     let (mut u, mut v) = (n[0] / l1, n[1] / l1);
