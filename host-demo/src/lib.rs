@@ -5,5 +5,6 @@
 
 pub mod camera;
 pub mod frame;
+pub mod hierarchy;
 pub mod mesh;
 pub mod render;

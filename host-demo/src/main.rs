@@ -7,6 +7,9 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand, ValueEnum};
+use vdlod_core::build::{BuildOptions, Cost};
+use vdlod_core::format::HierarchyView;
+use vdlod_demo::hierarchy;
 use vdlod_demo::mesh::{load_obj, load_obj_bytes, IndexedMesh, MeshError, BUNNY_NAME, BUNNY_OBJ};
 use vdlod_demo::render::{render_orbit, RenderOptions};
 use vdlod_raster::Shading;
@@ -26,6 +29,41 @@ struct Cli {
 enum Command {
     /// Fly the merge-tree paper's orbit around a mesh at full detail and write PNG frames.
     Render(RenderArgs),
+    /// Build a mesh's vertex hierarchy and write it as a .vdh file.
+    Build(BuildArgs),
+    /// Validate a .vdh file and print its figures.
+    Info {
+        /// The hierarchy file.
+        file: PathBuf,
+    },
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum CostArg {
+    /// Quadric error metric with optimal placement.
+    Qem,
+    /// Shortest edge first (merge-tree paper).
+    Edge,
+    /// Colour-aware cost of the importance paper.
+    Color,
+}
+
+#[derive(clap::Args)]
+struct BuildArgs {
+    /// OBJ file to build from.
+    mesh: PathBuf,
+    /// Output file.
+    #[arg(long, short)]
+    out: PathBuf,
+    /// Collapse cost.
+    #[arg(long, value_enum, default_value = "qem")]
+    cost: CostArg,
+    /// Balance the forest with the merge-tree paper's region-of-influence marking.
+    #[arg(long)]
+    balanced: bool,
+    /// Stop at this many base-mesh vertices (default: as few as topology allows).
+    #[arg(long, default_value_t = 0)]
+    base: u32,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -123,10 +161,41 @@ fn render(args: RenderArgs) -> Result<(), String> {
     Ok(())
 }
 
+fn build_command(args: BuildArgs) -> Result<(), String> {
+    let mesh = load_obj(&args.mesh).map_err(|e| e.to_string())?;
+    let opts = BuildOptions {
+        cost: match args.cost {
+            CostArg::Qem => Cost::Quadric,
+            CostArg::Edge => Cost::ShortestEdge,
+            CostArg::Color => Cost::Color,
+        },
+        balanced: args.balanced,
+        base_vertices: args.base,
+    };
+    let show = std::io::IsTerminal::is_terminal(&std::io::stderr());
+    let (_, bytes, seconds) = hierarchy::build_with_progress(&mesh, &opts, show)
+        .map_err(|e| format!("{}: {e}", args.mesh.display()))?;
+    std::fs::write(&args.out, &bytes)
+        .map_err(|e| format!("{}: cannot write: {e}", args.out.display()))?;
+    let view = HierarchyView::parse(&bytes).map_err(|e| format!("{}: {e}", args.out.display()))?;
+    println!("{}: {}", args.out.display(), hierarchy::summarize(&view));
+    println!("built in {seconds:.3} s");
+    Ok(())
+}
+
+fn info(file: PathBuf) -> Result<(), String> {
+    let bytes = hierarchy::read(&file)?;
+    let view = HierarchyView::parse(&bytes).map_err(|e| format!("{}: {e}", file.display()))?;
+    println!("{}: {}", file.display(), hierarchy::summarize(&view));
+    Ok(())
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Some(Command::Render(args)) => render(args),
+        Some(Command::Build(args)) => build_command(args),
+        Some(Command::Info { file }) => info(file),
         None => render(RenderArgs::default()),
     };
     match result {

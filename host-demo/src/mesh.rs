@@ -280,6 +280,89 @@ pub fn load_obj_bytes(name: &str, bytes: &[u8]) -> Result<IndexedMesh, MeshError
     Ok(mesh)
 }
 
+impl IndexedMesh {
+    /// One step of Loop subdivision: every triangle becomes four, vertices move to the Loop
+    /// averages (borders use the cubic B-spline rule), so a smooth surface gets four times the
+    /// triangles. Stands in for the merge-tree paper's 160k-face subdivided bunny.
+    pub fn loop_subdivide(&self) -> IndexedMesh {
+        use std::collections::HashMap;
+        let n = self.positions.len();
+        let p = |i: u32| Vec3::from(self.positions[i as usize]);
+        // Opposite corners of each undirected edge, in first-seen order.
+        let mut edges: HashMap<(u32, u32), (u32, [u32; 2])> = HashMap::new();
+        let mut order = Vec::new();
+        for t in &self.triangles {
+            for k in 0..3 {
+                let (a, b, c) = (t[k], t[(k + 1) % 3], t[(k + 2) % 3]);
+                let key = (a.min(b), a.max(b));
+                let next = (n + order.len()) as u32;
+                let entry = edges.entry(key).or_insert_with(|| {
+                    order.push(key);
+                    (next, [c, u32::MAX])
+                });
+                if entry.1[0] != c {
+                    entry.1[1] = c;
+                }
+            }
+        }
+        let mut positions = Vec::with_capacity(n + order.len());
+        // Old vertices: neighbour sums, and border neighbours.
+        let mut ring_sum = vec![Vec3::ZERO; n];
+        let mut ring_len = vec![0u32; n];
+        let mut border: Vec<Vec<u32>> = vec![Vec::new(); n];
+        for &(a, b) in &order {
+            let (_, opp) = edges[&(a, b)];
+            ring_sum[a as usize] += p(b);
+            ring_sum[b as usize] += p(a);
+            ring_len[a as usize] += 1;
+            ring_len[b as usize] += 1;
+            if opp[1] == u32::MAX {
+                border[a as usize].push(b);
+                border[b as usize].push(a);
+            }
+        }
+        for v in 0..n {
+            let old = p(v as u32);
+            let moved = if border[v].len() == 2 {
+                old * 0.75 + (p(border[v][0]) + p(border[v][1])) * 0.125
+            } else if ring_len[v] >= 3 && border[v].is_empty() {
+                let k = ring_len[v] as f32;
+                let beta = if ring_len[v] == 3 {
+                    3.0 / 16.0
+                } else {
+                    3.0 / (8.0 * k)
+                };
+                old * (1.0 - k * beta) + ring_sum[v] * beta
+            } else {
+                old
+            };
+            positions.push(moved.to_array());
+        }
+        for &(a, b) in &order {
+            let (_, opp) = edges[&(a, b)];
+            let mid = if opp[1] == u32::MAX {
+                (p(a) + p(b)) * 0.5
+            } else {
+                (p(a) + p(b)) * 0.375 + (p(opp[0]) + p(opp[1])) * 0.125
+            };
+            positions.push(mid.to_array());
+        }
+        let e = |a: u32, b: u32| edges[&(a.min(b), a.max(b))].0;
+        let mut triangles = Vec::with_capacity(self.triangles.len() * 4);
+        for &[a, b, c] in &self.triangles {
+            let (ab, bc, ca) = (e(a, b), e(b, c), e(c, a));
+            triangles.extend_from_slice(&[[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]]);
+        }
+        let normals = vertex_normals(&positions, &triangles);
+        IndexedMesh {
+            positions,
+            normals,
+            colors: None,
+            triangles,
+        }
+    }
+}
+
 /// Whether an OBJ line is a polyline (`l v1 v2 ...`).
 fn is_polyline(line: &[u8]) -> bool {
     let line = line.trim_ascii_start();
@@ -414,6 +497,19 @@ mod tests {
                 next += 1;
             }
         }
+    }
+
+    #[test]
+    fn loop_subdivision_quadruples_triangles() {
+        let cow = load_obj_bytes(COW_NAME, COW_OBJ).unwrap();
+        let fine = cow.loop_subdivide();
+        assert_eq!(fine.triangles.len(), 4 * cow.triangles.len());
+        // Closed: V - E + F stays 2, so V grows by E = 3F / 2.
+        assert_eq!(
+            fine.positions.len(),
+            cow.positions.len() + cow.triangles.len() * 3 / 2
+        );
+        assert!(fine.positions.iter().flatten().all(|c| c.is_finite()));
     }
 
     #[test]

@@ -1,0 +1,111 @@
+//! Hierarchy build time and peak memory, beside meshoptimizer (`meshopt` 0.7) simplifying the same
+//! mesh to the same base size, in the same run.
+//!
+//! Meshes: the bunny (75,408 triangles) and the bunny after one step of Loop subdivision (301,632
+//! triangles, the stand-in for the merge-tree paper's 160k-face model). vdlod builds the whole
+//! forest (QEM cost, default options) down to the base mesh; meshopt's `simplify` is asked for the
+//! same number of triangles with no error limit. Each is run `RUNS` times; the table gives the
+//! median time and the peak heap in use during the call (from a counting allocator), plus the
+//! ratios vdlod / meshopt.
+//!
+//! Run: `cargo bench --bench hierarchy`.
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::Instant;
+
+use meshopt::{SimplifyOptions, VertexDataAdapter};
+use vdlod_core::build::{build, BuildOptions, InputMesh};
+use vdlod_demo::mesh::{load_obj_bytes, IndexedMesh, BUNNY_NAME, BUNNY_OBJ};
+
+/// The system allocator, counting the bytes in use and their peak.
+struct Counting;
+
+static IN_USE: AtomicUsize = AtomicUsize::new(0);
+static PEAK: AtomicUsize = AtomicUsize::new(0);
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        let p = unsafe { System.alloc(layout) };
+        if !p.is_null() {
+            let now = IN_USE.fetch_add(layout.size(), Ordering::Relaxed) + layout.size();
+            PEAK.fetch_max(now, Ordering::Relaxed);
+        }
+        p
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) };
+        IN_USE.fetch_sub(layout.size(), Ordering::Relaxed);
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+const RUNS: usize = 3;
+
+/// Median seconds and peak extra heap bytes of `f`, and its last result.
+fn measure<T>(mut f: impl FnMut() -> T) -> (f64, usize, T) {
+    let mut times = Vec::new();
+    let mut peak = 0;
+    let mut last = None;
+    for _ in 0..RUNS {
+        let base = IN_USE.load(Ordering::Relaxed);
+        PEAK.store(base, Ordering::Relaxed);
+        let t = Instant::now();
+        let out = f();
+        times.push(t.elapsed().as_secs_f64());
+        peak = peak.max(PEAK.load(Ordering::Relaxed) - base);
+        last = Some(out);
+    }
+    times.sort_by(f64::total_cmp);
+    (times[RUNS / 2], peak, last.expect("RUNS > 0"))
+}
+
+fn compare(name: &str, mesh: &IndexedMesh) {
+    let input = InputMesh {
+        positions: &mesh.positions,
+        colors: None,
+        triangles: &mesh.triangles,
+    };
+    let (t_ours, m_ours, h) =
+        measure(|| build(&input, &BuildOptions::default(), &mut |_| {}).expect("valid mesh"));
+    let base = h.base_triangles.len();
+
+    let indices: Vec<u32> = mesh.triangles.iter().flatten().copied().collect();
+    let adapter =
+        VertexDataAdapter::new(meshopt::typed_to_bytes(&mesh.positions), 12, 0).expect("positions");
+    let (t_theirs, m_theirs, out) = measure(|| {
+        meshopt::simplify(
+            &indices,
+            &adapter,
+            base * 3,
+            1.0,
+            SimplifyOptions::None,
+            None,
+        )
+    });
+    println!(
+        "{name:<24} {:>8} tris | vdlod build {:>8.1} ms {:>7.1} MB -> base {:>5} tris | \
+         meshopt simplify {:>7.1} ms {:>6.1} MB -> {:>5} tris | vdlod/meshopt time {:.1}x memory {:.1}x",
+        mesh.triangles.len(),
+        t_ours * 1e3,
+        m_ours as f64 / 1e6,
+        base,
+        t_theirs * 1e3,
+        m_theirs as f64 / 1e6,
+        out.len() / 3,
+        t_ours / t_theirs,
+        m_ours as f64 / m_theirs as f64
+    );
+}
+
+fn main() {
+    // `cargo test --benches` runs bench binaries with `--bench` absent: keep that quick.
+    if !std::env::args().any(|a| a == "--bench") {
+        return;
+    }
+    let bunny = load_obj_bytes(BUNNY_NAME, BUNNY_OBJ).expect("bundled bunny");
+    compare("bunny", &bunny);
+    compare("bunny, Loop-subdivided", &bunny.loop_subdivide());
+}
