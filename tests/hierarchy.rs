@@ -66,6 +66,11 @@ fn check_round_trip(mesh: &IndexedMesh, opts: BuildOptions) -> Hierarchy {
     let h = hierarchy(mesh, opts);
     assert_eq!(sorted(&h.refine_all()), sorted(&mesh.triangles), "{opts:?}");
     assert_eq!(
+        sorted(&h.collapse_all(&mesh.triangles)),
+        sorted(&h.base_triangles),
+        "{opts:?}"
+    );
+    assert_eq!(
         topology(&h.base_triangles),
         topology(&mesh.triangles),
         "{opts:?}"

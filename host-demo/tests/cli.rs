@@ -138,3 +138,88 @@ fn renders_a_small_mesh() {
     assert!(pixels.iter().any(|p| *p != vdlod_demo::frame::BACKGROUND));
     assert!(dir.join("frames/frame_0001.png").exists());
 }
+
+fn fixture(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../fixtures")
+        .join(name)
+}
+
+#[test]
+fn build_and_info_agree_on_an_open_mesh() {
+    let dir = scratch_dir("cli_build");
+    let head = fixture("head.obj");
+    let out = demo(
+        &[
+            "build",
+            head.to_str().unwrap(),
+            "-o",
+            "head.vdh",
+            "--balanced",
+        ],
+        &dir,
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let built = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(built.contains("vertices 1487, faces 2918"), "{built}");
+    let info = demo(&["info", "head.vdh"], &dir);
+    assert!(info.status.success());
+    let info = String::from_utf8_lossy(&info.stdout).into_owned();
+    // Same figures line from the file as from the build.
+    assert_eq!(built.lines().next(), info.lines().next());
+}
+
+#[test]
+fn info_rejects_corrupted_files_in_one_line() {
+    let dir = scratch_dir("cli_info_bad");
+    let out = demo(
+        &[
+            "build",
+            fixture("cow.obj").to_str().unwrap(),
+            "-o",
+            "cow.vdh",
+        ],
+        &dir,
+    );
+    assert!(out.status.success());
+    let mut bytes = std::fs::read(dir.join("cow.vdh")).unwrap();
+    let mid = bytes.len() / 2;
+    bytes[mid] ^= 0xFF;
+    std::fs::write(dir.join("bad.vdh"), &bytes).unwrap();
+    let out = demo(&["info", "bad.vdh"], &dir);
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(stderr.contains("bad.vdh: checksum mismatch"), "{stderr}");
+}
+
+#[test]
+fn build_rejects_non_manifold_meshes_in_one_line() {
+    assert_build_error(
+        "fin.obj",
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nf 1 2 3\nf 2 1 4\nf 1 2 5\n",
+        "non-manifold",
+    );
+    assert_build_error(
+        "dup.obj",
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 2 3 1\n",
+        "repeats triangle 0",
+    );
+}
+
+fn assert_build_error(name: &str, text: &str, problem: &str) {
+    let dir = scratch_dir(&format!("cli_build_{name}"));
+    std::fs::write(dir.join(name), text).unwrap();
+    let out = demo(&["build", name, "-o", "x.vdh"], &dir);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(
+        stderr.contains(name) && stderr.contains(problem),
+        "{stderr}"
+    );
+}

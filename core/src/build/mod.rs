@@ -143,6 +143,42 @@ impl Hierarchy {
         (max, mean)
     }
 
+    /// Replays every collapse, first to last, on `input` (the triangles the hierarchy was built
+    /// from) using only the nodes' children and wings: each removes the triangles
+    /// `(c0, c1, w0)` and `(c1, c0, w1)` and renames `c0` and `c1` to the parent. Returns the
+    /// triangles left, each rotated to start at its smallest index; for a hierarchy from
+    /// [`build`] they are [`Hierarchy::base_triangles`].
+    pub fn collapse_all(&self, input: &[[u32; 3]]) -> Vec<[u32; 3]> {
+        let mut faces: Vec<Option<[u32; 3]>> = input.iter().map(|&t| Some(t)).collect();
+        let mut around: Vec<Vec<u32>> = alloc::vec![Vec::new(); self.nodes.len()];
+        for (f, t) in input.iter().enumerate() {
+            for &v in t {
+                if let Some(list) = around.get_mut(v as usize) {
+                    list.push(f as u32);
+                }
+            }
+        }
+        for p in self.leaves..self.nodes.len() as u32 {
+            let node = &self.nodes[p as usize];
+            let [c0, c1] = node.children;
+            let [w0, w1] = node.wings;
+            let removed = [rotate_to_min([c0, c1, w0]), rotate_to_min([c1, c0, w1])];
+            for c in [c0, c1] {
+                for f in core::mem::take(&mut around[c as usize]) {
+                    let Some(t) = faces[f as usize] else { continue };
+                    if removed.contains(&rotate_to_min(t)) {
+                        faces[f as usize] = None;
+                        continue;
+                    }
+                    let renamed = t.map(|v| if v == c0 || v == c1 { p } else { v });
+                    faces[f as usize] = Some(renamed);
+                    around[p as usize].push(f);
+                }
+            }
+        }
+        faces.into_iter().flatten().map(rotate_to_min).collect()
+    }
+
     /// Replays every vertex split, last collapse first, from the base mesh, using only the nodes'
     /// children and wings; returns the triangles with each rotated to start at its smallest index.
     /// For a hierarchy from [`build`], these are exactly the input's triangles.
