@@ -265,6 +265,16 @@ fn floor_crossing_the_near_plane_is_clipped_without_holes() {
     }
 }
 
+/// Draws `mesh` unlit into a guarded 64x48 frame, looking down -z from z = 3; checks the sentinels.
+fn draw_from_front(mesh: &Mesh<'_>) -> (Guarded, vdlod_raster::DrawStats) {
+    let mut g = Guarded::new(64, 48);
+    let stats = g
+        .draw(mesh, &unlit(camera(Vec3::new(0.0, 0.0, 3.0))))
+        .unwrap();
+    g.assert_sentinels();
+    (g, stats)
+}
+
 #[test]
 fn triangles_behind_the_camera_draw_nothing() {
     let positions = [[-1.0, -1.0, 5.0], [1.0, -1.0, 5.0], [0.0, 1.0, 5.0]];
@@ -273,11 +283,7 @@ fn triangles_behind_the_camera_draw_nothing() {
         triangles: &[[0, 1, 2]],
         ..Mesh::default()
     };
-    let mut g = Guarded::new(64, 48);
-    let stats = g
-        .draw(&mesh, &unlit(camera(Vec3::new(0.0, 0.0, 3.0))))
-        .unwrap();
-    g.assert_sentinels();
+    let (g, stats) = draw_from_front(&mesh);
     assert_eq!(stats.outside, 1);
     assert_eq!(g.drawn(), 0);
 }
@@ -300,11 +306,7 @@ fn huge_and_non_finite_coordinates_are_safe() {
         triangles: &triangles,
         ..Mesh::default()
     };
-    let mut g = Guarded::new(64, 48);
-    let stats = g
-        .draw(&mesh, &unlit(camera(Vec3::new(0.0, 0.0, 3.0))))
-        .unwrap();
-    g.assert_sentinels();
+    let (g, stats) = draw_from_front(&mesh);
     assert_eq!(stats.invalid, 2, "{stats:?}");
     // The huge triangle covers the whole view.
     assert_eq!(g.drawn(), 64 * 48);
