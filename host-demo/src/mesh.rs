@@ -453,9 +453,11 @@ mod tests {
         assert_eq!(morton3(1023, 1023, 1023), (1 << 30) - 1);
     }
 
+    type Bits = [u32; 3];
+
     /// Triangles as position bits, and vertices as position-and-normal bits: what reordering
     /// must keep, whatever the numbering.
-    fn content(m: &IndexedMesh) -> (BTreeSet<[[u32; 3]; 3]>, BTreeSet<[[u32; 3]; 2]>) {
+    fn content(m: &IndexedMesh) -> (BTreeSet<[Bits; 3]>, BTreeSet<[Bits; 2]>) {
         let bits = |v: &[f32; 3]| v.map(f32::to_bits);
         let triangles = m
             .triangles
