@@ -39,7 +39,10 @@ pub(crate) struct Engine<'o> {
     pub vfaces: Vec<Vec<u32>>,
     pub alive: Vec<bool>,
     pub alive_count: usize,
-    heap: BinaryHeap<Reverse<(u64, u32, u32)>>,
+    /// (cost as `f32` bits, index into `pushed`): eight bytes an entry, so sifting the heap
+    /// touches half the memory it would with the edge inside.
+    heap: BinaryHeap<Reverse<(u32, u32)>>,
+    pushed: Vec<(u32, u32)>,
     deferred: Vec<(u32, u32)>,
     /// Edges found illegal, by endpoint: retried when a collapse changes that endpoint's ring.
     rejected: Vec<Vec<u32>>,
@@ -94,6 +97,7 @@ impl<'o> Engine<'o> {
             alive_count: 0,
             vfaces,
             heap: BinaryHeap::new(),
+            pushed: Vec::new(),
             deferred: Vec::new(),
             rejected: vec![Vec::new(); n],
             collapses: Vec::new(),
@@ -156,12 +160,6 @@ impl<'o> Engine<'o> {
         (wings, count)
     }
 
-    /// In a manifold fan an inner vertex has as many triangles as neighbours, a border vertex one
-    /// fewer.
-    fn is_boundary_vertex(&self, v: u32) -> bool {
-        self.vfaces[v as usize].len() < self.neighbours(v).len()
-    }
-
     fn boundary_neighbours(&self, v: u32) -> Vec<u32> {
         self.neighbours(v)
             .into_iter()
@@ -195,13 +193,17 @@ impl<'o> Engine<'o> {
     fn push(&mut self, a: u32, b: u32) {
         let (a, b) = (a.min(b), a.max(b));
         let (_, cost) = self.evaluate(a, b);
-        // Non-negative doubles order like their bit patterns.
+        // Non-negative floats order like their bit patterns; ties go to the earlier push.
         let key = if cost.is_finite() {
-            cost.max(0.0)
+            (cost.max(0.0) as f32).min(f32::MAX)
         } else {
-            f64::MAX
+            f32::MAX
         };
-        self.heap.push(Reverse((key.to_bits(), a, b)));
+        let Ok(index) = u32::try_from(self.pushed.len()) else {
+            return; // past 2^32 pushes an edge is simply not considered again
+        };
+        self.pushed.push((a, b));
+        self.heap.push(Reverse((key.to_bits(), index)));
     }
 
     /// Whether collapsing `a-b` into `v` keeps the mesh a manifold of the same topology with no
@@ -234,7 +236,10 @@ impl<'o> Engine<'o> {
             return Ok(false);
         }
         let edge_on_border = count == 1;
-        let (ba, bb) = (self.is_boundary_vertex(a), self.is_boundary_vertex(b));
+        // In a manifold fan an inner vertex has as many triangles as neighbours, a border vertex
+        // one fewer.
+        let border = |v: u32, ring: &[u32]| self.vfaces[v as usize].len() < ring.len();
+        let (ba, bb) = (border(a, &na), border(b, &nb));
         if ba && bb && !edge_on_border {
             return Ok(false); // would pinch two borders (or a border and itself) together
         }
@@ -262,8 +267,9 @@ impl<'o> Engine<'o> {
             return Ok(false);
         }
         for &x in &w {
-            let min = if self.is_boundary_vertex(x) { 3 } else { 4 };
-            if self.neighbours(x).len() < min {
+            let ring = self.neighbours(x);
+            let min = if border(x, &ring) { 3 } else { 4 };
+            if ring.len() < min {
                 return Ok(false);
             }
         }
@@ -290,7 +296,7 @@ impl<'o> Engine<'o> {
     /// Collapses the cheapest legal edge; `false` when none is left.
     pub fn step(&mut self) -> bool {
         loop {
-            let Some(Reverse((_, a, b))) = self.heap.pop() else {
+            let Some(Reverse((_, index))) = self.heap.pop() else {
                 if self.deferred.is_empty() {
                     return false;
                 }
@@ -303,6 +309,7 @@ impl<'o> Engine<'o> {
                 }
                 continue;
             };
+            let (a, b) = self.pushed[index as usize];
             if !self.alive[a as usize] || !self.alive[b as usize] {
                 continue;
             }
