@@ -27,12 +27,14 @@ use vdlod_demo::mesh::{load_obj_bytes, IndexedMesh, BUNNY_NAME, BUNNY_OBJ};
 use vdlod_demo::render::camera_params;
 use vdlod_raster::{Light, Shading};
 
-/// `euc` pipeline doing what our Gouraud mode does: per-vertex Lambert, interpolated colour.
+/// `euc` pipeline doing what our Gouraud mode does with `unit_normals`: per-vertex Lambert from
+/// unit normals, interpolated colour.
 struct Gouraud<'a> {
     mvp: vek::Mat4<f32>,
     positions: &'a [[f32; 3]],
     normals: &'a [[f32; 3]],
     light: Light,
+    light_unit: glam::Vec3,
     base: [f32; 3],
 }
 
@@ -45,7 +47,9 @@ impl Pipeline for Gouraud<'_> {
     fn vert(&self, v: &u32) -> ([f32; 4], vek::Vec3<f32>) {
         let i = *v as usize;
         let clip = self.mvp * vek::Vec4::from_point(vek::Vec3::from(self.positions[i]));
-        let l = self.light.intensity(glam::Vec3::from(self.normals[i]));
+        let l = self
+            .light
+            .intensity_unit(glam::Vec3::from(self.normals[i]), self.light_unit);
         (clip.into_array(), vek::Vec3::from(self.base) * l)
     }
 
@@ -84,6 +88,7 @@ impl<'a> Scene<'a> {
                 positions: &mesh.positions,
                 normals: &mesh.normals,
                 light: params.light,
+                light_unit: params.light.unit_direction(),
                 base: params.base_color.map(|c| c as f32),
             },
             indices: mesh.triangles.iter().flatten().copied().collect(),

@@ -25,6 +25,8 @@ pub fn camera_params(
             ..Light::default()
         },
         shading,
+        // `IndexedMesh` normals are unit length (or zero) and the model matrix is the identity.
+        unit_normals: true,
         base_color: [214, 200, 176],
         wireframe: wireframe.then_some([20, 20, 20]),
         ..DrawParams::default()

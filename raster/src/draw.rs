@@ -15,7 +15,9 @@ use crate::edge::{
     ScreenVertex,
 };
 use crate::target::{Pixel, Target};
-use crate::vertex::{light_normal, shade_vertices, to_clip, Light, ShadedVertex, Viewport};
+use crate::vertex::{
+    shade_vertices, to_clip, Light, PreparedLighting, ShadedVertex, VertexLighting, Viewport,
+};
 use crate::wire::draw_line;
 
 /// Borrowed mesh data: per-vertex arrays of equal length and triangles indexing them.
@@ -62,6 +64,10 @@ pub struct DrawParams {
     pub base_color: [u8; 3],
     /// Skip triangles facing away from the camera.
     pub cull_back_faces: bool,
+    /// The normals are of unit length after [`DrawParams::normal_matrix`]: skip renormalizing them
+    /// (like OpenGL without `GL_NORMALIZE`), which saves a square root and a division per vertex.
+    /// Shading is wrong if they are not.
+    pub unit_normals: bool,
     /// Draw triangle edges in this colour over the filled frame.
     pub wireframe: Option<[u8; 3]>,
 }
@@ -75,6 +81,7 @@ impl Default for DrawParams {
             shading: Shading::default(),
             base_color: [200, 200, 200],
             cull_back_faces: true,
+            unit_normals: false,
             wireframe: None,
         }
     }
@@ -239,9 +246,15 @@ pub fn draw_indexed<P: Pixel>(
 
     // Vertex stage.
     let lighting = match (params.shading, mesh.normals) {
-        (Shading::Gouraud, Some(n)) => Some((&params.normal_matrix, &params.light, n)),
+        (Shading::Gouraud, Some(normals)) => Some(VertexLighting {
+            normal_matrix: &params.normal_matrix,
+            light: &params.light,
+            normals,
+            unit_normals: params.unit_normals,
+        }),
         _ => None,
     };
+    let prepared = lighting.map(|l| l.prepare());
     shade_vertices(
         &params.mvp,
         &viewport,
@@ -285,7 +298,7 @@ pub fn draw_indexed<P: Pixel>(
             let Some(bounds) = pixel_bounds(xy, target.width, target.height) else {
                 continue;
             };
-            let colors = triangle_colors(mesh, params, t, tri, &v);
+            let colors = triangle_colors(mesh, params, prepared.as_ref(), t, tri, &v);
             // Clockwise on screen, as the pixel loop wants it.
             let order = if area < 0 { [0, 2, 1] } else { [0, 1, 2] };
             let s = order.map(|k| ScreenVertex {
@@ -301,7 +314,7 @@ pub fn draw_indexed<P: Pixel>(
             stats.outside += 1;
         } else {
             stats.clipped += 1;
-            let colors = triangle_colors(mesh, params, t, tri, &v);
+            let colors = triangle_colors(mesh, params, prepared.as_ref(), t, tri, &v);
             for_each_clipped(&viewport, params, mesh, tri, colors, union, |s| {
                 fill(target, &mut stats, s)
             });
@@ -346,22 +359,12 @@ fn depth_test<P: Pixel>(c: &mut P, d: &mut u32, f: Fragment<'_>) {
     }
 }
 
-/// Light intensity at vertex `i` for per-vertex shading (1 when unlit).
-#[inline(always)]
-fn vertex_light(mesh: &Mesh<'_>, params: &DrawParams, i: usize) -> f32 {
-    match (params.shading, mesh.normals) {
-        (Shading::Gouraud, Some(n)) => {
-            light_normal(&params.normal_matrix, &params.light, Vec3::from(n[i]))
-        }
-        _ => 1.0,
-    }
-}
-
 /// The colours the three corners of triangle `t` are drawn with.
 #[inline(always)]
 fn triangle_colors(
     mesh: &Mesh<'_>,
     params: &DrawParams,
+    lighting: Option<&PreparedLighting>,
     t: usize,
     tri: &[u32; 3],
     v: &[&ShadedVertex; 3],
@@ -370,7 +373,10 @@ fn triangle_colors(
     match params.shading {
         Shading::Gouraud | Shading::Unlit => match face {
             Some(c) => tri.map(|i| {
-                let light = vertex_light(mesh, params, i as usize);
+                let light = match (lighting, mesh.normals) {
+                    (Some(l), Some(n)) => l.intensity(Vec3::from(n[i as usize])),
+                    _ => 1.0,
+                };
                 c.map(|c| c * light)
             }),
             None => v.map(|v| rgb_f32(v.rgb)),

@@ -45,6 +45,24 @@ impl Light {
         let cos = (n.dot(l) / libm::sqrtf(len2)).max(0.0);
         self.ambient + self.diffuse * cos
     }
+
+    /// [`Light::direction`] scaled to unit length (`+z` when it is zero or not finite).
+    pub fn unit_direction(&self) -> Vec3 {
+        let l = self.direction;
+        let len = libm::sqrtf(l.dot(l));
+        if len > 0.0 && len.is_finite() {
+            l / len
+        } else {
+            Vec3::Z
+        }
+    }
+
+    /// Intensity for a normal already of unit length, given [`Light::unit_direction`]: no square
+    /// root, no division.
+    #[inline]
+    pub fn intensity_unit(&self, n: Vec3, unit_direction: Vec3) -> f32 {
+        self.ambient + self.diffuse * n.dot(unit_direction).max(0.0)
+    }
 }
 
 /// A vertex after the vertex stage; the scratch element of [`crate::draw_indexed`].
@@ -172,6 +190,62 @@ pub fn shade_vertex(
     }
 }
 
+/// What lit shading needs per vertex.
+#[derive(Clone, Copy, Debug)]
+pub struct VertexLighting<'a> {
+    /// Maps normals into the light's space.
+    pub normal_matrix: &'a Mat3,
+    /// The light.
+    pub light: &'a Light,
+    /// One normal per vertex.
+    pub normals: &'a [[f32; 3]],
+    /// The normals are of unit length after the normal matrix: skip renormalizing them.
+    pub unit_normals: bool,
+}
+
+impl VertexLighting<'_> {
+    /// What stays the same for every vertex of a draw.
+    pub fn prepare(&self) -> PreparedLighting {
+        PreparedLighting {
+            columns: (*self.normal_matrix != Mat3::IDENTITY)
+                .then(|| self.normal_matrix.to_cols_array_2d()),
+            unit_direction: self.light.unit_direction(),
+            unit_normals: self.unit_normals,
+            light: *self.light,
+        }
+    }
+}
+
+/// [`VertexLighting`] prepared for a draw: the one place a vertex's light intensity is computed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PreparedLighting {
+    columns: Option<[[f32; 3]; 3]>,
+    unit_direction: Vec3,
+    unit_normals: bool,
+    light: Light,
+}
+
+impl PreparedLighting {
+    /// Intensity at a vertex with object-space normal `n`.
+    #[inline(always)]
+    pub fn intensity(&self, n: Vec3) -> f32 {
+        // Object-space lighting, the common case, skips the identity product.
+        let n = match &self.columns {
+            None => n,
+            Some(m) => Vec3::new(
+                m[0][0] * n.x + m[1][0] * n.y + m[2][0] * n.z,
+                m[0][1] * n.x + m[1][1] * n.y + m[2][1] * n.z,
+                m[0][2] * n.x + m[1][2] * n.y + m[2][2] * n.z,
+            ),
+        };
+        if self.unit_normals {
+            self.light.intensity_unit(n, self.unit_direction)
+        } else {
+            self.light.intensity(n)
+        }
+    }
+}
+
 /// Vertices per batch of [`shade_vertices`]: two AVX or four SSE/NEON registers per attribute.
 const LANES: usize = 8;
 
@@ -189,15 +263,13 @@ pub fn shade_vertices(
     mvp: &Mat4,
     viewport: &Viewport,
     positions: &[[f32; 3]],
-    lighting: Option<(&Mat3, &Light, &[[f32; 3]])>,
+    lighting: Option<VertexLighting<'_>>,
     colors: Option<&[[u8; 3]]>,
     base: [f32; 3],
     out: &mut [ShadedVertex],
 ) {
     let m = mvp.to_cols_array_2d();
-    let nm = lighting
-        .filter(|(nm, _, _)| **nm != Mat3::IDENTITY)
-        .map(|(nm, _, _)| nm.to_cols_array_2d());
+    let prepared = lighting.map(|l| l.prepare());
     for (first, out) in (0..).step_by(LANES).zip(out.chunks_mut(LANES)) {
         let len = out.len();
         // Gather the batch; lanes past the end of the mesh hold zeros and are not stored.
@@ -223,8 +295,8 @@ pub fn shade_vertices(
                 }
             }
         }
-        if let Some((_, _, normals)) = lighting {
-            for (k, q) in normals[first..first + len].iter().enumerate() {
+        if let Some(l) = lighting {
+            for (k, q) in l.normals[first..first + len].iter().enumerate() {
                 for a in 0..3 {
                     n[a][k] = q[a];
                 }
@@ -239,24 +311,10 @@ pub fn shade_vertices(
             }
         }
         let mut light = [1.0f32; LANES];
-        match (lighting, nm) {
-            // Lighting in object space, the common case: skip the identity product.
-            (Some((_, l, _)), None) => {
-                for k in 0..LANES {
-                    light[k] = l.intensity(Vec3::new(n[0][k], n[1][k], n[2][k]));
-                }
+        if let Some(p) = &prepared {
+            for (k, l) in light.iter_mut().enumerate() {
+                *l = p.intensity(Vec3::new(n[0][k], n[1][k], n[2][k]));
             }
-            (Some((_, l, _)), Some(nm)) => {
-                for k in 0..LANES {
-                    let t = Vec3::new(
-                        nm[0][0] * n[0][k] + nm[1][0] * n[1][k] + nm[2][0] * n[2][k],
-                        nm[0][1] * n[0][k] + nm[1][1] * n[1][k] + nm[2][1] * n[2][k],
-                        nm[0][2] * n[0][k] + nm[1][2] * n[1][k] + nm[2][2] * n[2][k],
-                    );
-                    light[k] = l.intensity(t);
-                }
-            }
-            (None, _) => {}
         }
         let mut screen = [(0, 0, 0.0f32); LANES];
         for (k, s) in screen.iter_mut().enumerate() {
@@ -289,12 +347,6 @@ pub fn shade_vertices(
 #[allow(clippy::manual_clamp)] // NaN must map into range
 pub fn saturate_u8(c: f32) -> u8 {
     round(c.max(0.0).min(255.0)) as u8
-}
-
-/// Intensity of `light` on `normal` after `normal_matrix`.
-#[inline(always)]
-pub fn light_normal(normal_matrix: &Mat3, light: &Light, normal: Vec3) -> f32 {
-    light.intensity(*normal_matrix * normal)
 }
 
 #[cfg(test)]
