@@ -37,6 +37,8 @@ pub(crate) struct Engine<'o> {
     marked: Vec<bool>,
     /// Live faces around each live vertex.
     pub vfaces: Vec<Vec<u32>>,
+    /// Sorted neighbours of each live vertex, kept up to date by [`Engine::collapse`].
+    vverts: Vec<Vec<u32>>,
     pub alive: Vec<bool>,
     pub alive_count: usize,
     /// (cost as `f32` bits, index into `pushed`): eight bytes an entry, so sifting the heap
@@ -84,7 +86,19 @@ impl<'o> Engine<'o> {
                     .map_or([0.0; 3], |c| c[i].map(|v| v as f64 / 255.0))
             })
             .collect();
+        let mut vverts: Vec<Vec<u32>> = vec![Vec::new(); n];
+        for tri in &faces {
+            for k in 0..3 {
+                vverts[tri[k] as usize].push(tri[(k + 1) % 3]);
+                vverts[tri[k] as usize].push(tri[(k + 2) % 3]);
+            }
+        }
+        for ring in vverts.iter_mut() {
+            ring.sort_unstable();
+            ring.dedup();
+        }
         let mut e = Engine {
+            vverts,
             opts,
             pos,
             quadric,
@@ -119,7 +133,7 @@ impl<'o> Engine<'o> {
             }
         }
         for v in 0..n as u32 {
-            for x in e.neighbours(v) {
+            for x in e.vverts[v as usize].clone() {
                 if v < x {
                     e.push(v, x);
                 }
@@ -129,15 +143,8 @@ impl<'o> Engine<'o> {
     }
 
     /// Sorted distinct neighbours of a live vertex.
-    pub fn neighbours(&self, v: u32) -> Vec<u32> {
-        let mut out: Vec<u32> = self.vfaces[v as usize]
-            .iter()
-            .flat_map(|&f| self.faces[f as usize])
-            .filter(|&x| x != v)
-            .collect();
-        out.sort_unstable();
-        out.dedup();
-        out
+    pub fn neighbours(&self, v: u32) -> &[u32] {
+        &self.vverts[v as usize]
     }
 
     /// The faces with directed edge `a -> b` and `b -> a`, as (third corner of the first or NONE,
@@ -162,7 +169,8 @@ impl<'o> Engine<'o> {
 
     fn boundary_neighbours(&self, v: u32) -> Vec<u32> {
         self.neighbours(v)
-            .into_iter()
+            .iter()
+            .copied()
             .filter(|&x| self.edge_faces(v, x).1 == 1)
             .collect()
     }
@@ -224,6 +232,7 @@ impl<'o> Engine<'o> {
             }
         }
         let (na, nb) = (self.neighbours(a), self.neighbours(b));
+        let (na, nb) = (&na[..], &nb[..]);
         // Link condition: the common neighbours are exactly the wings.
         let common: Vec<u32> = na
             .iter()
@@ -239,7 +248,7 @@ impl<'o> Engine<'o> {
         // In a manifold fan an inner vertex has as many triangles as neighbours, a border vertex
         // one fewer.
         let border = |v: u32, ring: &[u32]| self.vfaces[v as usize].len() < ring.len();
-        let (ba, bb) = (border(a, &na), border(b, &nb));
+        let (ba, bb) = (border(a, na), border(b, nb));
         if ba && bb && !edge_on_border {
             return Ok(false); // would pinch two borders (or a border and itself) together
         }
@@ -268,7 +277,7 @@ impl<'o> Engine<'o> {
         }
         for &x in &w {
             let ring = self.neighbours(x);
-            let min = if border(x, &ring) { 3 } else { 4 };
+            let min = if border(x, ring) { 3 } else { 4 };
             if ring.len() < min {
                 return Ok(false);
             }
@@ -395,7 +404,19 @@ impl<'o> Engine<'o> {
         self.rejected.push(Vec::new());
         self.rejected[ia].clear();
         self.rejected[ib].clear();
-        let ring = self.neighbours(p);
+        // The ring of p: both rings but a and b. Its members swap a and b for p, which as the
+        // newest vertex goes last and keeps their rings sorted.
+        let mut ring: Vec<u32> = core::mem::take(&mut self.vverts[ia]);
+        ring.extend(core::mem::take(&mut self.vverts[ib]));
+        ring.retain(|&x| x != a && x != b);
+        ring.sort_unstable();
+        ring.dedup();
+        for &x in &ring {
+            let r = &mut self.vverts[x as usize];
+            r.retain(|&y| y != a && y != b);
+            r.push(p);
+        }
+        self.vverts.push(ring.clone());
         self.deps.push(ring.clone());
         // Fresh costs for the edges of p (no other edge's cost changed); edges around it that were
         // illegal may have become legal.
