@@ -232,7 +232,6 @@ impl<'o> Engine<'o> {
             }
         }
         let (na, nb) = (self.neighbours(a), self.neighbours(b));
-        let (na, nb) = (&na[..], &nb[..]);
         // Link condition: the common neighbours are exactly the wings.
         let common: Vec<u32> = na
             .iter()
