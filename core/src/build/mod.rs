@@ -143,12 +143,38 @@ impl Hierarchy {
         (max, mean)
     }
 
+    /// Whether every id in the hierarchy is in range and children come before their parents (always
+    /// so for [`build`]'s output; the replays below return nothing for anything else).
+    pub fn is_consistent(&self) -> bool {
+        let n = self.nodes.len() as u32;
+        let leaves = self.leaves;
+        leaves <= n
+            && self.nodes.iter().enumerate().all(|(i, node)| {
+                let i = i as u32;
+                let parent_ok = node.parent == NONE || (node.parent > i && node.parent < n);
+                let split_ok = if i < leaves {
+                    node.children == [NONE; 2]
+                } else {
+                    node.children.iter().all(|&c| c < i)
+                        && node.children[0] != node.children[1]
+                        && node.wings[0] < n
+                        && (node.wings[1] == NONE || node.wings[1] < n)
+                };
+                parent_ok && split_ok
+            })
+            && self.base_triangles.iter().flatten().all(|&v| v < n)
+    }
+
     /// Replays every collapse, first to last, on `input` (the triangles the hierarchy was built
     /// from) using only the nodes' children and wings: each removes the triangles
     /// `(c0, c1, w0)` and `(c1, c0, w1)` and renames `c0` and `c1` to the parent. Returns the
     /// triangles left, each rotated to start at its smallest index; for a hierarchy from
     /// [`build`] they are [`Hierarchy::base_triangles`].
     pub fn collapse_all(&self, input: &[[u32; 3]]) -> Vec<[u32; 3]> {
+        let n = self.nodes.len() as u32;
+        if !self.is_consistent() || input.iter().flatten().any(|&v| v >= n) {
+            return Vec::new();
+        }
         let mut faces: Vec<Option<[u32; 3]>> = input.iter().map(|&t| Some(t)).collect();
         let mut around: Vec<Vec<u32>> = alloc::vec![Vec::new(); self.nodes.len()];
         for (f, t) in input.iter().enumerate() {
@@ -181,8 +207,12 @@ impl Hierarchy {
 
     /// Replays every vertex split, last collapse first, from the base mesh, using only the nodes'
     /// children and wings; returns the triangles with each rotated to start at its smallest index.
-    /// For a hierarchy from [`build`], these are exactly the input's triangles.
+    /// For a hierarchy from [`build`], these are exactly the input's triangles; for one that is not
+    /// [`Hierarchy::is_consistent`], nothing.
     pub fn refine_all(&self) -> Vec<[u32; 3]> {
+        if !self.is_consistent() {
+            return Vec::new();
+        }
         let mut faces: Vec<[u32; 3]> = self.base_triangles.clone();
         // Faces around each vertex, kept up to date.
         let mut around: Vec<Vec<u32>> = alloc::vec![Vec::new(); self.nodes.len()];

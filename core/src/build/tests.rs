@@ -338,3 +338,15 @@ fn bytes_round_trip_through_the_format() {
         Err(FormatError::TrailingBytes { .. })
     ));
 }
+
+#[test]
+fn replays_refuse_inconsistent_hierarchies() {
+    let (p, t) = grid(3);
+    let mut h = build_it(&p, &t, BuildOptions::default());
+    assert!(h.is_consistent());
+    let last = h.nodes.len() - 1;
+    h.nodes[last].children[0] = 10_000;
+    assert!(!h.is_consistent());
+    assert!(h.refine_all().is_empty());
+    assert!(h.collapse_all(&t).is_empty());
+}
