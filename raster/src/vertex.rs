@@ -166,30 +166,6 @@ pub fn to_clip(mvp: &Mat4, position: Vec3) -> Vec4 {
     mvp.x_axis * position.x + mvp.y_axis * position.y + mvp.z_axis * position.z + mvp.w_axis
 }
 
-/// Transforms, lights and classifies one vertex.
-///
-/// `rgb` is the vertex's unlit colour in `0.0..=255.0`, multiplied by `light`.
-#[inline]
-pub fn shade_vertex(
-    mvp: &Mat4,
-    viewport: &Viewport,
-    position: Vec3,
-    light: f32,
-    rgb: [f32; 3],
-) -> ShadedVertex {
-    let clip = to_clip(mvp, position);
-    let outcode = clip::outcode(clip);
-    // Projected whatever the outcode (the result is then unused but harmless): no branch.
-    let s = viewport.project(clip, [0.0; 3]);
-    ShadedVertex {
-        x: s.x,
-        y: s.y,
-        z: s.z,
-        rgb: rgb.map(|c| saturate_u8(c * light)),
-        outcode,
-    }
-}
-
 /// What lit shading needs per vertex.
 #[derive(Clone, Copy, Debug)]
 pub struct VertexLighting<'a> {
@@ -252,9 +228,10 @@ const LANES: usize = 8;
 /// Runs the vertex stage over a whole mesh.
 ///
 /// Vertices go through in batches of eight, attribute by attribute (structure of arrays), so that
-/// the compiler can use SIMD registers: each lane does exactly the operations [`shade_vertex`]
-/// does, in the same order, so the results are bit-identical to it (and across targets: a SIMD
-/// lane rounds as a scalar operation does). `lighting` gives the normal matrix, the light and the
+/// the compiler can use SIMD registers. Each lane runs the same per-vertex routines the clipping
+/// path uses ([`to_clip`]'s order of operations, [`Viewport::project`], [`clip::outcode`],
+/// [`PreparedLighting::intensity`]), so both agree to the bit, on every target (a SIMD lane rounds
+/// as a scalar operation does). `lighting` gives the normal matrix, the light and the
 /// vertex normals for lit shading; `colors` the vertex colours, else `base` is used.
 ///
 /// `out` must be exactly as long as `positions`, as must `normals` and `colors` when given
@@ -379,27 +356,61 @@ mod tests {
         assert_eq!(l.intensity(Vec3::splat(f32::NAN)), 0.25);
     }
 
+    /// Unlit vertex stage for up to 19 vertices, on the stack (the crate has no allocator).
+    fn shade(positions: &[[f32; 3]], mvp: &Mat4, vp: &Viewport) -> [ShadedVertex; 19] {
+        let mut out = [ShadedVertex::default(); 19];
+        let n = positions.len();
+        shade_vertices(
+            mvp,
+            vp,
+            positions,
+            None,
+            None,
+            [10.0, 20.0, 30.0],
+            &mut out[..n],
+        );
+        out
+    }
+
     #[test]
     fn classifies_behind_camera_and_non_finite() {
         let vp = Viewport::new(8, 8);
-        let behind = shade_vertex(
+        let out = shade(
+            &[[0.0, 0.0, -1.0], [f32::NAN, 0.0, 0.5], [0.0, 0.0, 0.5]],
             &Mat4::IDENTITY,
             &vp,
-            Vec3::new(0.0, 0.0, -1.0),
-            1.0,
-            [0.0; 3],
         );
-        assert_ne!(behind.outcode & clip::NEAR, 0);
-        let nan = shade_vertex(
-            &Mat4::IDENTITY,
-            &vp,
-            Vec3::new(f32::NAN, 0.0, 0.5),
-            1.0,
-            [0.0; 3],
-        );
-        assert_ne!(nan.outcode & clip::INVALID, 0);
+        assert_ne!(out[0].outcode & clip::NEAR, 0);
+        assert_ne!(out[1].outcode & clip::INVALID, 0);
+        assert_eq!(out[2].outcode, 0);
+        assert_eq!(out[2].rgb, [10, 20, 30]);
     }
 
+    #[test]
+    fn batches_agree_with_the_per_vertex_routines() {
+        // 19 vertices: two full batches of eight and a partial one.
+        let mut positions = [[0.0f32; 3]; 19];
+        for (i, p) in positions.iter_mut().enumerate() {
+            let t = i as f32;
+            *p = [
+                libm::sinf(t) * 1.7,
+                libm::cosf(1.3 * t) * 1.1,
+                libm::sinf(0.7 * t) * 2.5,
+            ];
+        }
+        let mvp = Mat4::perspective_rh(1.1, 1.5, 0.2, 20.0)
+            * Mat4::look_at_rh(Vec3::new(0.5, 0.8, 3.0), Vec3::ZERO, Vec3::Y);
+        let vp = Viewport::new(96, 64);
+        let out = shade(&positions, &mvp, &vp);
+        for (p, v) in positions.iter().zip(&out) {
+            let c = to_clip(&mvp, Vec3::from(*p));
+            let s = vp.project(c, [0.0; 3]);
+            assert_eq!(
+                (v.x, v.y, v.z, v.outcode),
+                (s.x, s.y, s.z, clip::outcode(c))
+            );
+        }
+    }
     #[test]
     fn rounds_half_to_even_like_libm_rint() {
         for v in [
