@@ -119,6 +119,21 @@ fn open_and_higher_genus_meshes_keep_their_topology() {
     }
 }
 
+/// A CAD model with sharp creases: many collapses are illegal (they would flip triangles), which
+/// once made retried edges pile up exponentially. The heap work must stay linear.
+#[test]
+fn fandisk_builds_with_linear_heap_work() {
+    let fandisk = fixture("fandisk.obj");
+    let h = check_round_trip(&fandisk, BuildOptions::default());
+    let edges = fandisk.triangles.len() as u64 * 3 / 2;
+    // About 3.5 pushes an edge are measured; the runaway reached millions within seconds.
+    assert!(
+        h.heap_pushes <= 6 * edges,
+        "{} pushes for {edges} edges",
+        h.heap_pushes
+    );
+}
+
 #[test]
 fn bunny_round_trips_keeps_topology_and_is_shallow_when_balanced() {
     let bunny = load_obj_bytes(BUNNY_NAME, BUNNY_OBJ).unwrap();

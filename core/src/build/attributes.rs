@@ -46,6 +46,7 @@ fn angle(a: Vec3d, b: Vec3d) -> f64 {
 }
 
 pub(crate) fn finish(mesh: &InputMesh<'_>, e: Engine<'_>) -> Hierarchy {
+    let heap_pushes = e.pushed.len() as u64;
     let leaves = mesh.positions.len();
     let m = e.pos.len();
     let mut nodes: Vec<Node> = (0..m)
@@ -206,5 +207,6 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, e: Engine<'_>) -> Hierarchy {
         leaves: leaves as u32,
         nodes,
         base_triangles,
+        heap_pushes,
     }
 }

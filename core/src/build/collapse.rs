@@ -44,7 +44,7 @@ pub(crate) struct Engine<'o> {
     /// (cost as `f32` bits, index into `pushed`): eight bytes an entry, so sifting the heap
     /// touches half the memory it would with the edge inside.
     heap: BinaryHeap<Reverse<(u32, u32)>>,
-    pushed: Vec<(u32, u32)>,
+    pub pushed: Vec<(u32, u32)>,
     deferred: Vec<(u32, u32)>,
     /// Edges found illegal, by endpoint: retried when a collapse changes that endpoint's ring.
     rejected: Vec<Vec<u32>>,
@@ -421,8 +421,14 @@ impl<'o> Engine<'o> {
         // illegal may have become legal.
         for &x in &ring {
             self.push(p, x);
-            for y in core::mem::take(&mut self.rejected[x as usize]) {
+            let mut retry = core::mem::take(&mut self.rejected[x as usize]);
+            retry.sort_unstable();
+            retry.dedup();
+            for y in retry {
                 if self.alive[y as usize] {
+                    // Out of y's list too, or every retry would push the edge once more per
+                    // endpoint and the copies would double with each rejection.
+                    self.rejected[y as usize].retain(|&z| z != x);
                     self.push(x, y);
                 }
             }
