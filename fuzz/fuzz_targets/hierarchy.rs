@@ -1,10 +1,13 @@
 //! Hostile bytes into the hierarchy loader: an error or a consistent view, never a panic.
+//!
+//! Each input is tried as it is and with its checksum recomputed, so that mutations reach the
+//! structural checks behind the CRC.
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use vdlod_core::format::{HierarchyView, NONE};
+use vdlod_core::format::{crc32, HierarchyView, HEADER_SIZE, NONE};
 
-fuzz_target!(|data: &[u8]| {
+fn check(data: &[u8]) {
     if let Ok(view) = HierarchyView::parse(data) {
         for i in 0..view.nodes() {
             let n = view.node(i);
@@ -12,12 +15,23 @@ fuzz_target!(|data: &[u8]| {
         }
         for p in view.leaves()..view.nodes() {
             let s = view.split(p);
+            assert!(s.children.iter().all(|&c| c < p));
             for d in s.dependencies.0..s.dependencies.1 {
                 assert!(view.dependency(d) < view.nodes());
             }
         }
         for t in 0..view.base_triangles() {
-            let _ = view.base_triangle(t);
+            assert!(view.base_triangle(t).iter().all(|&v| v < view.nodes()));
         }
+    }
+}
+
+fuzz_target!(|data: &[u8]| {
+    check(data);
+    if data.len() >= HEADER_SIZE {
+        let mut sealed = data.to_vec();
+        let crc = crc32(&sealed[HEADER_SIZE..]);
+        sealed[24..28].copy_from_slice(&crc.to_le_bytes());
+        check(&sealed);
     }
 });
