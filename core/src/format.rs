@@ -228,9 +228,19 @@ pub struct SplitView {
     pub dependencies: (u32, u32),
 }
 
+/// Offset of record `index` of `size` bytes in a section at `base`; `usize::MAX` (which reads as
+/// nothing) when it overflows, as it can on 16- and 32-bit targets for out-of-range ids.
+#[inline]
+fn record(base: usize, index: u32, size: usize) -> usize {
+    (index as usize)
+        .checked_mul(size)
+        .and_then(|o| o.checked_add(base))
+        .unwrap_or(usize::MAX)
+}
+
 #[inline]
 fn u16_at(b: &[u8], o: usize) -> u16 {
-    match b.get(o..o + 2) {
+    match b.get(o..o.saturating_add(2)) {
         Some(s) => u16::from_le_bytes([s[0], s[1]]),
         None => 0,
     }
@@ -238,7 +248,7 @@ fn u16_at(b: &[u8], o: usize) -> u16 {
 
 #[inline]
 fn u32_at(b: &[u8], o: usize) -> u32 {
-    match b.get(o..o + 4) {
+    match b.get(o..o.saturating_add(4)) {
         Some(s) => u32::from_le_bytes([s[0], s[1], s[2], s[3]]),
         None => NONE,
     }
@@ -479,12 +489,16 @@ impl<'a> HierarchyView<'a> {
 
     /// Node `i` (`i < nodes()`; out-of-range ids read as zeros, never panic).
     pub fn node(&self, i: u32) -> NodeView {
-        let o = self.offsets()[0] + i as usize * NODE_SIZE;
+        let o = record(self.offsets()[0], i, NODE_SIZE);
         let b = self.bytes;
-        let h = |k: usize| f16_to_f32(u16_at(b, o + 12 + 2 * k));
-        let byte = |k: usize| b.get(o + k).copied().unwrap_or(0);
+        let h = |k: usize| f16_to_f32(u16_at(b, o.saturating_add(12 + 2 * k)));
+        let byte = |k: usize| b.get(o.saturating_add(k)).copied().unwrap_or(0);
         NodeView {
-            position: [f32_at(b, o), f32_at(b, o + 4), f32_at(b, o + 8)],
+            position: [
+                f32_at(b, o),
+                f32_at(b, o.saturating_add(4)),
+                f32_at(b, o.saturating_add(8)),
+            ],
             radius: h(0),
             mu: h(1),
             delta: h(2),
@@ -492,39 +506,41 @@ impl<'a> HierarchyView<'a> {
             normal: oct_decode(byte(22) as i8, byte(23) as i8),
             cone_sin: byte(24) as f32 / 255.0,
             color: [byte(25), byte(26), byte(27)],
-            depth: u16_at(b, o + 28),
-            parent: u32_at(b, o + 30),
+            depth: u16_at(b, o.saturating_add(28)),
+            parent: u32_at(b, o.saturating_add(30)),
         }
     }
 
     /// The split record of parent `p` (`leaves() <= p < nodes()`).
     pub fn split(&self, p: u32) -> SplitView {
         let [_, s, de, ..] = self.offsets();
-        let k = p.wrapping_sub(self.leaves) as usize;
-        let o = s + k * SPLIT_SIZE;
+        let o = record(s, p.wrapping_sub(self.leaves), SPLIT_SIZE);
         let b = self.bytes;
-        let start = u32_at(b, o + 16);
-        let end = if p + 1 < self.nodes {
-            u32_at(b, o + SPLIT_SIZE + 16)
+        let start = u32_at(b, o.saturating_add(16));
+        let end = if p.saturating_add(1) < self.nodes {
+            u32_at(b, o.saturating_add(SPLIT_SIZE + 16))
         } else {
             u32_at(b, de)
         };
         SplitView {
-            children: [u32_at(b, o), u32_at(b, o + 4)],
-            wings: [u32_at(b, o + 8), u32_at(b, o + 12)],
+            children: [u32_at(b, o), u32_at(b, o.saturating_add(4))],
+            wings: [
+                u32_at(b, o.saturating_add(8)),
+                u32_at(b, o.saturating_add(12)),
+            ],
             dependencies: (start, end),
         }
     }
 
     /// Dependency entry `d`.
     pub fn dependency(&self, d: u32) -> u32 {
-        u32_at(self.bytes, self.offsets()[3] + d as usize * 4)
+        u32_at(self.bytes, record(self.offsets()[3], d, 4))
     }
 
     /// Base triangle `t`.
     pub fn base_triangle(&self, t: u32) -> [u32; 3] {
-        let o = self.offsets()[4] + t as usize * 12;
-        [0, 4, 8].map(|k| u32_at(self.bytes, o + k))
+        let o = record(self.offsets()[4], t, 12);
+        [0, 4, 8].map(|k| u32_at(self.bytes, o.saturating_add(k)))
     }
 }
 

@@ -319,6 +319,15 @@ fn bytes_round_trip_through_the_format() {
         .collect();
     assert_eq!(base, h.base_triangles);
 
+    // Out-of-range ids read as nothing, never panic (the offsets would overflow on small targets).
+    for id in [u32::MAX, u32::MAX - 1] {
+        assert_eq!(view.node(id).parent, NONE);
+        assert_eq!(view.split(id).children, [NONE; 2]);
+        assert_eq!(view.dependency(id), NONE);
+        assert_eq!(view.base_triangle(id), [NONE; 3]);
+    }
+    assert_eq!(view.split(0).children, [NONE; 2]); // a leaf has no split record
+
     // One flipped bit anywhere after the header breaks the checksum.
     let mut bad = bytes.clone();
     bad[bytes.len() / 2] ^= 0x10;
