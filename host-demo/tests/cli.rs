@@ -18,15 +18,16 @@ fn scratch_dir(name: &str) -> PathBuf {
     dir
 }
 
-fn assert_one_line_error(name: &str, text: &str, problem: &str) {
-    let dir = scratch_dir(&format!("cli_{name}"));
+/// Writes `text` to `name`, runs the demo with `args` (where `FILE` stands for `name`), and checks
+/// it fails with one line naming the file and the problem.
+fn assert_one_line_failure(name: &str, text: &str, args: &[&str], problem: &str) {
+    let dir = scratch_dir(&format!("cli_{}_{name}", args[0]));
     std::fs::write(dir.join(name), text).unwrap();
-    let out = demo(
-        &[
-            "render", name, "--frames", "1", "--width", "32", "--height", "24",
-        ],
-        &dir,
-    );
+    let args: Vec<&str> = args
+        .iter()
+        .map(|&a| if a == "FILE" { name } else { a })
+        .collect();
+    let out = demo(&args, &dir);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success(), "{name}: expected failure");
     assert_eq!(stderr.lines().count(), 1, "{name}: {stderr}");
@@ -38,6 +39,17 @@ fn assert_one_line_error(name: &str, text: &str, problem: &str) {
         stderr.contains(problem),
         "{name}: expected '{problem}' in: {stderr}"
     );
+}
+
+fn assert_one_line_error(name: &str, text: &str, problem: &str) {
+    let render = [
+        "render", "FILE", "--frames", "1", "--width", "32", "--height", "24",
+    ];
+    assert_one_line_failure(name, text, &render, problem);
+}
+
+fn assert_build_error(name: &str, text: &str, problem: &str) {
+    assert_one_line_failure(name, text, &["build", "FILE", "-o", "x.vdh"], problem);
 }
 
 #[test]
@@ -208,18 +220,5 @@ fn build_rejects_non_manifold_meshes_in_one_line() {
         "dup.obj",
         "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 2 3 1\n",
         "repeats triangle 0",
-    );
-}
-
-fn assert_build_error(name: &str, text: &str, problem: &str) {
-    let dir = scratch_dir(&format!("cli_build_{name}"));
-    std::fs::write(dir.join(name), text).unwrap();
-    let out = demo(&["build", name, "-o", "x.vdh"], &dir);
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(!out.status.success());
-    assert_eq!(stderr.lines().count(), 1, "{stderr}");
-    assert!(
-        stderr.contains(name) && stderr.contains(problem),
-        "{stderr}"
     );
 }

@@ -259,7 +259,7 @@ pub fn draw_indexed<P: Pixel>(
         &params.mvp,
         &viewport,
         mesh.positions,
-        lighting,
+        prepared.as_ref().zip(mesh.normals),
         mesh.colors,
         base,
         scratch,

@@ -240,13 +240,12 @@ pub fn shade_vertices(
     mvp: &Mat4,
     viewport: &Viewport,
     positions: &[[f32; 3]],
-    lighting: Option<VertexLighting<'_>>,
+    lighting: Option<(&PreparedLighting, &[[f32; 3]])>,
     colors: Option<&[[u8; 3]]>,
     base: [f32; 3],
     out: &mut [ShadedVertex],
 ) {
     let m = mvp.to_cols_array_2d();
-    let prepared = lighting.map(|l| l.prepare());
     for (first, out) in (0..).step_by(LANES).zip(out.chunks_mut(LANES)) {
         let len = out.len();
         // Gather the batch; lanes past the end of the mesh hold zeros and are not stored.
@@ -272,8 +271,8 @@ pub fn shade_vertices(
                 }
             }
         }
-        if let Some(l) = lighting {
-            for (k, q) in l.normals[first..first + len].iter().enumerate() {
+        if let Some((_, normals)) = lighting {
+            for (k, q) in normals[first..first + len].iter().enumerate() {
                 for a in 0..3 {
                     n[a][k] = q[a];
                 }
@@ -288,7 +287,7 @@ pub fn shade_vertices(
             }
         }
         let mut light = [1.0f32; LANES];
-        if let Some(p) = &prepared {
+        if let Some((p, _)) = lighting {
             for (k, l) in light.iter_mut().enumerate() {
                 *l = p.intensity(Vec3::new(n[0][k], n[1][k], n[2][k]));
             }

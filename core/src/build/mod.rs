@@ -49,8 +49,8 @@ use alloc::vec::Vec;
 pub use collapse::Collapse;
 pub use input::{validate, BuildError, InputMesh};
 
-/// "No vertex": a missing wing (border edge) or parent (root).
-pub const NONE: u32 = u32::MAX;
+/// "No vertex": a missing wing (border edge) or parent (root); the same value the file stores.
+pub use crate::format::NONE;
 
 /// How the next edge to collapse is chosen.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
