@@ -36,9 +36,10 @@ fn walk(view: &HierarchyView<'_>) {
             .children
             .iter()
             .all(|&c| c < p && view.node(c).parent == p));
-        for d in s.dependencies.0..s.dependencies.1 {
-            assert!(view.dependency(d) < view.nodes());
-        }
+        assert!(s
+            .neighbours
+            .iter()
+            .all(|&f| f == NONE || view.face_creator(f).is_none_or(|q| q > p)));
     }
     for t in 0..view.base_triangles() {
         assert!(view

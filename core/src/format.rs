@@ -11,28 +11,34 @@
 //!
 //! | section | size | content |
 //! |---|---|---|
-//! | header | 40 | magic `VDLH`, version `u16` = 1, flags `u16` (bit 0: colours present), `leaves`, `nodes`, `base_triangles`, `dependencies` (`u32` each), CRC-32 of everything after the header (`u32`), 12 reserved zero bytes |
+//! | header | 40 | magic `VDLH`, version `u16` = 2, flags `u16` (bit 0: colours present), `leaves`, `nodes`, `base_triangles` (`u32` each), 4 zero bytes, CRC-32 of everything after the header (`u32`), 12 reserved zero bytes |
 //! | nodes | 34 per node | position `3 x f32`; radius, `mu`, `delta`, spheroid `a`, `b` as `f16` rounded up; normal octahedral `2 x i8`; cone sine `u8` (`ceil(255 sin)`, 255: no useful cone); colour `3 x u8`; depth `u16`; parent `u32` (`0xFFFF_FFFF` for a root) |
-//! | splits | 20 per parent | children `2 x u32`, wings `2 x u32` (second `0xFFFF_FFFF` on a border), first dependency `u32` |
-//! | dependency end | 4 | one past the last parent's dependencies |
-//! | dependencies | 4 each | node ids |
+//! | splits | 32 per parent | children `2 x u32`, wings `2 x u32` (second `0xFFFF_FFFF` on a border), neighbour triangles `4 x u32` |
 //! | base triangles | 12 each | `3 x u32` root ids, counter-clockwise |
 //!
 //! Nodes `0..leaves` are the input vertices; nodes `leaves..nodes` are parents, each with a larger
 //! id than its children, so parent links can never form a cycle.
+//!
+//! Triangles have ids too ([`split_face`]): base triangle `k` is `k`, and the split of parent `p`
+//! adds triangle `base + 2 (p - leaves)` = `(c0, c1, w0)` and, unless on a border, the next id =
+//! `(c1, c0, w1)`. A split record's neighbours are the triangles across those two triangles'
+//! outer edges (`c1-w0`, `w0-c0`, `c0-w1`, `w1-c1`; `0xFFFF_FFFF` on a border), Hoppe's
+//! `fn0..fn3`: a split is legal when its neighbours exist, which is what the runtime cut checks
+//! and, when they do not, forces (each neighbour is a base triangle or made by a coarser split, so
+//! forcing ends).
 
 use core::fmt;
 
 /// First four bytes of a hierarchy file.
 pub const MAGIC: [u8; 4] = *b"VDLH";
 /// The version this crate reads and writes.
-pub const VERSION: u16 = 1;
+pub const VERSION: u16 = 2;
 /// Header size in bytes.
 pub const HEADER_SIZE: usize = 40;
 /// Bytes per node record.
 pub const NODE_SIZE: usize = 34;
 /// Bytes per split record.
-pub const SPLIT_SIZE: usize = 20;
+pub const SPLIT_SIZE: usize = 32;
 /// "No node" in parent and wing fields.
 pub const NONE: u32 = u32::MAX;
 /// Header flag: the nodes carry meaningful colours.
@@ -75,7 +81,7 @@ pub enum FormatError {
         /// What is wrong.
         what: &'static str,
     },
-    /// A dependency or base triangle refers to a missing or non-root node.
+    /// A base triangle refers to a missing or non-root node.
     BadReference {
         /// The section.
         section: &'static str,
@@ -189,7 +195,6 @@ pub struct HierarchyView<'a> {
     leaves: u32,
     nodes: u32,
     base_triangles: u32,
-    dependencies: u32,
 }
 
 /// One node, read from a [`HierarchyView`].
@@ -224,8 +229,18 @@ pub struct SplitView {
     pub children: [u32; 2],
     /// The wings; the second is [`NONE`] on a border.
     pub wings: [u32; 2],
-    /// Range of this parent's dependencies in [`HierarchyView::dependency`].
-    pub dependencies: (u32, u32),
+    /// Triangles across the added triangles' outer edges (`c1-w0`, `w0-c0`, `c0-w1`, `w1-c1`),
+    /// or [`NONE`].
+    pub neighbours: [u32; 4],
+}
+
+/// The id of a triangle a split adds: the first (`second == false`) or the second of parent
+/// `parent`'s split, in a hierarchy with `base` base triangles and `leaves` leaves. Wraps for
+/// ids out of range (a [`HierarchyView`] never stores those).
+#[inline]
+pub fn split_face(base: u32, leaves: u32, parent: u32, second: bool) -> u32 {
+    base.wrapping_add(parent.wrapping_sub(leaves).wrapping_mul(2))
+        .wrapping_add(second as u32)
 }
 
 /// Offset of record `index` of `size` bytes in a section at `base`; `usize::MAX` (which reads as
@@ -294,25 +309,17 @@ pub fn oct_decode(x: i8, y: i8) -> [f32; 3] {
 }
 
 impl<'a> HierarchyView<'a> {
-    /// Byte offsets of the sections: nodes, splits, dependency end, dependencies, base, total.
-    fn layout(leaves: u32, nodes: u32, deps: u32, base: u32) -> [u64; 6] {
+    /// Byte offsets of the sections: nodes, splits, base triangles, total.
+    fn layout(leaves: u32, nodes: u32, base: u32) -> [u64; 4] {
         let n = HEADER_SIZE as u64;
         let s = n + nodes as u64 * NODE_SIZE as u64;
-        let de = s + (nodes as u64 - leaves as u64) * SPLIT_SIZE as u64;
-        let d = de + 4;
-        let b = d + deps as u64 * 4;
+        let b = s + (nodes as u64 - leaves as u64) * SPLIT_SIZE as u64;
         let end = b + base as u64 * 12;
-        [n, s, de, d, b, end]
+        [n, s, b, end]
     }
 
-    fn offsets(&self) -> [usize; 6] {
-        Self::layout(
-            self.leaves,
-            self.nodes,
-            self.dependencies,
-            self.base_triangles,
-        )
-        .map(|o| o as usize)
+    fn offsets(&self) -> [usize; 4] {
+        Self::layout(self.leaves, self.nodes, self.base_triangles).map(|o| o as usize)
     }
 
     /// Validates `bytes` and returns a view of them.
@@ -336,22 +343,18 @@ impl<'a> HierarchyView<'a> {
             leaves: u32_at(bytes, 8),
             nodes: u32_at(bytes, 12),
             base_triangles: u32_at(bytes, 16),
-            dependencies: u32_at(bytes, 20),
         };
         if view.nodes < view.leaves
             || view.nodes - view.leaves > view.leaves
             || view.nodes == NONE
             || view.flags & !FLAG_COLORS != 0
+            || (view.base_triangles as u64 + 2 * (view.nodes - view.leaves) as u64) >= NONE as u64
+            || bytes[20..24].iter().any(|&b| b != 0)
             || bytes[28..40].iter().any(|&b| b != 0)
         {
             return Err(FormatError::BadCounts);
         }
-        let end = Self::layout(
-            view.leaves,
-            view.nodes,
-            view.dependencies,
-            view.base_triangles,
-        )[5];
+        let end = Self::layout(view.leaves, view.nodes, view.base_triangles)[3];
         let actual = bytes.len() as u64;
         if actual < end {
             return Err(FormatError::Truncated {
@@ -400,7 +403,7 @@ impl<'a> HierarchyView<'a> {
     }
 
     fn check_splits(&self) -> Result<(), FormatError> {
-        let mut previous_end = 0;
+        let faces = self.faces();
         for p in self.leaves..self.nodes {
             let bad = |what| Err(FormatError::BadNode { node: p, what });
             let s = self.split(p);
@@ -415,24 +418,29 @@ impl<'a> HierarchyView<'a> {
             if w0 >= self.nodes || (w1 != NONE && w1 >= self.nodes) {
                 return bad("wing out of range");
             }
-            if s.children.contains(&w0) || s.children.contains(&w1) {
-                return bad("wing equals a child");
+            if s.children.contains(&w0) || s.children.contains(&w1) || w0 == w1 {
+                return bad("wing equals a child or the other wing");
             }
-            let (start, end) = s.dependencies;
-            if start != previous_end || end < start || end > self.dependencies {
-                return bad("dependency range out of order");
+            // Each neighbour exists before this split: a base triangle or one a coarser split
+            // (larger id) adds; none across a missing triangle. (One triangle can be the
+            // neighbour of both added ones, when a child has three neighbours.)
+            let n = s.neighbours;
+            for &f in n.iter().filter(|&&f| f != NONE) {
+                if f >= faces || self.face_creator(f).is_some_and(|q| q <= p) {
+                    return bad("neighbour triangle out of range or not older than the split");
+                }
             }
-            previous_end = end;
-        }
-        if previous_end != self.dependencies {
-            return Err(FormatError::BadCounts);
-        }
-        for d in 0..self.dependencies {
-            if self.dependency(d) >= self.nodes {
-                return Err(FormatError::BadReference {
-                    section: "dependencies",
-                    index: d,
-                });
+            if n[0] == n[1] || (n[2] == n[3] && n[2] != NONE) {
+                return bad("a triangle neighbours one added triangle twice");
+            }
+            if n[0] == NONE && n[1] == NONE {
+                return bad("first added triangle has no neighbour");
+            }
+            if w1 == NONE && (n[2] != NONE || n[3] != NONE) {
+                return bad("neighbours of a missing triangle");
+            }
+            if w1 != NONE && n[2] == NONE && n[3] == NONE {
+                return bad("second added triangle has no neighbour");
             }
         }
         Ok(())
@@ -472,9 +480,33 @@ impl<'a> HierarchyView<'a> {
         self.base_triangles
     }
 
-    /// Total dependency entries.
-    pub fn dependencies(&self) -> u32 {
-        self.dependencies
+    /// Triangle ids in use: the base triangles plus two per split.
+    pub fn faces(&self) -> u32 {
+        self.base_triangles + 2 * (self.nodes - self.leaves)
+    }
+
+    /// The parent whose split adds triangle `face`, or `None` for a base triangle (and for ids out
+    /// of range).
+    #[inline]
+    pub fn face_creator(&self, face: u32) -> Option<u32> {
+        let k = face.checked_sub(self.base_triangles)?;
+        let p = self.leaves.checked_add(k / 2)?;
+        (p < self.nodes).then_some(p)
+    }
+
+    /// The id of a triangle parent `p`'s split adds (see [`split_face`]).
+    #[inline]
+    pub fn split_face(&self, p: u32, second: bool) -> u32 {
+        split_face(self.base_triangles, self.leaves, p, second)
+    }
+
+    /// Node `i`'s parent, or [`NONE`] (cheaper than [`HierarchyView::node`]).
+    #[inline]
+    pub fn parent(&self, i: u32) -> u32 {
+        u32_at(
+            self.bytes,
+            record(self.offsets()[0], i, NODE_SIZE).saturating_add(30),
+        )
     }
 
     /// Whether the nodes carry meaningful colours.
@@ -511,35 +543,22 @@ impl<'a> HierarchyView<'a> {
         }
     }
 
-    /// The split record of parent `p` (`leaves() <= p < nodes()`).
+    /// The split record of parent `p` (`leaves() <= p < nodes()`; anything else reads as
+    /// [`NONE`]s).
     pub fn split(&self, p: u32) -> SplitView {
-        let [_, s, de, ..] = self.offsets();
-        let o = record(s, p.wrapping_sub(self.leaves), SPLIT_SIZE);
-        let b = self.bytes;
-        let start = u32_at(b, o.saturating_add(16));
-        let end = if p.saturating_add(1) < self.nodes {
-            u32_at(b, o.saturating_add(SPLIT_SIZE + 16))
-        } else {
-            u32_at(b, de)
-        };
+        let o = record(self.offsets()[1], p.wrapping_sub(self.leaves), SPLIT_SIZE);
+        let o = if p < self.leaves { usize::MAX } else { o };
+        let at = |k: usize| u32_at(self.bytes, o.saturating_add(4 * k));
         SplitView {
-            children: [u32_at(b, o), u32_at(b, o.saturating_add(4))],
-            wings: [
-                u32_at(b, o.saturating_add(8)),
-                u32_at(b, o.saturating_add(12)),
-            ],
-            dependencies: (start, end),
+            children: [at(0), at(1)],
+            wings: [at(2), at(3)],
+            neighbours: [at(4), at(5), at(6), at(7)],
         }
-    }
-
-    /// Dependency entry `d`.
-    pub fn dependency(&self, d: u32) -> u32 {
-        u32_at(self.bytes, record(self.offsets()[3], d, 4))
     }
 
     /// Base triangle `t`.
     pub fn base_triangle(&self, t: u32) -> [u32; 3] {
-        let o = record(self.offsets()[4], t, 12);
+        let o = record(self.offsets()[2], t, 12);
         [0, 4, 8].map(|k| u32_at(self.bytes, o.saturating_add(k)))
     }
 }

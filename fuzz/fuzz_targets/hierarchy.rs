@@ -16,9 +16,10 @@ fn check(data: &[u8]) {
         for p in view.leaves()..view.nodes() {
             let s = view.split(p);
             assert!(s.children.iter().all(|&c| c < p));
-            for d in s.dependencies.0..s.dependencies.1 {
-                assert!(view.dependency(d) < view.nodes());
-            }
+            assert!(s
+                .neighbours
+                .iter()
+                .all(|&f| f == NONE || view.face_creator(f).is_none_or(|q| q > p)));
         }
         for t in 0..view.base_triangles() {
             assert!(view.base_triangle(t).iter().all(|&v| v < view.nodes()));

@@ -63,11 +63,30 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, e: Engine<'_>) -> Hierarchy {
             ..Node::default()
         })
         .collect();
-    for (c, deps) in e.collapses.iter().zip(&e.deps) {
+    // Triangle ids as the file numbers them: the base triangles first, then two per split.
+    let base_count = e.face_alive.iter().filter(|&&a| a).count() as u32;
+    let mut face_id = vec![NONE; e.faces.len()];
+    let mut next = 0;
+    for (f, &alive) in e.face_alive.iter().enumerate() {
+        if alive {
+            face_id[f] = next;
+            next += 1;
+        }
+    }
+    for (s, c) in e.collapses.iter().enumerate() {
+        for (k, &f) in c.faces.iter().enumerate() {
+            if let Some(id) = face_id.get_mut(f as usize) {
+                *id = base_count + 2 * s as u32 + k as u32;
+            }
+        }
+    }
+    for c in &e.collapses {
         let p = c.parent as usize;
         nodes[p].children = c.children;
         nodes[p].wings = c.wings;
-        nodes[p].dependencies = deps.clone();
+        nodes[p].neighbours = c
+            .neighbours
+            .map(|f| face_id.get(f as usize).copied().unwrap_or(NONE));
         for ch in c.children {
             nodes[ch as usize].parent = c.parent;
         }

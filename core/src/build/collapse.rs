@@ -24,6 +24,11 @@ pub struct Collapse {
     pub children: [u32; 2],
     /// Third corners of the removed triangles; `wings[1]` is `NONE` on a boundary edge.
     pub wings: [u32; 2],
+    /// The removed triangles (input triangle indices): `(c0, c1, w0)` and `(c1, c0, w1)` or `NONE`.
+    pub faces: [u32; 2],
+    /// The triangles across their outer edges, as input triangle indices or `NONE` on a border:
+    /// across `c1-w0`, `w0-c0`, `c0-w1`, `w1-c1`.
+    pub neighbours: [u32; 4],
 }
 
 pub(crate) struct Engine<'o> {
@@ -49,8 +54,6 @@ pub(crate) struct Engine<'o> {
     /// Edges found illegal, by endpoint: retried when a collapse changes that endpoint's ring.
     rejected: Vec<Vec<u32>>,
     pub collapses: Vec<Collapse>,
-    /// Neighbours of each parent when it formed (the merge-tree paper's dependencies, §3.2).
-    pub deps: Vec<Vec<u32>>,
 }
 
 fn face_normal(p: &[Vec3d], f: [u32; 3]) -> Vec3d {
@@ -115,7 +118,6 @@ impl<'o> Engine<'o> {
             deferred: Vec::new(),
             rejected: vec![Vec::new(); n],
             collapses: Vec::new(),
-            deps: Vec::new(),
         };
         e.alive_count = e.alive.iter().filter(|&&a| a).count();
         // Boundary quadrics keep open borders in place.
@@ -165,6 +167,21 @@ impl<'o> Engine<'o> {
             }
         }
         (wings, count)
+    }
+
+    /// The live face with directed edge `a -> b`, or `NONE`.
+    fn face_with_edge(&self, a: u32, b: u32) -> u32 {
+        if a == NONE || b == NONE {
+            return NONE;
+        }
+        self.vfaces[a as usize]
+            .iter()
+            .copied()
+            .find(|&f| {
+                let t = self.faces[f as usize];
+                (0..3).any(|k| t[k] == a && t[(k + 1) % 3] == b)
+            })
+            .unwrap_or(NONE)
     }
 
     fn boundary_neighbours(&self, v: u32) -> Vec<u32> {
@@ -344,6 +361,15 @@ impl<'o> Engine<'o> {
         } else {
             ([b, a], [wings[1], wings[0]])
         };
+        let [c0, c1] = children;
+        let [w0, w1] = wings;
+        let faces = [self.face_with_edge(c0, c1), self.face_with_edge(c1, c0)];
+        let neighbours = [
+            self.face_with_edge(w0, c1),
+            self.face_with_edge(c0, w0),
+            self.face_with_edge(w1, c0),
+            self.face_with_edge(c1, w1),
+        ];
         let p = self.pos.len() as u32;
         let (ia, ib) = (a as usize, b as usize);
         self.pos.push(v);
@@ -399,6 +425,8 @@ impl<'o> Engine<'o> {
             parent: p,
             children,
             wings,
+            faces,
+            neighbours,
         });
         self.rejected.push(Vec::new());
         self.rejected[ia].clear();
@@ -416,7 +444,6 @@ impl<'o> Engine<'o> {
             r.push(p);
         }
         self.vverts.push(ring.clone());
-        self.deps.push(ring.clone());
         // Fresh costs for the edges of p (no other edge's cost changed); edges around it that were
         // illegal may have become legal.
         for &x in &ring {

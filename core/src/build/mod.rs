@@ -16,7 +16,7 @@
 //! Each node then gets what the run-time tests need ([`Node`]): a bounding-sphere radius over its
 //! subtree's region (merge-tree §3.3), a cone of normals, Hoppe-style uniform and normal deviation
 //! and the wavelet paper's normal-aligned spheroid (equation 3), colour, depth, and its
-//! dependencies. [`Hierarchy::refine_all`] replays every split from the base mesh with nothing but
+//! neighbouring triangles (Hoppe's `fn0..fn3`). [`Hierarchy::refine_all`] replays every split from the base mesh with nothing but
 //! the nodes' records.
 //!
 //! ```
@@ -85,7 +85,7 @@ pub struct Progress {
 }
 
 /// One vertex of the forest.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Node {
     /// Position.
     pub position: [f32; 3],
@@ -96,9 +96,12 @@ pub struct Node {
     pub children: [u32; 2],
     /// Third corners of the triangles the split adds; `wings[1]` is [`NONE`] on a border.
     pub wings: [u32; 2],
-    /// Neighbours when the node was formed: all must be present for it to split or to form
-    /// (merge-tree paper §3.2). Empty for leaves.
-    pub dependencies: Vec<u32>,
+    /// The triangles across the outer edges of the two the split adds, in the order
+    /// `c1-w0`, `w0-c0`, `c0-w1`, `w1-c1`, or [`NONE`] on a border; triangles are numbered as
+    /// [`Hierarchy::face_id`] says. They are Hoppe's `fn0..fn3`: the split is legal when all four
+    /// exist in the current mesh, the collapse when they are still the added triangles'
+    /// neighbours. Leaves: `[NONE; 4]`.
+    pub neighbours: [u32; 4],
     /// Radius of a sphere around `position` holding the node's region and all its descendants'.
     pub radius: f32,
     /// Axis of the cone of normals of the node's region (unit length).
@@ -132,7 +135,40 @@ pub struct Hierarchy {
     pub heap_pushes: u64,
 }
 
+impl Default for Node {
+    fn default() -> Node {
+        Node {
+            position: [0.0; 3],
+            parent: NONE,
+            children: [NONE; 2],
+            wings: [NONE; 2],
+            neighbours: [NONE; 4],
+            radius: 0.0,
+            normal: [0.0, 0.0, 1.0],
+            cone_sin: 1.0,
+            mu: 0.0,
+            delta: 0.0,
+            spheroid: [0.0; 2],
+            color: [0; 3],
+            depth: 0,
+        }
+    }
+}
+
 impl Hierarchy {
+    /// The id of a triangle: base triangle `k` is `k`; the split of parent `p` adds triangles
+    /// `base + 2 (p - leaves)` (`children[0], children[1], wings[0]`) and the next id
+    /// (`children[1], children[0], wings[1]`, absent on a border). Every triangle of every cut
+    /// has one id for as long as it exists, whatever its corners are renamed to.
+    pub fn face_id(&self, parent: u32, second: bool) -> u32 {
+        crate::format::split_face(
+            self.base_triangles.len() as u32,
+            self.leaves,
+            parent,
+            second,
+        )
+    }
+
     /// The roots: the vertices of the base mesh (including input vertices no triangle used).
     pub fn roots(&self) -> impl Iterator<Item = u32> + '_ {
         (0..self.nodes.len() as u32).filter(|&i| self.nodes[i as usize].parent == NONE)

@@ -308,11 +308,10 @@ fn bytes_round_trip_through_the_format() {
     for p in h.leaves..h.nodes.len() as u32 {
         let s = view.split(p);
         let n = &h.nodes[p as usize];
-        assert_eq!((s.children, s.wings), (n.children, n.wings));
-        let deps: Vec<u32> = (s.dependencies.0..s.dependencies.1)
-            .map(|d| view.dependency(d))
-            .collect();
-        assert_eq!(deps, n.dependencies);
+        assert_eq!(
+            (s.children, s.wings, s.neighbours),
+            (n.children, n.wings, n.neighbours)
+        );
     }
     let base: Vec<[u32; 3]> = (0..view.base_triangles())
         .map(|k| view.base_triangle(k))
@@ -323,7 +322,6 @@ fn bytes_round_trip_through_the_format() {
     for id in [u32::MAX, u32::MAX - 1] {
         assert_eq!(view.node(id).parent, NONE);
         assert_eq!(view.split(id).children, [NONE; 2]);
-        assert_eq!(view.dependency(id), NONE);
         assert_eq!(view.base_triangle(id), [NONE; 3]);
     }
     assert_eq!(view.split(0).children, [NONE; 2]); // a leaf has no split record

@@ -15,12 +15,9 @@ impl Hierarchy {
         // A hierarchy that is not `is_consistent` gives bytes that `parse` rejects, not a panic.
         let parent_nodes = self.nodes.get(self.leaves as usize..).unwrap_or(&[]);
         let parents = parent_nodes.len();
-        let deps: usize = self.nodes.iter().map(|n| n.dependencies.len()).sum();
         let size = HEADER_SIZE
             + self.nodes.len() * NODE_SIZE
             + parents * SPLIT_SIZE
-            + 4
-            + deps * 4
             + self.base_triangles.len() * 12;
         let mut out = Vec::with_capacity(size);
         out.extend_from_slice(&MAGIC);
@@ -30,7 +27,7 @@ impl Hierarchy {
             self.leaves,
             self.nodes.len() as u32,
             self.base_triangles.len() as u32,
-            deps as u32,
+            0,
         ] {
             out.extend_from_slice(&count.to_le_bytes());
         }
@@ -49,17 +46,9 @@ impl Hierarchy {
             out.extend_from_slice(&n.depth.to_le_bytes());
             out.extend_from_slice(&n.parent.to_le_bytes());
         }
-        let mut first = 0u32;
         for n in parent_nodes {
-            for v in [n.children[0], n.children[1], n.wings[0], n.wings[1], first] {
+            for v in n.children.iter().chain(&n.wings).chain(&n.neighbours) {
                 out.extend_from_slice(&v.to_le_bytes());
-            }
-            first += n.dependencies.len() as u32;
-        }
-        out.extend_from_slice(&first.to_le_bytes());
-        for n in parent_nodes {
-            for d in &n.dependencies {
-                out.extend_from_slice(&d.to_le_bytes());
             }
         }
         for t in &self.base_triangles {
