@@ -13,4 +13,7 @@ extern crate alloc;
 
 #[cfg(feature = "build")]
 pub mod build;
+pub mod cut;
 pub mod format;
+mod nodemap;
+pub mod policy;

@@ -358,4 +358,4 @@ pub fn build(
 }
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;

@@ -47,7 +47,7 @@ pub fn topology(triangles: &[[u32; 3]]) -> (i64, usize) {
     )
 }
 
-fn sorted(mut t: Vec<[u32; 3]>) -> Vec<[u32; 3]> {
+pub(crate) fn sorted(mut t: Vec<[u32; 3]>) -> Vec<[u32; 3]> {
     for x in t.iter_mut() {
         *x = rotate_to_min(*x);
     }
@@ -56,7 +56,7 @@ fn sorted(mut t: Vec<[u32; 3]>) -> Vec<[u32; 3]> {
 }
 
 /// An `n` by `n` grid of quads, split in two, gently curved so collapses have costs that differ.
-fn grid(n: u32) -> (Vec<[f32; 3]>, Vec<[u32; 3]>) {
+pub(crate) fn grid(n: u32) -> (Vec<[f32; 3]>, Vec<[u32; 3]>) {
     let mut p = Vec::new();
     for j in 0..=n {
         for i in 0..=n {
@@ -76,7 +76,7 @@ fn grid(n: u32) -> (Vec<[f32; 3]>, Vec<[u32; 3]>) {
 }
 
 /// A unit sphere: an octahedron subdivided `levels` times (4-to-1), vertices pushed outwards.
-fn sphere(levels: u32) -> (Vec<[f32; 3]>, Vec<[u32; 3]>) {
+pub(crate) fn sphere(levels: u32) -> (Vec<[f32; 3]>, Vec<[u32; 3]>) {
     let mut p: Vec<[f32; 3]> = alloc::vec![
         [1.0, 0.0, 0.0],
         [-1.0, 0.0, 0.0],
@@ -120,7 +120,7 @@ fn sphere(levels: u32) -> (Vec<[f32; 3]>, Vec<[u32; 3]>) {
     (p, t)
 }
 
-fn build_it(p: &[[f32; 3]], t: &[[u32; 3]], opts: BuildOptions) -> Hierarchy {
+pub(crate) fn build_it(p: &[[f32; 3]], t: &[[u32; 3]], opts: BuildOptions) -> Hierarchy {
     let mesh = InputMesh {
         positions: p,
         colors: None,

@@ -1,0 +1,173 @@
+//! Cut tests on generated meshes (fixtures and long camera paths are in the workspace's `tests/`).
+
+use alloc::boxed::Box;
+use alloc::vec::Vec;
+
+use super::*;
+use crate::build::tests::{build_it, grid, sorted, sphere, topology};
+use crate::build::BuildOptions;
+
+type Small = Cut<1024, 2048, 256>;
+
+fn node_triangles<const V: usize, const F: usize, const Q: usize>(
+    cut: &Cut<V, F, Q>,
+) -> Vec<[u32; 3]> {
+    let nodes = cut.nodes();
+    let t = cut
+        .triangles()
+        .iter()
+        .map(|t| t.map(|s| nodes[s as usize]))
+        .collect();
+    sorted(t)
+}
+
+fn meshes() -> Vec<(&'static str, Vec<u8>, Vec<[u32; 3]>)> {
+    let mut out = Vec::new();
+    for (name, (p, t), balanced) in [
+        ("sphere", sphere(3), false),
+        ("sphere balanced", sphere(3), true),
+        ("grid", grid(12), false),
+        ("grid balanced", grid(12), true),
+    ] {
+        let opts = BuildOptions {
+            balanced,
+            ..BuildOptions::default()
+        };
+        let h = build_it(&p, &t, opts);
+        out.push((name, h.to_bytes(false), t));
+    }
+    out
+}
+
+#[test]
+fn full_refinement_gives_the_input_and_full_coarsening_the_base() {
+    for (name, bytes, input) in meshes() {
+        let h = HierarchyView::parse(&bytes).unwrap();
+        let mut cut: Box<Small> = Box::default();
+        cut.reset(&h).unwrap();
+        let base = node_triangles(&cut);
+        let mut rounds = 0;
+        while cut.refine_everything(&h) > 0 {
+            cut.check(&h).unwrap_or_else(|d| panic!("{name}: {d:?}"));
+            rounds += 1;
+            assert!(rounds < 100, "{name}: refinement does not end");
+        }
+        assert_eq!(node_triangles(&cut), sorted(input.clone()), "{name}");
+        // Collapse finest first until nothing is left to collapse.
+        loop {
+            let mut done = 0;
+            for p in h.leaves()..h.nodes() {
+                if cut.collapse(&h, p).is_ok() {
+                    done += 1;
+                    cut.check(&h).unwrap_or_else(|d| panic!("{name}: {d:?}"));
+                }
+            }
+            if done == 0 {
+                break;
+            }
+        }
+        assert_eq!(node_triangles(&cut), base, "{name}");
+    }
+}
+
+#[test]
+fn random_splits_and_collapses_keep_a_valid_manifold() {
+    for (name, bytes, input) in meshes() {
+        let h = HierarchyView::parse(&bytes).unwrap();
+        let expected = topology(&input);
+        let mut cut: Box<Small> = Box::default();
+        cut.reset(&h).unwrap();
+        let mut x = 0x2545_F491u32;
+        let mut splits = 0;
+        let mut collapses = 0;
+        for _ in 0..3000 {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            let v = cut.nodes()[(x >> 8) as usize % cut.vertices()];
+            if x & 1 == 0 || x & 6 == 0 {
+                if let Ok(k) = cut.force_split(&h, v, 0, &mut |_| Ok(())) {
+                    splits += k;
+                }
+            } else {
+                let p = h.parent(v);
+                if p != NONE && cut.collapse(&h, p).is_ok() {
+                    collapses += 1;
+                }
+            }
+            cut.check(&h).unwrap_or_else(|d| panic!("{name}: {d:?}"));
+            assert_eq!(topology(&node_triangles(&cut)), expected, "{name}");
+        }
+        assert!(splits > 100 && collapses > 100, "{name}: {splits} {collapses}");
+    }
+}
+
+#[test]
+fn forced_splits_bring_what_a_split_needs() {
+    let (p, t) = sphere(3);
+    let bytes = build_it(&p, &t, BuildOptions::default()).to_bytes(false);
+    let h = HierarchyView::parse(&bytes).unwrap();
+    let mut cut: Box<Small> = Box::default();
+    cut.reset(&h).unwrap();
+    // Every leaf's parent can be reached from the base mesh by forcing alone.
+    for leaf in 0..h.leaves() {
+        let mut v = leaf;
+        while !cut.is_active(v) {
+            let mut a = h.parent(v);
+            while !cut.is_active(a) {
+                a = h.parent(a);
+            }
+            cut.force_split(&h, a, 0, &mut |_| Ok(())).unwrap();
+            v = leaf;
+        }
+        cut.check(&h).unwrap();
+    }
+    assert_eq!(node_triangles(&cut), sorted(t));
+}
+
+#[test]
+fn refusals_leave_the_cut_as_it_was() {
+    let (p, t) = grid(8);
+    let bytes = build_it(&p, &t, BuildOptions::default()).to_bytes(false);
+    let h = HierarchyView::parse(&bytes).unwrap();
+    // Room for the base mesh and hardly more.
+    let mut cut: Box<Cut<8, 8, 8>> = Box::default();
+    cut.reset(&h).unwrap();
+    let before = node_triangles(&cut);
+    let mut refusals = 0;
+    for _ in 0..4 {
+        let nodes: Vec<u32> = cut.nodes().to_vec();
+        for v in nodes {
+            match cut.force_split(&h, v, 0, &mut |_| Ok(())) {
+                Ok(_) | Err(Refused::NotActive) | Err(Refused::NoSuchOperation) => {}
+                Err(Refused::Capacity) => refusals += 1,
+                Err(e) => panic!("{e:?}"),
+            }
+            cut.check(&h).unwrap();
+        }
+    }
+    assert!(refusals > 0);
+    assert!(cut.vertices() <= 8 && cut.triangles().len() <= 8);
+    assert_ne!(node_triangles(&cut), before);
+    // A budget refusal changes nothing.
+    let mut cut2: Box<Small> = Box::default();
+    cut2.reset(&h).unwrap();
+    let v = cut2.nodes()[0];
+    assert_eq!(
+        cut2.force_split(&h, v, 0, &mut |_| Err(Refused::Budget)),
+        Err(Refused::Budget)
+    );
+    assert_eq!(node_triangles(&cut2), before);
+}
+
+#[test]
+fn the_size_is_what_the_documentation_says() {
+    // 111 bytes per vertex slot (node, fan, bounds 40, position, normal, colours, flags, blend
+    // state 32), 36 per triangle slot (corners, neighbours, id, node-map entry), 20 per queue
+    // entry, plus a few words.
+    let per = |v: usize, f: usize, q: usize| 111 * v + 36 * f + 20 * q;
+    let small = Cut::<1024, 2048, 256>::BYTES;
+    let big = Cut::<2048, 4096, 512>::BYTES;
+    assert_eq!(big - small, per(1024, 2048, 256));
+    assert!(small - per(1024, 2048, 256) <= 256, "{small}");
+}

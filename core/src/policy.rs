@@ -1,0 +1,470 @@
+//! Refinement policies: where does this camera want detail?
+//!
+//! The cut asks a [`Policy`] about every active vertex each frame, so a policy is a few
+//! multiply-adds over the vertex's cached [`Bounds`] and the frame's [`View`]: no square root on
+//! the common path, no allocation, no state. It answers with a [`Demand`]: whether the vertex's
+//! region can be seen at all (frustum and back-face tests: changes they cause are not blended),
+//! and how far over tolerance its error is (`error > 1` asks for a split; larger is more urgent,
+//! which orders the budget's priority queue).
+//!
+//! Policies compose: a tuple `(A, B)` is visible when both are and demands the larger error, so
+//! the LOD lecture's `qrefine` is `(Frustum, (BackFace, ScreenError::new(1.0)))`.
+//!
+//! | policy | source |
+//! |---|---|
+//! | [`Frustum`] | bounding spheres against the six planes (merge-tree paper §3.4, wavelet paper §3.3.1) |
+//! | [`BackFace`] | normal cones, Hoppe's `oriented_away` (wavelet paper §3.3.2) |
+//! | [`ScreenError`] | the spheroid's projected radius in pixels, equations 4 and 5 of the wavelet paper, with separate silhouette and interior tolerances (§3.3.3) |
+//! | [`MergeTree`] | the merge-tree paper's `shouldRefine`: near the camera and in the frustum |
+//! | [`Importance`] | the importance paper's `area / (distance tan(FOV)) max(-cos θ, sin θ)` against a threshold |
+//!
+//! ```
+//! use vdlod_core::policy::{BackFace, Bounds, Frustum, Policy, ScreenError, View};
+//! let view = View::look_at([0.0, 0.0, 5.0], [0.0; 3], [0.0, 1.0, 0.0], 1.0, 4.0 / 3.0, 480.0);
+//! let qrefine = (Frustum, (BackFace, ScreenError::new(1.0)));
+//! // A vertex facing the camera with a 0.05-unit error, 5 units away: about 4 px on screen.
+//! let b = Bounds { center: [0.0; 3], radius: 0.1, axis: [0.0, 0.0, 1.0], cone_sin: 0.2,
+//!                  a2: 0.05 * 0.05, b2: 0.05 * 0.05 };
+//! let d = qrefine.demand(&b, &view);
+//! assert!(d.visible && d.error > 1.0);
+//! ```
+
+/// What a policy needs to know about a vertex: its node's bounds as the file stores them.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Bounds {
+    /// The node's position.
+    pub center: [f32; 3],
+    /// Radius of a sphere around `center` holding the node's region.
+    pub radius: f32,
+    /// Axis of the cone of normals (unit length).
+    pub axis: [f32; 3],
+    /// Sine of the cone's half-angle (1: no useful cone).
+    pub cone_sin: f32,
+    /// Square of the error spheroid's radius along the axis (`a^2`, wavelet paper eq. 4).
+    pub a2: f32,
+    /// Square of the error spheroid's radius across the axis (`b^2`).
+    pub b2: f32,
+}
+
+/// A policy's answer for one vertex.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Demand {
+    /// Whether the vertex's region may be seen (in the frustum, not facing away).
+    pub visible: bool,
+    /// How far over tolerance: a split is wanted when `error > 1`; larger is more urgent.
+    pub error: f32,
+}
+
+impl Demand {
+    /// Visible, wanting nothing.
+    pub const NONE: Demand = Demand {
+        visible: true,
+        error: 0.0,
+    };
+    /// Culled: wants nothing, and changes it causes are not blended.
+    pub const CULLED: Demand = Demand {
+        visible: false,
+        error: 0.0,
+    };
+}
+
+/// A camera for one frame, reduced to what the policies test against.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct View {
+    /// Eye position.
+    pub eye: [f32; 3],
+    /// Unit viewing direction.
+    pub forward: [f32; 3],
+    /// Frustum planes `(n, d)` with inward unit normals: a point `x` is inside when
+    /// `n . x + d >= 0`. Left, right, bottom, top, near (far is not tested).
+    pub planes: [[f32; 4]; 5],
+    /// Vertical field of view in radians.
+    pub fov_y: f32,
+    /// Pixels covered by one unit of length at distance one, across the view:
+    /// `height / (2 tan(fov_y / 2))`.
+    pub pixels_per_unit: f32,
+}
+
+#[inline]
+fn dot(a: [f32; 3], b: [f32; 3]) -> f32 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+#[inline]
+fn sub(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn cross(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn normalize(a: [f32; 3]) -> Option<[f32; 3]> {
+    let l = libm::sqrtf(dot(a, a));
+    (l > 0.0 && l.is_finite()).then(|| [a[0] / l, a[1] / l, a[2] / l])
+}
+
+impl View {
+    /// The view from `eye` towards `target` with `up` roughly up, a vertical field of view of
+    /// `fov_y` radians, width / height `aspect`, on a viewport `height` pixels tall. Degenerate
+    /// input (eye on the target, `up` along the view) falls back to looking down `-z` with `+y` up.
+    pub fn look_at(
+        eye: [f32; 3],
+        target: [f32; 3],
+        up: [f32; 3],
+        fov_y: f32,
+        aspect: f32,
+        height: f32,
+    ) -> View {
+        Self::with_frustum_scale(eye, target, up, fov_y, aspect, height, 1.0)
+    }
+
+    /// Like [`View::look_at`], but the frustum planes are those of a frustum whose cross-section
+    /// is `scale` times the camera's in each direction (the merge-tree paper's frustum size,
+    /// Table 1: 0.2 keeps a fifth of the width and height); the pixel scale stays the camera's.
+    pub fn with_frustum_scale(
+        eye: [f32; 3],
+        target: [f32; 3],
+        up: [f32; 3],
+        fov_y: f32,
+        aspect: f32,
+        height: f32,
+        scale: f32,
+    ) -> View {
+        let forward = normalize(sub(target, eye)).unwrap_or([0.0, 0.0, -1.0]);
+        let right = normalize(cross(forward, up))
+            .or_else(|| normalize(cross(forward, [0.0, 0.0, 1.0])))
+            .unwrap_or([1.0, 0.0, 0.0]);
+        let true_up = cross(right, forward);
+        let tan_y = libm::tanf(fov_y * 0.5);
+        let ty = tan_y * scale;
+        let tx = ty * aspect;
+        let plane = |n: [f32; 3]| {
+            let n = normalize(n).unwrap_or(forward);
+            [n[0], n[1], n[2], -dot(n, eye)]
+        };
+        let comb = |t: f32, side: [f32; 3], sign: f32| {
+            [
+                forward[0] * t + side[0] * sign,
+                forward[1] * t + side[1] * sign,
+                forward[2] * t + side[2] * sign,
+            ]
+        };
+        View {
+            eye,
+            forward,
+            planes: [
+                plane(comb(tx, right, 1.0)),
+                plane(comb(tx, right, -1.0)),
+                plane(comb(ty, true_up, 1.0)),
+                plane(comb(ty, true_up, -1.0)),
+                plane(forward),
+            ],
+            fov_y,
+            pixels_per_unit: height / (2.0 * tan_y),
+        }
+    }
+
+    /// Whether the sphere `(center, radius)` reaches into the frustum.
+    #[inline]
+    pub fn sphere_visible(&self, center: [f32; 3], radius: f32) -> bool {
+        self.planes
+            .iter()
+            .all(|p| p[0] * center[0] + p[1] * center[1] + p[2] * center[2] + p[3] >= -radius)
+    }
+}
+
+/// A refinement policy (see the module documentation).
+pub trait Policy {
+    /// The policy's demand for a vertex with bounds `b` seen from `view`.
+    fn demand(&self, b: &Bounds, view: &View) -> Demand;
+}
+
+impl<A: Policy, B: Policy> Policy for (A, B) {
+    #[inline]
+    fn demand(&self, b: &Bounds, view: &View) -> Demand {
+        let x = self.0.demand(b, view);
+        if !x.visible {
+            return Demand::CULLED;
+        }
+        let y = self.1.demand(b, view);
+        if !y.visible {
+            return Demand::CULLED;
+        }
+        Demand {
+            visible: true,
+            error: x.error.max(y.error),
+        }
+    }
+}
+
+impl<P: Policy + ?Sized> Policy for &P {
+    #[inline]
+    fn demand(&self, b: &Bounds, view: &View) -> Demand {
+        (**self).demand(b, view)
+    }
+}
+
+/// Culls vertices whose bounding sphere lies outside the view frustum; wants nothing itself.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Frustum;
+
+impl Policy for Frustum {
+    #[inline]
+    fn demand(&self, b: &Bounds, view: &View) -> Demand {
+        if view.sphere_visible(b.center, b.radius) {
+            Demand::NONE
+        } else {
+            Demand::CULLED
+        }
+    }
+}
+
+/// Culls vertices whose whole cone of normals faces away from the eye (Hoppe's `oriented_away`,
+/// with the cone's apex moved towards the eye by the bounding radius so that regions seen at an
+/// angle stay in); wants nothing itself.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BackFace;
+
+impl Policy for BackFace {
+    #[inline]
+    fn demand(&self, b: &Bounds, view: &View) -> Demand {
+        let r = sub(b.center, view.eye);
+        let s = dot(b.axis, r) - b.radius;
+        let d2 = dot(r, r);
+        if s > 0.0 && s * s > d2 * b.cone_sin * b.cone_sin {
+            Demand::CULLED
+        } else {
+            Demand::NONE
+        }
+    }
+}
+
+/// Wants a split while the node's error spheroid projects to more than the tolerance in pixels
+/// (wavelet paper equations 4 and 5). Vertices whose normal cone spans both front- and
+/// back-facing directions may lie on the silhouette and get the silhouette tolerance; the others
+/// get the interior one.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ScreenError {
+    /// Tolerance in pixels near the silhouette.
+    pub silhouette: f32,
+    /// Tolerance in pixels elsewhere.
+    pub interior: f32,
+}
+
+impl ScreenError {
+    /// The same tolerance, in pixels, everywhere.
+    pub fn new(pixels: f32) -> ScreenError {
+        ScreenError {
+            silhouette: pixels,
+            interior: pixels,
+        }
+    }
+
+    /// The projected error radius of `b` in pixels (for tests and pictures; the policy itself
+    /// needs no square root).
+    pub fn pixels(b: &Bounds, view: &View) -> f32 {
+        let r = sub(b.center, view.eye);
+        let d2 = dot(r, r);
+        let rn = dot(r, b.axis);
+        let lhs = (b.a2 * d2 + (b.b2 - b.a2) * rn * rn).max(b.b2 * d2);
+        libm::sqrtf(lhs / (d2 * d2)) * view.pixels_per_unit
+    }
+}
+
+impl Policy for ScreenError {
+    #[inline]
+    fn demand(&self, b: &Bounds, view: &View) -> Demand {
+        let r = sub(b.center, view.eye);
+        let d2 = dot(r, r);
+        let rn = dot(r, b.axis);
+        // Squared projected radius times d^4: equation 4 (the spheroid seen at an angle) and
+        // equation 5 (its cross-section, seen from any direction).
+        let lhs = (b.a2 * d2 + (b.b2 - b.a2) * rn * rn).max(b.b2 * d2);
+        let silhouette = rn * rn <= d2 * b.cone_sin * b.cone_sin;
+        let tol = if silhouette {
+            self.silhouette
+        } else {
+            self.interior
+        };
+        let k = tol / view.pixels_per_unit;
+        let rhs = k * k * d2 * d2;
+        let error = if rhs > 0.0 {
+            lhs / rhs
+        } else if lhs > 0.0 {
+            f32::MAX
+        } else {
+            0.0
+        };
+        Demand {
+            visible: true,
+            error,
+        }
+    }
+}
+
+/// The merge-tree paper's `shouldRefine` (§3.4): refine while the bounding sphere reaches into
+/// the frustum and comes within `near` of the eye; nearer is more urgent. With `near` infinite,
+/// everything in the frustum refines to the leaves, as in the paper's Table 1.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MergeTree {
+    /// Distance from the eye within which detail is wanted.
+    pub near: f32,
+}
+
+impl Policy for MergeTree {
+    #[inline]
+    fn demand(&self, b: &Bounds, view: &View) -> Demand {
+        if !view.sphere_visible(b.center, b.radius) {
+            return Demand::CULLED;
+        }
+        let r = sub(b.center, view.eye);
+        let gap = (libm::sqrtf(dot(r, r)) - b.radius).max(0.0);
+        Demand {
+            visible: true,
+            error: if gap < self.near {
+                1.0 + 1.0 / (1.0 + gap)
+            } else {
+                0.0
+            },
+        }
+    }
+}
+
+/// The importance paper's view importance (§IV), `area / (distance tan(FOV)) max(-cos θ, sin θ)`
+/// with θ between the normal and the eye-to-vertex direction, over `threshold`. A vertex stands
+/// for the triangles around it: its region's area is taken as `radius^2` (the file stores no
+/// area), so the threshold is in units of the mesh's length.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Importance {
+    /// Importance above which a split is wanted (the paper found 0.3 pleasing on its meshes).
+    pub threshold: f32,
+}
+
+impl Policy for Importance {
+    #[inline]
+    fn demand(&self, b: &Bounds, view: &View) -> Demand {
+        let r = sub(b.center, view.eye);
+        let d = libm::sqrtf(dot(r, r)).max(f32::MIN_POSITIVE);
+        let cos = (dot(b.axis, r) / d).clamp(-1.0, 1.0);
+        let sin = libm::sqrtf(1.0 - cos * cos);
+        let tan_fov = libm::tanf(view.fov_y).abs().max(1e-6);
+        let importance = b.radius * b.radius / (d * tan_fov) * (-cos).max(sin);
+        Demand {
+            visible: true,
+            error: if self.threshold > 0.0 {
+                importance / self.threshold
+            } else {
+                f32::MAX
+            },
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn view() -> View {
+        View::look_at(
+            [0.0, 0.0, 10.0],
+            [0.0; 3],
+            [0.0, 1.0, 0.0],
+            core::f32::consts::FRAC_PI_3,
+            4.0 / 3.0,
+            480.0,
+        )
+    }
+
+    fn bounds(center: [f32; 3], axis: [f32; 3], a: f32, b: f32) -> Bounds {
+        Bounds {
+            center,
+            radius: 0.1,
+            axis,
+            cone_sin: 0.1,
+            a2: a * a,
+            b2: b * b,
+        }
+    }
+
+    #[test]
+    fn frustum_keeps_what_is_ahead_and_culls_what_is_behind_or_aside() {
+        let v = view();
+        let f = |c| Frustum.demand(&bounds(c, [0.0, 0.0, 1.0], 0.0, 0.0), &v);
+        assert!(f([0.0; 3]).visible);
+        assert!(!f([0.0, 0.0, 20.0]).visible); // behind the eye
+        assert!(!f([100.0, 0.0, 0.0]).visible);
+        // tan(30 deg) * 10 = 5.77 at the target plane, times the aspect horizontally.
+        assert!(f([0.0, 5.6, 0.0]).visible && !f([0.0, 6.0, 0.0]).visible);
+        let small = View::with_frustum_scale(
+            v.eye,
+            [0.0; 3],
+            [0.0, 1.0, 0.0],
+            v.fov_y,
+            4.0 / 3.0,
+            480.0,
+            0.2,
+        );
+        assert!(!small.sphere_visible([0.0, 2.0, 0.0], 0.1));
+        assert!(small.sphere_visible([0.0, 1.0, 0.0], 0.1));
+    }
+
+    #[test]
+    fn back_facing_cones_are_culled() {
+        let v = view();
+        let toward = bounds([0.0; 3], [0.0, 0.0, 1.0], 0.0, 0.0);
+        let away = bounds([0.0; 3], [0.0, 0.0, -1.0], 0.0, 0.0);
+        let edge_on = bounds([0.0; 3], [1.0, 0.0, 0.0], 0.0, 0.0);
+        assert!(BackFace.demand(&toward, &v).visible);
+        assert!(!BackFace.demand(&away, &v).visible);
+        assert!(BackFace.demand(&edge_on, &v).visible);
+    }
+
+    #[test]
+    fn screen_error_matches_the_projected_size_in_pixels() {
+        let v = view();
+        // A disc of radius 0.1 facing the eye at distance 10: 0.1 / (2 tan 30) * 480 / 10 px.
+        let b = bounds([0.0; 3], [0.0, 0.0, 1.0], 0.0, 0.1);
+        let px = 0.1 * 480.0 / (2.0 * libm::tanf(core::f32::consts::FRAC_PI_6) * 10.0);
+        assert!((ScreenError::pixels(&b, &v) - px).abs() < 1e-3 * px);
+        assert!(ScreenError::new(px * 0.99).demand(&b, &v).error > 1.0);
+        assert!(ScreenError::new(px * 1.01).demand(&b, &v).error < 1.0);
+        // Error along the normal is invisible face-on and full size edge-on (equation 4).
+        let along = bounds([0.0; 3], [0.0, 0.0, 1.0], 0.1, 0.0);
+        assert!(ScreenError::pixels(&along, &v) < 1e-3);
+        let sideways = bounds([0.0; 3], [1.0, 0.0, 0.0], 0.1, 0.0);
+        assert!((ScreenError::pixels(&sideways, &v) - px).abs() < 1e-3 * px);
+    }
+
+    #[test]
+    fn silhouette_vertices_get_the_silhouette_tolerance() {
+        let v = view();
+        let p = ScreenError {
+            silhouette: 0.5,
+            interior: 4.0,
+        };
+        // About 2.1 px of error: over the silhouette tolerance, under the interior one.
+        let facing = bounds([0.0; 3], [0.0, 0.0, 1.0], 0.0, 0.05);
+        let edge_on = bounds([0.0; 3], [1.0, 0.0, 0.0], 0.05, 0.05);
+        assert!(p.demand(&facing, &v).error < 1.0);
+        assert!(p.demand(&edge_on, &v).error > 1.0);
+    }
+
+    #[test]
+    fn merge_tree_and_importance_prefer_what_is_near() {
+        let v = view();
+        let near = bounds([0.0, 0.0, 5.0], [0.0, 0.0, 1.0], 0.0, 0.0);
+        let far = bounds([0.0, 0.0, -20.0], [0.0, 0.0, 1.0], 0.0, 0.0);
+        let m = MergeTree { near: 10.0 };
+        assert!(m.demand(&near, &v).error > 1.0);
+        assert!(m.demand(&far, &v).error <= 1.0);
+        let i = Importance { threshold: 1e-3 };
+        assert!(i.demand(&near, &v).error > i.demand(&far, &v).error);
+        let both = (Frustum, m);
+        assert!(!both.demand(&bounds([0.0, 0.0, 50.0], [0.0; 3], 0.0, 0.0), &v).visible);
+    }
+}
