@@ -11,6 +11,7 @@
 #[cfg(feature = "build")]
 extern crate alloc;
 
+pub mod adapt;
 #[cfg(feature = "build")]
 pub mod build;
 pub mod cut;

@@ -465,6 +465,10 @@ mod tests {
         let i = Importance { threshold: 1e-3 };
         assert!(i.demand(&near, &v).error > i.demand(&far, &v).error);
         let both = (Frustum, m);
-        assert!(!both.demand(&bounds([0.0, 0.0, 50.0], [0.0; 3], 0.0, 0.0), &v).visible);
+        assert!(
+            !both
+                .demand(&bounds([0.0, 0.0, 50.0], [0.0; 3], 0.0, 0.0), &v)
+                .visible
+        );
     }
 }

@@ -46,6 +46,7 @@
 
 use core::fmt;
 
+use heapless::binary_heap::{BinaryHeap, Max};
 use heapless::Vec;
 
 use crate::format::{HierarchyView, NodeView, NONE};
@@ -173,10 +174,13 @@ pub struct Cut<const V: usize, const F: usize, const Q: usize> {
     pub(crate) fid: Vec<u32, F>,
     // Work queues.
     pub(crate) stack: Vec<u32, Q>,
-    pub(crate) candidates: Vec<(f32, u32), Q>,
+    /// Split candidates: (error bits, node), largest error first.
+    pub(crate) candidates: BinaryHeap<(u32, u32), Max, Q>,
+    /// Collapse candidates: (parent's error, parent); the error is negative when culled.
     pub(crate) pairs: Vec<(f32, u32), Q>,
     pub(crate) coloring: Coloring,
     pub(crate) threshold: f32,
+    pub(crate) geomorph_frames: u16,
 }
 
 impl<const V: usize, const F: usize, const Q: usize> Default for Cut<V, F, Q> {
@@ -220,7 +224,11 @@ fn prev3(k: usize) -> usize {
 pub fn depth_color(depth: u16) -> [u8; 3] {
     let t = (depth.min(24) as f32) / 24.0;
     let ramp = |x: f32| (x.clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
-    [ramp(2.0 * t - 1.0), ramp(1.0 - libm::fabsf(2.0 * t - 1.0)), ramp(1.0 - 2.0 * t)]
+    [
+        ramp(2.0 * t - 1.0),
+        ramp(1.0 - libm::fabsf(2.0 * t - 1.0)),
+        ramp(1.0 - 2.0 * t),
+    ]
 }
 
 pub(crate) fn bounds_of(n: &NodeView) -> Bounds {
@@ -256,10 +264,11 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
             adj: Vec::new(),
             fid: Vec::new(),
             stack: Vec::new(),
-            candidates: Vec::new(),
+            candidates: BinaryHeap::new(),
             pairs: Vec::new(),
             coloring: Coloring::Node,
             threshold: 1.0,
+            geomorph_frames: 0,
         }
     }
 
@@ -317,8 +326,7 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
                         let (c, d) = (self.tri[g][j], self.tri[g][next3(j)]);
                         let same = g != f && c == a && d == b;
                         let paired = c == b && d == a;
-                        if same || (paired && self.adj[f][k] != NIL && self.adj[f][k] != g as u32)
-                        {
+                        if same || (paired && self.adj[f][k] != NIL && self.adj[f][k] != g as u32) {
                             self.clear();
                             return Err(CutError::BaseNotManifold { triangle: f as u32 });
                         }
@@ -358,7 +366,7 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         self.threshold = 1.0;
     }
 
-    fn tint_of(&self, n: &NodeView) -> [u8; 3] {
+    pub(crate) fn tint_of(&self, n: &NodeView) -> [u8; 3] {
         match self.coloring {
             Coloring::Node => n.color,
             Coloring::Depth => depth_color(n.depth),

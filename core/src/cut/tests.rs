@@ -21,7 +21,10 @@ fn node_triangles<const V: usize, const F: usize, const Q: usize>(
     sorted(t)
 }
 
-fn meshes() -> Vec<(&'static str, Vec<u8>, Vec<[u32; 3]>)> {
+/// A name, a hierarchy file, and the triangles it was built from.
+type Case = (&'static str, Vec<u8>, Vec<[u32; 3]>);
+
+fn meshes() -> Vec<Case> {
     let mut out = Vec::new();
     for (name, (p, t), balanced) in [
         ("sphere", sphere(3), false),
@@ -98,7 +101,10 @@ fn random_splits_and_collapses_keep_a_valid_manifold() {
             cut.check(&h).unwrap_or_else(|d| panic!("{name}: {d:?}"));
             assert_eq!(topology(&node_triangles(&cut)), expected, "{name}");
         }
-        assert!(splits > 100 && collapses > 100, "{name}: {splits} {collapses}");
+        assert!(
+            splits > 100 && collapses > 100,
+            "{name}: {splits} {collapses}"
+        );
     }
 }
 
@@ -170,4 +176,148 @@ fn the_size_is_what_the_documentation_says() {
     let big = Cut::<2048, 4096, 512>::BYTES;
     assert_eq!(big - small, per(1024, 2048, 256));
     assert!(small - per(1024, 2048, 256) <= 256, "{small}");
+}
+
+mod adapt {
+    use super::*;
+    use crate::adapt::Budget;
+    use crate::policy::{BackFace, Frustum, ScreenError, View};
+
+    fn orbit(i: u32, distance: f32) -> View {
+        let a = i as f32 * 0.07;
+        let eye = [
+            distance * libm::cosf(a),
+            0.4 * libm::sinf(0.3 * i as f32),
+            distance * libm::sinf(a),
+        ];
+        View::look_at(eye, [0.0; 3], [0.0, 1.0, 0.0], 1.0, 4.0 / 3.0, 480.0)
+    }
+
+    fn sphere_bytes() -> Vec<u8> {
+        let (p, t) = sphere(4);
+        build_it(&p, &t, BuildOptions::default()).to_bytes(false)
+    }
+
+    type Mid = Cut<4096, 8192, 2048>;
+
+    #[test]
+    fn frames_keep_the_mesh_valid_within_budget_and_repeat_exactly() {
+        let bytes = sphere_bytes();
+        let h = HierarchyView::parse(&bytes).unwrap();
+        let policy = (Frustum, (BackFace, ScreenError::new(0.5)));
+        let budget = Budget {
+            max_triangles: 600,
+            ..Budget::default()
+        };
+        let run = || {
+            let mut cut: Box<Mid> = Box::default();
+            cut.reset(&h).unwrap();
+            cut.set_geomorph_frames(4);
+            let mut frames = Vec::new();
+            for i in 0..150 {
+                let distance = 1.5 + 4.0 * libm::fabsf(libm::sinf(i as f32 * 0.05));
+                let s = cut.adapt(&h, &orbit(i, distance), &policy, &budget);
+                cut.check(&h).unwrap_or_else(|d| panic!("frame {i}: {d:?}"));
+                assert!(s.triangles <= 600 && !s.over_budget, "frame {i}: {s:?}");
+                assert_eq!(s.triangles as usize, cut.triangles().len());
+                frames.push((node_triangles(&cut), cut.positions().to_vec()));
+            }
+            frames
+        };
+        let first = run();
+        assert!(first.iter().any(|(t, _)| t.len() > 500), "the budget binds");
+        assert_eq!(first, run());
+    }
+
+    #[test]
+    fn the_budget_goes_where_the_error_is_largest() {
+        let bytes = sphere_bytes();
+        let h = HierarchyView::parse(&bytes).unwrap();
+        let policy = ScreenError::new(0.1);
+        let view = orbit(0, 3.0);
+        let mut cut: Box<Mid> = Box::default();
+        cut.reset(&h).unwrap();
+        let budget = Budget {
+            max_triangles: 300,
+            ..Budget::default()
+        };
+        for _ in 0..5 {
+            cut.adapt(&h, &view, &policy, &budget);
+        }
+        assert!(cut.triangles().len() >= 290 && cut.triangles().len() <= 300);
+        // The side facing the camera (with the larger projected error) got more vertices.
+        let eye = view.eye;
+        let near = cut
+            .positions()
+            .iter()
+            .filter(|p| p[0] * eye[0] + p[1] * eye[1] + p[2] * eye[2] > 0.0)
+            .count();
+        assert!(
+            near * 10 > cut.vertices() * 6,
+            "{near} of {}",
+            cut.vertices()
+        );
+    }
+
+    #[test]
+    fn regulation_reaches_the_target_and_ops_are_capped() {
+        let bytes = sphere_bytes();
+        let h = HierarchyView::parse(&bytes).unwrap();
+        let policy = (Frustum, ScreenError::new(1.0));
+        let mut cut: Box<Mid> = Box::default();
+        cut.reset(&h).unwrap();
+        let budget = Budget {
+            target_triangles: 400,
+            max_ops: 40,
+            ..Budget::default()
+        };
+        let mut last = 0;
+        for i in 0..60 {
+            let s = cut.adapt(&h, &orbit(0, 3.0), &policy, &budget);
+            assert!(s.vsplits + s.ecols <= 40, "frame {i}: {s:?}");
+            last = s.triangles;
+        }
+        assert!((360..=440).contains(&last), "{last}");
+    }
+
+    #[test]
+    fn geomorphs_blend_and_settle() {
+        let bytes = sphere_bytes();
+        let h = HierarchyView::parse(&bytes).unwrap();
+        let policy = ScreenError::new(2.0);
+        let mut cut: Box<Mid> = Box::default();
+        cut.reset(&h).unwrap();
+        cut.set_geomorph_frames(8);
+        let far = orbit(0, 30.0);
+        let near = orbit(0, 2.0);
+        for _ in 0..20 {
+            cut.adapt(&h, &far, &policy, &Budget::default());
+        }
+        let settled = |cut: &Mid| {
+            cut.positions()
+                .iter()
+                .zip(cut.nodes())
+                .all(|(p, &n)| *p == h.node(n).position)
+        };
+        assert!(settled(&cut));
+        let s = cut.adapt(&h, &near, &policy, &Budget::default());
+        assert!(s.vsplits > 0 && s.blending > 0, "{s:?}");
+        assert!(!settled(&cut));
+        // Blending vertices lie on the segment from their parent's position to their own.
+        for _ in 0..12 {
+            cut.adapt(&h, &near, &policy, &Budget::default());
+        }
+        assert!(settled(&cut));
+        // Moving away again blends the collapses before doing them.
+        let s = cut.adapt(&h, &far, &policy, &Budget::default());
+        assert_eq!(s.ecols, 0);
+        assert!(s.blending > 0);
+        let mut ecols = 0;
+        for _ in 0..300 {
+            ecols += cut.adapt(&h, &far, &policy, &Budget::default()).ecols;
+            cut.check(&h).unwrap();
+        }
+        assert!(ecols > 0);
+        assert!(settled(&cut));
+    }
 }
