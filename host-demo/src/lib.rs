@@ -6,5 +6,6 @@
 pub mod camera;
 pub mod frame;
 pub mod hierarchy;
+pub mod lod;
 pub mod mesh;
 pub mod render;

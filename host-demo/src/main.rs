@@ -1,15 +1,17 @@
 //! `vdlod-demo`: renders meshes with the vdlod rasterizer and writes PNG frames.
 //!
-//! With no arguments it renders the bundled Stanford bunny around the merge-tree paper's orbit
-//! into `./out/`.
+//! With no arguments it flies a view-dependent cut of the bundled Stanford bunny around the
+//! merge-tree paper's orbit and writes frames, statistics, a plot and a comparison into `./out/`.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand, ValueEnum};
+use vdlod_core::adapt::Budget;
 use vdlod_core::build::{BuildOptions, Cost};
 use vdlod_core::format::HierarchyView;
 use vdlod_demo::hierarchy;
+use vdlod_demo::lod::{self, OrbitOptions, PolicyChoice};
 use vdlod_demo::mesh::{load_obj, load_obj_bytes, IndexedMesh, MeshError, BUNNY_NAME, BUNNY_OBJ};
 use vdlod_demo::render::{render_orbit, RenderOptions};
 use vdlod_raster::Shading;
@@ -27,6 +29,9 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// Fly the merge-tree paper's orbit with a view-dependent cut: frames, stats.csv, plot.png,
+    /// side_by_side.png (adapted | full detail | difference).
+    Orbit(OrbitArgs),
     /// Fly the merge-tree paper's orbit around a mesh at full detail and write PNG frames.
     Render(RenderArgs),
     /// Build a mesh's vertex hierarchy and write it as a .vdh file.
@@ -64,6 +69,99 @@ struct BuildArgs {
     /// Stop at this many base-mesh vertices (default: as few as topology allows).
     #[arg(long, default_value_t = 0)]
     base: u32,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum PolicyArg {
+    /// Frustum, back-face and screen-space error (--tolerance, --interior).
+    Screen,
+    /// The merge-tree paper's shouldRefine: everything in the frustum, to the leaves.
+    MergeTree,
+    /// The importance paper's triangle importance over --threshold.
+    Importance,
+}
+
+#[derive(clap::Args)]
+struct OrbitArgs {
+    /// OBJ mesh (its hierarchy is built first) or .vdh hierarchy (default: the bundled bunny).
+    mesh: Option<PathBuf>,
+    /// Output directory.
+    #[arg(long, short, default_value = "out")]
+    out: PathBuf,
+    /// Triangle budget: the cut never has more.
+    #[arg(long)]
+    budget: Option<u32>,
+    /// Regulate the tolerance towards this many triangles.
+    #[arg(long)]
+    target: Option<u32>,
+    /// Splits plus collapses per frame at most.
+    #[arg(long)]
+    max_ops: Option<u32>,
+    /// Screen-space tolerance in pixels (at the silhouette, and inside unless --interior).
+    #[arg(long, default_value_t = 1.0)]
+    tolerance: f32,
+    /// Screen-space tolerance in pixels inside the silhouette.
+    #[arg(long)]
+    interior: Option<f32>,
+    /// Refinement policy.
+    #[arg(long, value_enum, default_value = "screen")]
+    policy: PolicyArg,
+    /// Importance threshold (with --policy importance).
+    #[arg(long, default_value_t = 0.3)]
+    threshold: f32,
+    /// Frustum size: the refinement frustum's width and height relative to the camera's
+    /// (the merge-tree paper's Table 1 uses 0.4, 0.2, 0.1).
+    #[arg(long, default_value_t = 1.0)]
+    frustum: f32,
+    /// Frames in one revolution.
+    #[arg(long, default_value_t = 72, value_parser = clap::value_parser!(u32).range(1..=100_000))]
+    frames: u32,
+    /// Frame width in pixels.
+    #[arg(long, default_value_t = 640)]
+    width: usize,
+    /// Frame height in pixels.
+    #[arg(long, default_value_t = 480)]
+    height: usize,
+    /// Geomorph length in frames (0: none).
+    #[arg(long, default_value_t = 4)]
+    geomorph: u16,
+    /// False colour by forest depth.
+    #[arg(long)]
+    depth_colors: bool,
+    /// Draw triangle edges.
+    #[arg(long)]
+    wireframe: bool,
+    /// Also write each frame's active mesh as mesh_NNNN.obj.
+    #[arg(long)]
+    dump_mesh: bool,
+    /// Fly the peer orbit (20 degrees up) of ../shared/peers instead of the level one.
+    #[arg(long)]
+    peer_orbit: bool,
+}
+
+impl Default for OrbitArgs {
+    fn default() -> Self {
+        OrbitArgs {
+            mesh: None,
+            out: PathBuf::from("out"),
+            budget: None,
+            target: None,
+            max_ops: None,
+            tolerance: 1.0,
+            interior: None,
+            policy: PolicyArg::Screen,
+            threshold: 0.3,
+            frustum: 1.0,
+            frames: 72,
+            width: 640,
+            height: 480,
+            geomorph: 4,
+            depth_colors: false,
+            wireframe: false,
+            dump_mesh: false,
+            peer_orbit: false,
+        }
+    }
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -161,6 +259,106 @@ fn render(args: RenderArgs) -> Result<(), String> {
     Ok(())
 }
 
+/// The hierarchy bytes and the full-detail mesh of an OBJ or .vdh argument.
+fn load_lod(mesh: Option<&PathBuf>) -> Result<(String, Vec<u8>, IndexedMesh), String> {
+    let is_vdh = mesh.is_some_and(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("vdh")));
+    if let (true, Some(path)) = (is_vdh, mesh) {
+        let bytes = hierarchy::read(path)?;
+        let view = HierarchyView::parse(&bytes).map_err(|e| format!("{}: {e}", path.display()))?;
+        let mut cut = lod::new_cut();
+        let full =
+            lod::full_detail(&view, &mut cut).map_err(|e| format!("{}: {e}", path.display()))?;
+        return Ok((path.display().to_string(), bytes, full));
+    }
+    let (name, mut full) = load(mesh).map_err(|e| e.to_string())?;
+    let show = std::io::IsTerminal::is_terminal(&std::io::stderr());
+    let (_, bytes, seconds) = hierarchy::build_with_progress(&full, &BuildOptions::default(), show)
+        .map_err(|e| format!("{name}: {e}"))?;
+    println!("{name}: hierarchy built in {seconds:.2} s");
+    full.reorder_for_locality();
+    Ok((name, bytes, full))
+}
+
+fn orbit_command(args: OrbitArgs) -> Result<(), String> {
+    let (name, bytes, full) = load_lod(args.mesh.as_ref())?;
+    let mut budget = Budget::default();
+    if let Some(b) = args.budget {
+        budget.max_triangles = b;
+    }
+    if let Some(t) = args.target {
+        budget.target_triangles = t;
+    }
+    if let Some(m) = args.max_ops {
+        budget.max_ops = m;
+    }
+    let opts = OrbitOptions {
+        width: args.width,
+        height: args.height,
+        frames: args.frames,
+        frustum: args.frustum,
+        policy: match args.policy {
+            PolicyArg::Screen => PolicyChoice::Screen {
+                silhouette: args.tolerance,
+                interior: args.interior.unwrap_or(args.tolerance),
+            },
+            PolicyArg::MergeTree => PolicyChoice::MergeTree,
+            PolicyArg::Importance => PolicyChoice::Importance {
+                threshold: args.threshold,
+            },
+        },
+        budget,
+        geomorph_frames: args.geomorph,
+        depth_colors: args.depth_colors,
+        wireframe: args.wireframe,
+        dump_mesh: args.dump_mesh,
+        write_frames: true,
+        peer_orbit: args.peer_orbit,
+    };
+    println!(
+        "{name}: {} vertices, {} triangles at full detail; {} frames at {}x{} into {}",
+        full.positions.len(),
+        full.triangles.len(),
+        opts.frames,
+        opts.width,
+        opts.height,
+        args.out.display()
+    );
+    let summary = lod::run_orbit(&bytes, &full, &opts, &args.out, |f| {
+        println!(
+                "frame {:04}  triangles {:>7}  splits {:>5}  collapses {:>5}  adapt {:>8.1} us  render {:>7.2} ms  full {:>7.2} ms  PSNR {:>6.2} dB",
+                f.index,
+                f.stats.triangles,
+                f.stats.vsplits,
+                f.stats.ecols,
+                f.adapt_us,
+                f.render_us / 1e3,
+                f.full_render_us / 1e3,
+                f.psnr_db
+            )
+    })?;
+    let first = summary.frames[0];
+    println!(
+        "first frame (from the base mesh): {} triangles, {} splits, {:.1} us",
+        first.stats.triangles, first.stats.vsplits, first.adapt_us
+    );
+    println!(
+        "other frames, median: adapt {:.1} us, {:.0} triangles, {:.1} splits + {:.1} collapses; adapt + render {:.2} ms vs full detail {:.2} ms; PSNR mean {:.2} dB",
+        summary.median_after_first(|f| f.adapt_us),
+        summary.median_after_first(|f| f.stats.triangles as f64),
+        summary.mean_after_first(|f| f.stats.vsplits as f64),
+        summary.mean_after_first(|f| f.stats.ecols as f64),
+        summary.median_after_first(|f| (f.adapt_us + f.render_us) / 1e3),
+        summary.median_after_first(|f| f.full_render_us / 1e3),
+        summary.mean_after_first(|f| f.psnr_db.min(99.0)),
+    );
+    println!(
+        "wrote {}/stats.csv, plot.png, side_by_side.png (frame {})",
+        args.out.display(),
+        summary.compared
+    );
+    Ok(())
+}
+
 fn build_command(args: BuildArgs) -> Result<(), String> {
     let mesh = load_obj(&args.mesh).map_err(|e| e.to_string())?;
     let opts = BuildOptions {
@@ -191,12 +389,18 @@ fn info(file: PathBuf) -> Result<(), String> {
 }
 
 fn main() -> ExitCode {
+    // The cut's arenas are built by value: give them a large stack.
+    lod::with_large_stack(run)
+}
+
+fn run() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
+        Some(Command::Orbit(args)) => orbit_command(args),
         Some(Command::Render(args)) => render(args),
         Some(Command::Build(args)) => build_command(args),
         Some(Command::Info { file }) => info(file),
-        None => render(RenderArgs::default()),
+        None => orbit_command(OrbitArgs::default()),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -178,22 +178,13 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, e: Engine<'_>) -> Hierarchy {
             along = along.max(dot(d, n).abs());
             across = across.max(len(cross(d, n)));
         }
-        // Equation 3: a / b from the largest components, then scaled to hold every vector.
-        let (a, b) = if across <= 0.0 {
-            (along, 0.0)
-        } else if along <= 0.0 {
-            (0.0, across)
-        } else {
-            let ratio = along / across;
-            let mut b2 = 0.0f64;
-            for &leaf in &order[s as usize..t as usize] {
-                let d = sub(pos[leaf as usize], pos[p]);
-                let (u, w) = (dot(d, n), len(cross(d, n)));
-                b2 = b2.max(u * u / (ratio * ratio) + w * w);
-            }
-            let b = libm::sqrt(b2);
-            (ratio * b, b)
-        };
+        // The error of replacing the region by the node: each leaf's offset from the coarse
+        // surface, which near the node is its tangent plane, so the offset lies along the normal
+        // (Hoppe's normal deviation). A region's extent across the normal is not an error: a flat
+        // region simplifies to nothing visible however wide it is. The spheroid of equation 3 is
+        // then `a` = the largest offset, `b` = 0 (a conservative bound where the coarse fan
+        // bends away from the tangent plane).
+        let (a, b) = (along, 0.0);
         let [c0, c1] = c.children.map(|x| &nodes[x as usize]);
         let mono = |own: f64, f: fn(&Node) -> f32| own.max(f(c0) as f64).max(f(c1) as f64);
         let mu = mono(across, |n| n.mu);

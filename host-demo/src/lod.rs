@@ -1,0 +1,474 @@
+//! The `orbit` command: a view-dependent cut flown around a mesh, frame by frame, beside the
+//! full-detail mesh, with statistics, a plot and an image comparison.
+
+use std::fmt::Write as _;
+use std::io::Write as _;
+use std::path::Path;
+use std::time::Instant;
+
+use vdlod_core::adapt::{Budget, FrameStats};
+use vdlod_core::cut::{Coloring, Cut};
+use vdlod_core::format::HierarchyView;
+use vdlod_core::policy::{BackFace, Frustum, Importance, MergeTree, Policy, ScreenError, View};
+use vdlod_raster::{Mesh, Rgba8, Shading};
+
+use crate::camera::{Camera, Orbit};
+use crate::frame::{save_png, Frame, FrameError};
+use crate::mesh::{vertex_normals, Bounds, IndexedMesh};
+use crate::render::camera_params;
+
+/// The cut the demo uses: up to 262,144 active vertices and 524,288 triangles (a fully refined
+/// Loop-subdivided bunny fits), 32,768 queue entries; about 48 MB.
+pub type DemoCut = Cut<{ 1 << 18 }, { 1 << 19 }, { 1 << 15 }>;
+
+/// A cut on the heap. The demo's cut is too large for a thread's default stack, so call this
+/// (and run the demo) on a thread with a large stack, as `main` does.
+pub fn new_cut() -> Box<DemoCut> {
+    Box::default()
+}
+
+/// Runs `f` on a thread with a 1 GiB stack (reserved, not used: pages are touched only as
+/// needed), so that cuts of any capacity can be built by value.
+pub fn with_large_stack<T: Send + 'static>(f: impl FnOnce() -> T + Send + 'static) -> T {
+    std::thread::Builder::new()
+        .stack_size(1 << 30)
+        .spawn(f)
+        .expect("spawning a thread")
+        .join()
+        .unwrap_or_else(|e| std::panic::resume_unwind(e))
+}
+
+/// Which policy decides where detail goes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PolicyChoice {
+    /// Frustum, back-face and screen-space error with silhouette and interior tolerances (px).
+    Screen {
+        /// Silhouette tolerance in pixels.
+        silhouette: f32,
+        /// Interior tolerance in pixels.
+        interior: f32,
+    },
+    /// The merge-tree paper's `shouldRefine`: everything in the (scaled) frustum, to the leaves.
+    MergeTree,
+    /// The importance paper's triangle importance over a threshold, in the frustum.
+    Importance {
+        /// Threshold.
+        threshold: f32,
+    },
+}
+
+/// Settings of [`run_orbit`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct OrbitOptions {
+    /// Frame width in pixels.
+    pub width: usize,
+    /// Frame height in pixels.
+    pub height: usize,
+    /// Frames in one revolution.
+    pub frames: u32,
+    /// The merge-tree paper's frustum size: the refinement frustum's width and height relative
+    /// to the camera's.
+    pub frustum: f32,
+    /// The policy.
+    pub policy: PolicyChoice,
+    /// Triangle budget.
+    pub budget: Budget,
+    /// Geomorph length in frames.
+    pub geomorph_frames: u16,
+    /// False colour by forest depth.
+    pub depth_colors: bool,
+    /// Draw triangle edges.
+    pub wireframe: bool,
+    /// Write each frame's active mesh as `mesh_NNNN.obj`.
+    pub dump_mesh: bool,
+    /// Write `frame_NNNN.png` (the statistics, plot and comparison are always written).
+    pub write_frames: bool,
+    /// Fly the peer orbit (20 degrees up) instead of the merge-tree paper's (level).
+    pub peer_orbit: bool,
+}
+
+impl Default for OrbitOptions {
+    fn default() -> Self {
+        OrbitOptions {
+            width: 640,
+            height: 480,
+            frames: 72,
+            frustum: 1.0,
+            policy: PolicyChoice::Screen {
+                silhouette: 1.0,
+                interior: 1.0,
+            },
+            budget: Budget::default(),
+            geomorph_frames: 4,
+            depth_colors: false,
+            wireframe: false,
+            dump_mesh: false,
+            write_frames: true,
+            peer_orbit: false,
+        }
+    }
+}
+
+/// One frame's figures.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OrbitFrame {
+    /// Frame number.
+    pub index: u32,
+    /// What the cut did.
+    pub stats: FrameStats,
+    /// Microseconds in [`Cut::adapt`].
+    pub adapt_us: f64,
+    /// Microseconds drawing the cut.
+    pub render_us: f64,
+    /// Microseconds drawing the full-detail mesh.
+    pub full_render_us: f64,
+    /// PSNR of the adapted frame against the full-detail frame, in dB (infinite when equal).
+    pub psnr_db: f64,
+}
+
+/// The full-detail mesh of a hierarchy: every split done, in leaf numbering.
+pub fn full_detail(h: &HierarchyView<'_>, cut: &mut DemoCut) -> Result<IndexedMesh, String> {
+    cut.reset(h).map_err(|e| e.to_string())?;
+    while cut.refine_everything(h) > 0 {}
+    let positions: Vec<[f32; 3]> = (0..h.leaves()).map(|i| h.node(i).position).collect();
+    let nodes = cut.nodes();
+    let triangles: Vec<[u32; 3]> = cut
+        .triangles()
+        .iter()
+        .map(|t| t.map(|s| nodes[s as usize]))
+        .collect();
+    if triangles.iter().flatten().any(|&v| v >= h.leaves()) {
+        return Err("the cut holds too little for full detail".into());
+    }
+    let colors = h
+        .has_colors()
+        .then(|| (0..h.leaves()).map(|i| h.node(i).color).collect());
+    let mut mesh = IndexedMesh {
+        normals: vertex_normals(&positions, &triangles),
+        positions,
+        colors,
+        triangles,
+    };
+    mesh.reorder_for_locality();
+    Ok(mesh)
+}
+
+/// Bounds of the hierarchy's leaves.
+pub fn leaf_bounds(h: &HierarchyView<'_>) -> Bounds {
+    let mut min = glam::Vec3::splat(f32::INFINITY);
+    let mut max = glam::Vec3::splat(f32::NEG_INFINITY);
+    for i in 0..h.leaves() {
+        let p = glam::Vec3::from(h.node(i).position);
+        min = min.min(p);
+        max = max.max(p);
+    }
+    Bounds { min, max }
+}
+
+/// The policy view of `camera`, with the refinement frustum scaled by `frustum`.
+pub fn policy_view(camera: &Camera, aspect: f32, height: usize, frustum: f32) -> View {
+    View::with_frustum_scale(
+        camera.eye.into(),
+        camera.target.into(),
+        camera.up.into(),
+        camera.fov_y,
+        aspect,
+        height as f32,
+        frustum,
+    )
+}
+
+/// The policy for `choice`, as a trait object.
+pub fn make_policy(choice: PolicyChoice) -> Box<dyn Policy + Send> {
+    match choice {
+        PolicyChoice::Screen {
+            silhouette,
+            interior,
+        } => Box::new((
+            Frustum,
+            (
+                BackFace,
+                ScreenError {
+                    silhouette,
+                    interior,
+                },
+            ),
+        )),
+        PolicyChoice::MergeTree => Box::new(MergeTree {
+            near: f32::INFINITY,
+        }),
+        PolicyChoice::Importance { threshold } => Box::new((Frustum, Importance { threshold })),
+    }
+}
+
+/// The cut as a rasterizer mesh (no copy).
+pub fn cut_mesh<'a>(cut: &'a DemoCut, colors: bool) -> Mesh<'a> {
+    Mesh {
+        positions: cut.positions(),
+        normals: Some(cut.normals()),
+        colors: colors.then(|| cut.colors()),
+        triangles: cut.triangles(),
+        face_colors: None,
+    }
+}
+
+/// PSNR in dB of `a` against `b` over the RGB channels (infinite when equal).
+pub fn psnr(a: &[Rgba8], b: &[Rgba8]) -> f64 {
+    let n = a.len().min(b.len()).max(1);
+    let sum: u64 = a
+        .iter()
+        .zip(b)
+        .map(|(x, y)| {
+            (0..3)
+                .map(|k| {
+                    let d = x.0[k] as i64 - y.0[k] as i64;
+                    (d * d) as u64
+                })
+                .sum::<u64>()
+        })
+        .sum();
+    if sum == 0 {
+        return f64::INFINITY;
+    }
+    let mse = sum as f64 / (3 * n) as f64;
+    10.0 * (255.0f64 * 255.0 / mse).log10()
+}
+
+/// Adapted frame, full-detail frame and their difference (amplified 4x, red where the adapted
+/// frame differs) side by side.
+pub fn side_by_side(width: usize, height: usize, a: &[Rgba8], b: &[Rgba8]) -> Vec<Rgba8> {
+    let mut out = vec![Rgba8([255; 4]); width * 3 * height];
+    for y in 0..height {
+        for x in 0..width {
+            let i = y * width + x;
+            let row = y * width * 3;
+            out[row + x] = a[i];
+            out[row + width + x] = b[i];
+            let d = (0..3)
+                .map(|k| (a[i].0[k] as i32 - b[i].0[k] as i32).unsigned_abs())
+                .max()
+                .unwrap_or(0);
+            let v = (d * 4).min(255) as u8;
+            out[row + 2 * width + x] = Rgba8([255, 255 - v, 255 - v, 255]);
+        }
+    }
+    out
+}
+
+/// A plot of triangles (top, blue) and milliseconds (bottom: adapt + render in orange, the
+/// full-detail render in grey) per frame.
+pub fn plot(frames: &[OrbitFrame]) -> Result<Vec<u8>, FrameError> {
+    let (w, h) = (800u32, 420u32);
+    let mut pixmap = tiny_skia::Pixmap::new(w, h)
+        .ok_or_else(|| FrameError::Png("cannot make the plot".into()))?;
+    pixmap.fill(tiny_skia::Color::WHITE);
+    let panel = |top: f32| tiny_skia::Rect::from_xywh(40.0, top, w as f32 - 60.0, 170.0);
+    let mut paint = tiny_skia::Paint::default();
+    let n = frames.len().max(2) as f32;
+    let mut draw =
+        |pixmap: &mut tiny_skia::Pixmap, top: f32, values: &[f64], max: f64, rgb: (u8, u8, u8)| {
+            let Some(r) = panel(top) else { return };
+            let mut pb = tiny_skia::PathBuilder::new();
+            for (i, v) in values.iter().enumerate() {
+                let x = r.left() + r.width() * i as f32 / (n - 1.0);
+                let y = r.bottom() - r.height() * (v / max.max(1e-12)).min(1.0) as f32;
+                if i == 0 {
+                    pb.move_to(x, y);
+                } else {
+                    pb.line_to(x, y);
+                }
+            }
+            if let Some(path) = pb.finish() {
+                paint.set_color_rgba8(rgb.0, rgb.1, rgb.2, 255);
+                let stroke = tiny_skia::Stroke {
+                    width: 2.0,
+                    ..Default::default()
+                };
+                pixmap.stroke_path(
+                    &path,
+                    &paint,
+                    &stroke,
+                    tiny_skia::Transform::identity(),
+                    None,
+                );
+            }
+        };
+    // Frames and grid lines at quarters of each panel's maximum.
+    let mut grid = tiny_skia::Paint::default();
+    grid.set_color_rgba8(210, 210, 210, 255);
+    for top in [20.0f32, 230.0] {
+        if let Some(r) = panel(top) {
+            for q in 0..=4 {
+                let y = r.top() + r.height() * q as f32 / 4.0;
+                if let Some(line) = tiny_skia::Rect::from_xywh(r.left(), y, r.width(), 1.0) {
+                    pixmap.fill_rect(line, &grid, tiny_skia::Transform::identity(), None);
+                }
+            }
+        }
+    }
+    let tris: Vec<f64> = frames.iter().map(|f| f.stats.triangles as f64).collect();
+    let tmax = tris.iter().cloned().fold(1.0, f64::max);
+    draw(&mut pixmap, 20.0, &tris, tmax, (40, 90, 200));
+    let ours: Vec<f64> = frames
+        .iter()
+        .map(|f| (f.adapt_us + f.render_us) / 1e3)
+        .collect();
+    let full: Vec<f64> = frames.iter().map(|f| f.full_render_us / 1e3).collect();
+    let mmax = ours.iter().chain(&full).cloned().fold(1e-3, f64::max);
+    draw(&mut pixmap, 230.0, &full, mmax, (150, 150, 150));
+    draw(&mut pixmap, 230.0, &ours, mmax, (230, 120, 20));
+    pixmap
+        .encode_png()
+        .map_err(|e| FrameError::Png(e.to_string()))
+}
+
+/// Writes the cut's mesh as an OBJ file (positions as blended, 1-based faces).
+pub fn write_obj(path: &Path, cut: &DemoCut) -> std::io::Result<()> {
+    let mut s = String::with_capacity(cut.vertices() * 40 + cut.triangles().len() * 24);
+    for p in cut.positions() {
+        let _ = writeln!(s, "v {} {} {}", p[0], p[1], p[2]);
+    }
+    for t in cut.triangles() {
+        let _ = writeln!(s, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1);
+    }
+    std::fs::write(path, s)
+}
+
+/// What [`run_orbit`] measured over the whole orbit.
+#[derive(Clone, Debug, PartialEq)]
+pub struct OrbitSummary {
+    /// Per frame.
+    pub frames: Vec<OrbitFrame>,
+    /// Frame whose comparison went into `side_by_side.png`.
+    pub compared: u32,
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    if v.is_empty() {
+        return 0.0;
+    }
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+impl OrbitSummary {
+    /// Median of a per-frame figure over the frames after the first (the first refines from the
+    /// base mesh and is reported on its own).
+    pub fn median_after_first(&self, f: impl Fn(&OrbitFrame) -> f64) -> f64 {
+        median(self.frames.iter().skip(1).map(f).collect())
+    }
+
+    /// Mean of a per-frame figure over the frames after the first.
+    pub fn mean_after_first(&self, f: impl Fn(&OrbitFrame) -> f64) -> f64 {
+        let v: Vec<f64> = self.frames.iter().skip(1).map(f).collect();
+        v.iter().sum::<f64>() / v.len().max(1) as f64
+    }
+}
+
+/// Flies the orbit: adapts the cut, draws it and the full-detail mesh, writes `frame_NNNN.png`,
+/// `stats.csv`, `plot.png`, `side_by_side.png` (and `mesh_NNNN.obj` with `dump_mesh`) into
+/// `out_dir`. `report` is called after each frame.
+pub fn run_orbit(
+    bytes: &[u8],
+    full: &IndexedMesh,
+    opts: &OrbitOptions,
+    out_dir: &Path,
+    mut report: impl FnMut(&OrbitFrame),
+) -> Result<OrbitSummary, String> {
+    let h = HierarchyView::parse(bytes).map_err(|e| e.to_string())?;
+    let io = |e: std::io::Error| format!("{}: {e}", out_dir.display());
+    std::fs::create_dir_all(out_dir).map_err(io)?;
+    let mut cut = new_cut();
+    cut.set_coloring(if opts.depth_colors {
+        Coloring::Depth
+    } else {
+        Coloring::Node
+    });
+    cut.reset(&h).map_err(|e| e.to_string())?;
+    cut.set_geomorph_frames(opts.geomorph_frames);
+    let colors = opts.depth_colors || h.has_colors();
+    let bounds = full.bounds();
+    let orbit = if opts.peer_orbit {
+        Orbit::peer(&bounds, opts.frames)
+    } else {
+        Orbit::merge_tree(&bounds, opts.frames)
+    };
+    let policy = make_policy(opts.policy);
+    let mut frame = Frame::new(opts.width, opts.height).map_err(|e| e.to_string())?;
+    let mut reference = Frame::new(opts.width, opts.height).map_err(|e| e.to_string())?;
+    let full_mesh = full.as_raster_mesh();
+    let mut csv = String::from(
+        "frame,triangles,vsplits,ecols,adapt_us,render_us,full_render_us,psnr_db,vertices,forced,blending,threshold,budget_limited\n",
+    );
+    let mut frames = Vec::with_capacity(opts.frames as usize);
+    let compared = opts.frames / 2;
+    for i in 0..opts.frames {
+        let camera = orbit.camera(i);
+        let view = policy_view(&camera, frame.aspect(), opts.height, opts.frustum);
+        let start = Instant::now();
+        let stats = cut.adapt(&h, &view, &&*policy, &opts.budget);
+        let adapt_us = start.elapsed().as_secs_f64() * 1e6;
+        let mut params = camera_params(&camera, frame.aspect(), Shading::Gouraud, opts.wireframe);
+        let start = Instant::now();
+        frame
+            .draw(&cut_mesh(&cut, colors), &params)
+            .map_err(|e| e.to_string())?;
+        let render_us = start.elapsed().as_secs_f64() * 1e6;
+        params.wireframe = None;
+        let start = Instant::now();
+        reference
+            .draw(&full_mesh, &params)
+            .map_err(|e| e.to_string())?;
+        let full_render_us = start.elapsed().as_secs_f64() * 1e6;
+        let f = OrbitFrame {
+            index: i,
+            stats,
+            adapt_us,
+            render_us,
+            full_render_us,
+            psnr_db: psnr(frame.pixels(), reference.pixels()),
+        };
+        if opts.write_frames {
+            frame
+                .save_png(&out_dir.join(format!("frame_{i:04}.png")))
+                .map_err(|e| e.to_string())?;
+        }
+        if opts.dump_mesh {
+            write_obj(&out_dir.join(format!("mesh_{i:04}.obj")), &cut).map_err(io)?;
+        }
+        if i == compared {
+            let side = side_by_side(opts.width, opts.height, frame.pixels(), reference.pixels());
+            save_png(
+                &out_dir.join("side_by_side.png"),
+                opts.width * 3,
+                opts.height,
+                &side,
+            )
+            .map_err(|e| e.to_string())?;
+        }
+        let _ = writeln!(
+            csv,
+            "{},{},{},{},{:.1},{:.1},{:.1},{:.3},{},{},{},{},{}",
+            i,
+            stats.triangles,
+            stats.vsplits,
+            stats.ecols,
+            adapt_us,
+            render_us,
+            full_render_us,
+            f.psnr_db,
+            stats.vertices,
+            stats.forced,
+            stats.blending,
+            stats.threshold,
+            stats.budget_limited as u8,
+        );
+        report(&f);
+        frames.push(f);
+    }
+    let mut file = std::fs::File::create(out_dir.join("stats.csv")).map_err(io)?;
+    file.write_all(csv.as_bytes()).map_err(io)?;
+    let png = plot(&frames).map_err(|e| e.to_string())?;
+    std::fs::write(out_dir.join("plot.png"), png).map_err(io)?;
+    Ok(OrbitSummary { frames, compared })
+}
