@@ -23,7 +23,7 @@
 //! Full capacity, a full queue, the budget and the operation limit keep the cut coarser and are
 //! reported in [`FrameStats`]; nothing panics.
 
-use crate::cut::{bounds_of, Cut, Morph, Refused};
+use crate::cut::{Cut, Morph, Refused};
 use crate::format::{HierarchyView, NONE};
 use crate::policy::{Policy, View};
 
@@ -162,11 +162,11 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         };
     }
 
-    fn sibling_active(&self, h: &HierarchyView<'_>, node: u32) -> bool {
-        let p = h.parent(node);
+    fn sibling_active(&self, h: &HierarchyView<'_>, i: usize) -> bool {
+        let p = self.family[i][0];
         p != NONE && {
             let [c0, c1] = h.split(p).children;
-            let other = if c0 == node { c1 } else { c0 };
+            let other = if c0 == self.node[i] { c1 } else { c0 };
             self.slot_of.get(other).is_some()
         }
     }
@@ -208,7 +208,7 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
             };
             self.flags[i] = was | d.visible as u8;
             let node = self.node[i];
-            if self.morph[i].collapsing && !self.sibling_active(h, node) {
+            if self.morph[i].collapsing && !self.sibling_active(h, i) {
                 // The pair was broken up (a forced split took the sibling): blend back.
                 self.start_blend(i, false);
             }
@@ -221,16 +221,19 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
                 }
                 continue;
             }
-            let p = h.parent(node);
-            if p == NONE {
+            let Some(p) = self.pair_parent(i) else {
                 continue;
-            }
-            let [c0, c1] = h.split(p).children;
-            if c0 != node || self.slot_of.get(c1).is_none() {
-                continue;
-            }
-            let dp = policy.demand(&bounds_of(&h.node(p)), view);
+            };
+            let dp = policy.demand(&self.parent_bounds[i], view);
             let e = if dp.visible { dp.error } else { -1.0 };
+            if e > t {
+                // The parent is wanted: a collapse under way blends back.
+                let j = self.family[i][2] as usize;
+                if self.morph[i].collapsing || self.morph[j].collapsing {
+                    self.start_blend(i, false);
+                    self.start_blend(j, false);
+                }
+            }
             if self.pairs.push((e, p)).is_err() {
                 stats.queue_overflow = true;
             }
@@ -239,6 +242,9 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         // Coarsen where the parent is no longer needed.
         for k in 0..self.pairs.len() {
             let (e, p) = self.pairs[k];
+            if e > t {
+                continue;
+            }
             let [c0, c1] = h.split(p).children;
             let (Some(a), Some(b)) = (self.slot_of.get(c0), self.slot_of.get(c1)) else {
                 continue;
@@ -246,14 +252,6 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
             let (a, b) = (a as usize, b as usize);
             let (ma, mb) = (self.morph[a], self.morph[b]);
             let blending = ma.collapsing && mb.collapsing;
-            if e > t {
-                if ma.collapsing || mb.collapsing {
-                    // The parent is wanted again: the children blend back.
-                    self.start_blend(a, false);
-                    self.start_blend(b, false);
-                }
-                continue;
-            }
             if ops >= budget.max_ops {
                 stats.ops_limited = true;
                 break;
@@ -405,14 +403,8 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
             }
             self.pairs.clear();
             for i in 0..self.node.len() {
-                let node = self.node[i];
-                let p = h.parent(node);
-                if p == NONE {
-                    continue;
-                }
-                let [c0, c1] = h.split(p).children;
-                if c0 == node && self.slot_of.get(c1).is_some() {
-                    let dp = policy.demand(&bounds_of(&h.node(p)), view);
+                if let Some(p) = self.pair_parent(i) {
+                    let dp = policy.demand(&self.parent_bounds[i], view);
                     let e = if dp.visible { dp.error } else { -1.0 };
                     if self.pairs.push((e, p)).is_err() {
                         stats.queue_overflow = true;

@@ -195,6 +195,8 @@ pub struct HierarchyView<'a> {
     leaves: u32,
     nodes: u32,
     base_triangles: u32,
+    /// Byte offsets of the node, split and base-triangle sections.
+    offsets: [usize; 3],
 }
 
 /// One node, read from a [`HierarchyView`].
@@ -318,8 +320,8 @@ impl<'a> HierarchyView<'a> {
         [n, s, b, end]
     }
 
-    fn offsets(&self) -> [usize; 4] {
-        Self::layout(self.leaves, self.nodes, self.base_triangles).map(|o| o as usize)
+    fn offsets(&self) -> [usize; 3] {
+        self.offsets
     }
 
     /// Validates `bytes` and returns a view of them.
@@ -343,6 +345,7 @@ impl<'a> HierarchyView<'a> {
             leaves: u32_at(bytes, 8),
             nodes: u32_at(bytes, 12),
             base_triangles: u32_at(bytes, 16),
+            offsets: [0; 3],
         };
         if view.nodes < view.leaves
             || view.nodes - view.leaves > view.leaves
@@ -354,7 +357,8 @@ impl<'a> HierarchyView<'a> {
         {
             return Err(FormatError::BadCounts);
         }
-        let end = Self::layout(view.leaves, view.nodes, view.base_triangles)[3];
+        let layout = Self::layout(view.leaves, view.nodes, view.base_triangles);
+        let end = layout[3];
         let actual = bytes.len() as u64;
         if actual < end {
             return Err(FormatError::Truncated {
@@ -368,6 +372,11 @@ impl<'a> HierarchyView<'a> {
                 actual,
             });
         }
+        // The sections fit in `bytes`, so their offsets fit in usize.
+        let view = HierarchyView {
+            offsets: [layout[0] as usize, layout[1] as usize, layout[2] as usize],
+            ..view
+        };
         let stored = u32_at(bytes, 24);
         let computed = crc32(&bytes[HEADER_SIZE..]);
         if stored != computed {
@@ -540,6 +549,28 @@ impl<'a> HierarchyView<'a> {
             color: [byte(25), byte(26), byte(27)],
             depth: u16_at(b, o.saturating_add(28)),
             parent: u32_at(b, o.saturating_add(30)),
+        }
+    }
+
+    /// What the refinement policies need of node `i`, decoded without the rest of the record.
+    #[inline]
+    pub fn bounds(&self, i: u32) -> crate::policy::Bounds {
+        let o = record(self.offsets[0], i, NODE_SIZE);
+        let b = self.bytes;
+        let h = |k: usize| f16_to_f32(u16_at(b, o.saturating_add(12 + 2 * k)));
+        let byte = |k: usize| b.get(o.saturating_add(k)).copied().unwrap_or(0);
+        let (sa, sb) = (h(3), h(4));
+        crate::policy::Bounds {
+            center: [
+                f32_at(b, o),
+                f32_at(b, o.saturating_add(4)),
+                f32_at(b, o.saturating_add(8)),
+            ],
+            radius: h(0),
+            axis: oct_decode(byte(22) as i8, byte(23) as i8),
+            cone_sin: byte(24) as f32 / 255.0,
+            a2: sa * sa,
+            b2: sb * sb,
         }
     }
 

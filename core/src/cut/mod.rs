@@ -17,11 +17,11 @@
 //! panics on any hierarchy [`HierarchyView::parse`] accepted: an operation that would overflow a
 //! capacity is refused and counted instead.
 //!
-//! Memory: [`Cut::BYTES`] = 111 bytes per vertex slot (node, a triangle of its fan, cached
-//! bounds, position, normal, colours, flags, blend state), 36 per triangle slot (corners,
+//! Memory: [`Cut::BYTES`] = 163 bytes per vertex slot (node, a triangle of its fan, cached
+//! bounds, parent, sibling and the parent's bounds, position, normal, colours, flags, blend state), 36 per triangle slot (corners,
 //! neighbours, id, and a node-map entry) and 20 per queue entry, plus a few words; asserted in
 //! the tests. A closed mesh has about two triangles per vertex, so `F = 2 V` and
-//! `Q = V / 4` cost about 190 bytes per active vertex.
+//! `Q = V / 4` cost about 240 bytes per active vertex.
 //!
 //! ```
 //! # #[cfg(feature = "build")] {
@@ -157,6 +157,12 @@ pub struct Cut<const V: usize, const F: usize, const Q: usize> {
     /// One triangle around the vertex (`NIL` for none).
     pub(crate) fan: Vec<u32, V>,
     pub(crate) bounds: Vec<Bounds, V>,
+    /// The parent, and when this is the parent's first child its sibling and the sibling's
+    /// slot when active (else `NIL`s), so that each pair is looked at once per frame without
+    /// reading the file or the node map.
+    pub(crate) family: Vec<[u32; 3], V>,
+    /// The parent's bounds, for first children (the collapse test reads them every frame).
+    pub(crate) parent_bounds: Vec<Bounds, V>,
     pub(crate) positions: Vec<[f32; 3], V>,
     pub(crate) normals: Vec<[f32; 3], V>,
     pub(crate) colors: Vec<[u8; 3], V>,
@@ -253,6 +259,8 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
             node: Vec::new(),
             fan: Vec::new(),
             bounds: Vec::new(),
+            family: Vec::new(),
+            parent_bounds: Vec::new(),
             positions: Vec::new(),
             normals: Vec::new(),
             colors: Vec::new(),
@@ -350,6 +358,8 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         self.node.clear();
         self.fan.clear();
         self.bounds.clear();
+        self.family.clear();
+        self.parent_bounds.clear();
         self.positions.clear();
         self.normals.clear();
         self.colors.clear();
@@ -373,6 +383,35 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         }
     }
 
+    /// Fills slot `s`'s family entry, and its first sibling's if `s` holds a second child.
+    fn link_family(&mut self, h: &HierarchyView<'_>, s: u32) {
+        let node = self.node[s as usize];
+        let p = h.parent(node);
+        let mut entry = [NONE, NIL, NIL];
+        let mut pb = Bounds::default();
+        if p != NONE {
+            let [c0, c1] = h.split(p).children;
+            entry[0] = p;
+            if c0 == node {
+                entry[1] = c1;
+                entry[2] = self.slot_of.get(c1).unwrap_or(NIL);
+                pb = h.bounds(p);
+            } else if let Some(x) = self.slot_of.get(c0) {
+                self.family[x as usize][2] = s;
+            }
+        }
+        self.family[s as usize] = entry;
+        self.parent_bounds[s as usize] = pb;
+    }
+
+    /// Whether the vertex at slot `i` is a first child whose sibling is active; then returns
+    /// the parent.
+    #[inline]
+    pub(crate) fn pair_parent(&self, i: usize) -> Option<u32> {
+        let [p, sibling, slot] = self.family[i];
+        (sibling != NIL && self.node.get(slot as usize) == Some(&sibling)).then_some(p)
+    }
+
     /// Appends a vertex for `node`; `false` when full. `start` = the blend it starts with.
     fn push_vertex(&mut self, h: &HierarchyView<'_>, node: u32, start: Option<Morph>) -> bool {
         if self.node.is_full() || !self.slot_of.insert(node, self.node.len() as u32) {
@@ -383,6 +422,8 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         let _ = self.node.push(node);
         let _ = self.fan.push(NIL);
         let _ = self.bounds.push(bounds_of(&n));
+        let _ = self.family.push([NONE, NIL, NIL]);
+        let _ = self.parent_bounds.push(Bounds::default());
         let (pos, normal, color, morph) = match start {
             Some(m) => (m.from_pos, m.from_normal, m.from_color, m),
             None => (n.position, n.normal, tint, Morph::default()),
@@ -393,6 +434,7 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         let _ = self.tint.push(tint);
         let _ = self.flags.push(1);
         let _ = self.morph.push(morph);
+        self.link_family(h, self.node.len() as u32 - 1);
         true
     }
 
@@ -405,6 +447,7 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         let _ = self.slot_of.insert(node, s as u32);
         self.node[s] = node;
         self.bounds[s] = bounds_of(&n);
+        self.link_family(h, s as u32);
         self.tint[s] = tint;
         match start {
             Some(m) => {
@@ -865,7 +908,7 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         }
         self.set_vertex(h, a as usize, node, None);
         self.slot_of.remove(self.node[b as usize]);
-        self.remove_vertex(b)
+        self.remove_vertex(h, b)
             .map(|moved_to| if moved_to == a { b } else { a })
             .unwrap_or(a)
     }
@@ -901,7 +944,7 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
 
     /// Swap-removes vertex slot `v` (its node is already out of the map). Returns the slot the
     /// last vertex moved from, if it moved.
-    fn remove_vertex(&mut self, v: u32) -> Option<u32> {
+    fn remove_vertex(&mut self, h: &HierarchyView<'_>, v: u32) -> Option<u32> {
         let last = self.node.len() as u32 - 1;
         let moved = (v != last).then(|| {
             let mut fan: Vec<u32, MAX_FAN> = Vec::new();
@@ -918,6 +961,8 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
             self.node[i] = self.node[j];
             self.fan[i] = self.fan[j];
             self.bounds[i] = self.bounds[j];
+            self.family[i] = self.family[j];
+            self.parent_bounds[i] = self.parent_bounds[j];
             self.positions[i] = self.positions[j];
             self.normals[i] = self.normals[j];
             self.colors[i] = self.colors[j];
@@ -925,11 +970,21 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
             self.flags[i] = self.flags[j];
             self.morph[i] = self.morph[j];
             let _ = self.slot_of.insert(self.node[i], v);
+            // A second child tells its first sibling where it went.
+            let [p, sibling, _] = self.family[i];
+            if p != NONE && sibling == NIL {
+                let c0 = h.split(p).children[0];
+                if let Some(x) = self.slot_of.get(c0) {
+                    self.family[x as usize][2] = v;
+                }
+            }
             last
         });
         self.node.pop();
         self.fan.pop();
         self.bounds.pop();
+        self.family.pop();
+        self.parent_bounds.pop();
         self.positions.pop();
         self.normals.pop();
         self.colors.pop();
