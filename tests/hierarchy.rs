@@ -1,57 +1,10 @@
 //! The hierarchy builder on the fixtures: exact round trips, topology kept, forest depth.
 
-use vdlod_core::build::{build, rotate_to_min, BuildOptions, Cost, Hierarchy, InputMesh, NONE};
-use vdlod_demo::mesh::{
-    load_obj, load_obj_bytes, IndexedMesh, BUNNY_NAME, BUNNY_OBJ, COW_NAME, COW_OBJ,
-};
+mod common;
 
-fn fixture(name: &str) -> IndexedMesh {
-    load_obj(
-        &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("fixtures")
-            .join(name),
-    )
-    .unwrap()
-}
-
-fn sorted(t: &[[u32; 3]]) -> Vec<[u32; 3]> {
-    let mut t: Vec<[u32; 3]> = t.iter().map(|&t| rotate_to_min(t)).collect();
-    t.sort_unstable();
-    t
-}
-
-/// Euler characteristic and number of border loops.
-fn topology(triangles: &[[u32; 3]]) -> (i64, usize) {
-    use std::collections::{BTreeMap, BTreeSet};
-    let verts: BTreeSet<u32> = triangles.iter().flatten().copied().collect();
-    let directed: BTreeSet<(u32, u32)> = triangles
-        .iter()
-        .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
-        .collect();
-    let undirected: BTreeSet<(u32, u32)> = directed
-        .iter()
-        .map(|&(a, b)| (a.min(b), a.max(b)))
-        .collect();
-    let border: BTreeMap<u32, u32> = directed
-        .iter()
-        .filter(|&&(a, b)| !directed.contains(&(b, a)))
-        .map(|&(a, b)| (a, b))
-        .collect();
-    let mut seen = BTreeSet::new();
-    let mut loops = 0;
-    for &start in border.keys() {
-        if seen.contains(&start) {
-            continue;
-        }
-        loops += 1;
-        let mut v = start;
-        while seen.insert(v) {
-            v = border[&v];
-        }
-    }
-    let chi = verts.len() as i64 - undirected.len() as i64 + triangles.len() as i64;
-    (chi, loops)
-}
+use common::{fixture, sorted, topology};
+use vdlod_core::build::{build, BuildOptions, Cost, Hierarchy, InputMesh, NONE};
+use vdlod_demo::mesh::{load_obj_bytes, IndexedMesh, BUNNY_NAME, BUNNY_OBJ, COW_NAME, COW_OBJ};
 
 fn hierarchy(mesh: &IndexedMesh, opts: BuildOptions) -> Hierarchy {
     let input = InputMesh {

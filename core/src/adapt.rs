@@ -65,6 +65,9 @@ pub struct FrameStats {
     pub forced: u32,
     /// Edge collapses done.
     pub ecols: u32,
+    /// Of those, collapses that only enforced [`Budget::max_triangles`] after it was lowered
+    /// (the hard limit wins over [`Budget::max_ops`]).
+    pub budget_ecols: u32,
     /// Vertices with a geomorph running.
     pub blending: u32,
     /// The error threshold used (1 unless regulated).
@@ -420,6 +423,7 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
                 }
                 if self.collapse_now(h, self.pairs[k].1) {
                     stats.ecols += 1;
+                    stats.budget_ecols += 1;
                     progress = true;
                 }
             }
