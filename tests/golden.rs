@@ -139,3 +139,51 @@ fn frames_are_identical_from_run_to_run() {
     let opts = small(Shading::Gouraud, true);
     assert_eq!(orbit_frame(&mesh, 3, &opts), orbit_frame(&mesh, 3, &opts));
 }
+
+/// Frames `indices` of the peer orbit flown by a cut of the bunny (1 px, geomorphs over 4
+/// frames), optionally in false colour by forest depth.
+fn lod_frames(indices: &'static [u32], depth: bool) -> Vec<Vec<Rgba8>> {
+    use vdlod_core::adapt::Budget;
+    use vdlod_core::cut::{Coloring, Cut};
+    use vdlod_core::format::HierarchyView;
+    use vdlod_core::policy::{BackFace, Frustum, ScreenError};
+    use vdlod_demo::camera::Orbit;
+    use vdlod_demo::lod::{cut_mesh, policy_view, with_large_stack};
+    with_large_stack(move || {
+        let mesh = bunny();
+        let (_, bytes, _) =
+            vdlod_demo::hierarchy::build_with_progress(&mesh, &Default::default(), false).unwrap();
+        let h = HierarchyView::parse(&bytes).unwrap();
+        let mut cut: Box<Cut<{ 1 << 16 }, { 1 << 17 }, { 1 << 14 }>> = Box::default();
+        cut.set_coloring(if depth { Coloring::Depth } else { Coloring::Node });
+        cut.reset(&h).unwrap();
+        cut.set_geomorph_frames(4);
+        let orbit = Orbit::peer(&mesh.bounds(), 36);
+        let mut frame = Frame::new(W, H).unwrap();
+        let policy = (Frustum, (BackFace, ScreenError::new(1.0)));
+        let mut out = Vec::new();
+        for i in 0..=*indices.iter().max().unwrap() {
+            let camera = orbit.camera(i);
+            let view = policy_view(&camera, frame.aspect(), H, 1.0);
+            cut.adapt(&h, &view, &policy, &Budget::default());
+            if indices.contains(&i) {
+                let params = camera_params(&camera, frame.aspect(), Shading::Gouraud, false);
+                frame.draw(&cut_mesh(&cut, depth), &params).unwrap();
+                out.push(frame.pixels().to_vec());
+            }
+        }
+        out
+    })
+}
+
+#[test]
+fn bunny_cut_over_the_peer_orbit() {
+    for (k, pixels) in lod_frames(&[0, 5, 20], false).iter().enumerate() {
+        check(&format!("bunny_cut_{k}"), pixels);
+    }
+}
+
+#[test]
+fn bunny_cut_in_depth_colours() {
+    check("bunny_cut_depth", &lod_frames(&[12], true)[0]);
+}

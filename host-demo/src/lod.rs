@@ -202,7 +202,10 @@ pub fn make_policy(choice: PolicyChoice) -> Box<dyn Policy + Send> {
 }
 
 /// The cut as a rasterizer mesh (no copy).
-pub fn cut_mesh<'a>(cut: &'a DemoCut, colors: bool) -> Mesh<'a> {
+pub fn cut_mesh<const V: usize, const F: usize, const Q: usize>(
+    cut: &Cut<V, F, Q>,
+    colors: bool,
+) -> Mesh<'_> {
     Mesh {
         positions: cut.positions(),
         normals: Some(cut.normals()),

@@ -145,7 +145,7 @@ pub enum Coloring {
     /// The nodes' colours from the file.
     #[default]
     Node,
-    /// A false colour by depth in the forest: blue at the roots through green to red at depth 24.
+    /// A false colour by depth in the forest ([`depth_color`]).
     Depth,
 }
 
@@ -226,15 +226,20 @@ fn prev3(k: usize) -> usize {
     }
 }
 
-/// The false colour of a forest depth.
+/// The false colour of a forest depth: eight distinct hues, repeating, so that neighbouring
+/// levels always differ.
 pub fn depth_color(depth: u16) -> [u8; 3] {
-    let t = (depth.min(24) as f32) / 24.0;
-    let ramp = |x: f32| (x.clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
-    [
-        ramp(2.0 * t - 1.0),
-        ramp(1.0 - libm::fabsf(2.0 * t - 1.0)),
-        ramp(1.0 - 2.0 * t),
-    ]
+    const PALETTE: [[u8; 3]; 8] = [
+        [230, 25, 75],
+        [245, 130, 48],
+        [255, 225, 25],
+        [60, 180, 75],
+        [70, 240, 240],
+        [0, 130, 200],
+        [145, 30, 180],
+        [240, 50, 230],
+    ];
+    PALETTE[depth as usize % PALETTE.len()]
 }
 
 pub(crate) fn bounds_of(n: &NodeView) -> Bounds {
