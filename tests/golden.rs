@@ -155,7 +155,11 @@ fn lod_frames(indices: &'static [u32], depth: bool) -> Vec<Vec<Rgba8>> {
             vdlod_demo::hierarchy::build_with_progress(&mesh, &Default::default(), false).unwrap();
         let h = HierarchyView::parse(&bytes).unwrap();
         let mut cut: Box<Cut<{ 1 << 16 }, { 1 << 17 }, { 1 << 14 }>> = Box::default();
-        cut.set_coloring(if depth { Coloring::Depth } else { Coloring::Node });
+        cut.set_coloring(if depth {
+            Coloring::Depth
+        } else {
+            Coloring::Node
+        });
         cut.reset(&h).unwrap();
         cut.set_geomorph_frames(4);
         let orbit = Orbit::peer(&mesh.bounds(), 36);

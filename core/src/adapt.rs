@@ -23,7 +23,7 @@
 //! Full capacity, a full queue, the budget and the operation limit keep the cut coarser and are
 //! reported in [`FrameStats`]; nothing panics.
 
-use crate::cut::{Cut, Morph, Refused};
+use crate::cut::{Cut, Morph, Refused, BLOCKED, VISIBLE, WAS_VISIBLE};
 use crate::format::{HierarchyView, NONE};
 use crate::policy::{Policy, View};
 
@@ -84,9 +84,6 @@ pub struct FrameStats {
     /// not legal yet, or the base mesh alone is larger).
     pub over_budget: bool,
 }
-
-const VISIBLE: u8 = 1;
-const WAS_VISIBLE: u8 = 2;
 
 #[inline]
 fn lerp3(a: [f32; 3], b: [f32; 3], s: f32) -> [f32; 3] {
@@ -209,7 +206,7 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
             } else {
                 0
             };
-            self.flags[i] = was | d.visible as u8;
+            self.flags[i] = (self.flags[i] & BLOCKED) | was | d.visible as u8;
             let node = self.node[i];
             if self.morph[i].collapsing && !self.sibling_active(h, i) {
                 // The pair was broken up (a forced split took the sibling): blend back.
@@ -229,9 +226,12 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
             };
             let dp = policy.demand(&self.parent_bounds[i], view);
             let e = if dp.visible { dp.error } else { -1.0 };
+            let j = self.family[i][2] as usize;
+            if e <= t && self.flags[i] & self.flags[j] & BLOCKED != 0 {
+                continue;
+            }
             if e > t {
                 // The parent is wanted: a collapse under way blends back.
-                let j = self.family[i][2] as usize;
                 if self.morph[i].collapsing || self.morph[j].collapsing {
                     self.start_blend(i, false);
                     self.start_blend(j, false);
@@ -267,13 +267,19 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
                 if self.collapse_legal(h, p).is_ok() {
                     self.start_blend(a, true);
                     self.start_blend(b, true);
+                } else {
+                    self.flags[a] |= BLOCKED;
+                    self.flags[b] |= BLOCKED;
                 }
                 continue;
             }
             if self.collapse_now(h, p) {
                 stats.ecols += 1;
                 ops += 1;
-            } else if blending {
+            } else if !blending {
+                self.flags[a] |= BLOCKED;
+                self.flags[b] |= BLOCKED;
+            } else {
                 // Arrived, but the neighbourhood changed meanwhile: blend back.
                 self.start_blend(a, false);
                 self.start_blend(b, false);

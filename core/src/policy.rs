@@ -8,7 +8,9 @@
 //! which orders the budget's priority queue).
 //!
 //! Policies compose: a tuple `(A, B)` is visible when both are and demands the larger error, so
-//! the LOD lecture's `qrefine` is `(Frustum, (BackFace, ScreenError::new(1.0)))`.
+//! the LOD lecture's `qrefine` is `(Frustum, (BackFace, ScreenError::new(1.0)))`. [`QRefine`] is
+//! the same three tests fused, sharing their subexpressions: the one to use when speed matters
+//! (it gives the same answers, tested below).
 //!
 //! | policy | source |
 //! |---|---|
@@ -172,9 +174,13 @@ impl View {
     /// Whether the sphere `(center, radius)` reaches into the frustum.
     #[inline]
     pub fn sphere_visible(&self, center: [f32; 3], radius: f32) -> bool {
-        self.planes
-            .iter()
-            .all(|p| p[0] * center[0] + p[1] * center[1] + p[2] * center[2] + p[3] >= -radius)
+        // Branch-free: the nearest plane decides.
+        let mut nearest = f32::INFINITY;
+        for p in &self.planes {
+            let d = p[0] * center[0] + p[1] * center[1] + p[2] * center[2] + p[3];
+            nearest = nearest.min(d);
+        }
+        nearest >= -radius
     }
 }
 
@@ -291,10 +297,62 @@ impl Policy for ScreenError {
         } else {
             self.interior
         };
-        let k = tol / view.pixels_per_unit;
-        let rhs = k * k * d2 * d2;
+        // (projected radius / tolerance)^2 = lhs ppu^2 / (tol^2 d^4), with one division.
+        let rhs = tol * tol * d2 * d2;
         let error = if rhs > 0.0 {
-            lhs / rhs
+            lhs * (view.pixels_per_unit * view.pixels_per_unit) / rhs
+        } else if lhs > 0.0 {
+            f32::MAX
+        } else {
+            0.0
+        };
+        Demand {
+            visible: true,
+            error,
+        }
+    }
+}
+
+/// The LOD lecture's `qrefine`: [`Frustum`], [`BackFace`] and [`ScreenError`] in one pass that
+/// computes the eye vector and its length once.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct QRefine {
+    /// Screen-space tolerances.
+    pub error: ScreenError,
+}
+
+impl QRefine {
+    /// The same tolerance, in pixels, everywhere.
+    pub fn new(pixels: f32) -> QRefine {
+        QRefine {
+            error: ScreenError::new(pixels),
+        }
+    }
+}
+
+impl Policy for QRefine {
+    #[inline]
+    fn demand(&self, b: &Bounds, view: &View) -> Demand {
+        if !view.sphere_visible(b.center, b.radius) {
+            return Demand::CULLED;
+        }
+        let r = sub(b.center, view.eye);
+        let d2 = dot(r, r);
+        let rn = dot(r, b.axis);
+        let cs2 = b.cone_sin * b.cone_sin;
+        let s = rn - b.radius;
+        if s > 0.0 && s * s > d2 * cs2 {
+            return Demand::CULLED;
+        }
+        let lhs = (b.a2 * d2 + (b.b2 - b.a2) * rn * rn).max(b.b2 * d2);
+        let tol = if rn * rn <= d2 * cs2 {
+            self.error.silhouette
+        } else {
+            self.error.interior
+        };
+        let rhs = tol * tol * d2 * d2;
+        let error = if rhs > 0.0 {
+            lhs * (view.pixels_per_unit * view.pixels_per_unit) / rhs
         } else if lhs > 0.0 {
             f32::MAX
         } else {
@@ -452,6 +510,53 @@ mod tests {
         let edge_on = bounds([0.0; 3], [1.0, 0.0, 0.0], 0.05, 0.05);
         assert!(p.demand(&facing, &v).error < 1.0);
         assert!(p.demand(&edge_on, &v).error > 1.0);
+    }
+
+    #[test]
+    fn qrefine_is_the_three_tests_composed() {
+        let v = view();
+        let composed = (
+            Frustum,
+            (
+                BackFace,
+                ScreenError {
+                    silhouette: 0.5,
+                    interior: 3.0,
+                },
+            ),
+        );
+        let fused = QRefine {
+            error: ScreenError {
+                silhouette: 0.5,
+                interior: 3.0,
+            },
+        };
+        let mut x = 0x1234_5678u32;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            (x >> 8) as f32 / (1u32 << 24) as f32
+        };
+        for _ in 0..10_000 {
+            let c = [
+                next() * 20.0 - 10.0,
+                next() * 20.0 - 10.0,
+                next() * 20.0 - 10.0,
+            ];
+            let n =
+                normalize([next() - 0.5, next() - 0.5, next() - 0.5]).unwrap_or([0.0, 0.0, 1.0]);
+            let a = next() * 0.2;
+            let b = Bounds {
+                center: c,
+                radius: next(),
+                axis: n,
+                cone_sin: next(),
+                a2: a * a,
+                b2: if next() < 0.5 { 0.0 } else { a * a * next() },
+            };
+            assert_eq!(composed.demand(&b, &v), fused.demand(&b, &v), "{b:?}");
+        }
     }
 
     #[test]

@@ -9,7 +9,7 @@ use std::time::Instant;
 use vdlod_core::adapt::{Budget, FrameStats};
 use vdlod_core::cut::{Coloring, Cut};
 use vdlod_core::format::HierarchyView;
-use vdlod_core::policy::{BackFace, Frustum, Importance, MergeTree, Policy, ScreenError, View};
+use vdlod_core::policy::{Frustum, Importance, MergeTree, Policy, QRefine, ScreenError, View};
 use vdlod_raster::{Mesh, Rgba8, Shading};
 
 use crate::camera::{Camera, Orbit};
@@ -184,16 +184,12 @@ pub fn make_policy(choice: PolicyChoice) -> Box<dyn Policy + Send> {
         PolicyChoice::Screen {
             silhouette,
             interior,
-        } => Box::new((
-            Frustum,
-            (
-                BackFace,
-                ScreenError {
-                    silhouette,
-                    interior,
-                },
-            ),
-        )),
+        } => Box::new(QRefine {
+            error: ScreenError {
+                silhouette,
+                interior,
+            },
+        }),
         PolicyChoice::MergeTree => Box::new(MergeTree {
             near: f32::INFINITY,
         }),

@@ -56,6 +56,14 @@ use crate::policy::Bounds;
 /// A slot that holds nothing (no neighbour across a border edge, no incident triangle).
 pub const NIL: u32 = u32::MAX;
 
+/// Vertex flag: visible at the last evaluation.
+pub(crate) const VISIBLE: u8 = 1;
+/// Vertex flag: visible at the evaluation before.
+pub(crate) const WAS_VISIBLE: u8 = 2;
+/// Vertex flag, set on both children: their collapse was found illegal, and nothing around
+/// them has collapsed since (a collapse clears it on its fan), so it is not retried.
+pub(crate) const BLOCKED: u8 = 4;
+
 /// Longest fan walked around one vertex; a hierarchy with larger vertex degrees is refused
 /// rather than walked forever.
 pub const MAX_FAN: usize = 1024;
@@ -168,7 +176,7 @@ pub struct Cut<const V: usize, const F: usize, const Q: usize> {
     pub(crate) colors: Vec<[u8; 3], V>,
     /// The colour the vertex blends towards (its node's, or the depth colour).
     pub(crate) tint: Vec<[u8; 3], V>,
-    /// Bit 0: visible at the last evaluation.
+    /// [`VISIBLE`], [`WAS_VISIBLE`], [`BLOCKED`].
     pub(crate) flags: Vec<u8, V>,
     pub(crate) morph: Vec<Morph, V>,
     pub(crate) slot_of: NodeMap<F>,
@@ -437,7 +445,7 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         let _ = self.normals.push(normal);
         let _ = self.colors.push(color);
         let _ = self.tint.push(tint);
-        let _ = self.flags.push(1);
+        let _ = self.flags.push(VISIBLE);
         let _ = self.morph.push(morph);
         self.link_family(h, self.node.len() as u32 - 1);
         true
@@ -452,6 +460,7 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         let _ = self.slot_of.insert(node, s as u32);
         self.node[s] = node;
         self.bounds[s] = bounds_of(&n);
+        self.flags[s] &= !BLOCKED;
         self.link_family(h, s as u32);
         self.tint[s] = tint;
         match start {
@@ -913,9 +922,21 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         }
         self.set_vertex(h, a as usize, node, None);
         self.slot_of.remove(self.node[b as usize]);
-        self.remove_vertex(h, b)
+        let p = self
+            .remove_vertex(h, b)
             .map(|moved_to| if moved_to == a { b } else { a })
-            .unwrap_or(a)
+            .unwrap_or(a);
+        // Collapses around here may have become legal.
+        let mut fan: Vec<u32, MAX_FAN> = Vec::new();
+        let _ = self.for_fan(p, |f| {
+            let _ = fan.push(f);
+        });
+        for &f in &fan {
+            for v in self.tri[f as usize] {
+                self.flags[v as usize] &= !BLOCKED;
+            }
+        }
+        p
     }
 
     /// Swap-removes triangle slot `f`, re-pointing whatever pointed at the moved one.
