@@ -23,7 +23,7 @@
 //! Full capacity, a full queue, the budget and the operation limit keep the cut coarser and are
 //! reported in [`FrameStats`]; nothing panics.
 
-use crate::cut::{Cut, Morph, Refused, BLOCKED, VISIBLE, WAS_VISIBLE};
+use crate::cut::{Cut, Morph, Refused, BLENDING, BLOCKED, COLLAPSING, VISIBLE, WAS_VISIBLE};
 use crate::format::{HierarchyView, NONE};
 use crate::policy::{Policy, View};
 
@@ -96,7 +96,7 @@ fn lerp3(a: [f32; 3], b: [f32; 3], s: f32) -> [f32; 3] {
 
 /// Sorts `(error, id)` pairs by error, then id (a total order: the result never depends on the
 /// order they were found in).
-fn sort_pairs(pairs: &mut [(f32, u32)]) {
+fn sort_pairs(pairs: &mut [(f32, u32, u32)]) {
     pairs.sort_unstable_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
 }
 
@@ -115,10 +115,14 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
     fn advance(&mut self, h: &HierarchyView<'_>, i: usize) {
         let m = &mut self.morph[i];
         if m.left == 0 {
+            self.flags[i] &= !BLENDING;
             return;
         }
         let total = self.geomorph_frames.max(1);
         m.left = (m.left - 1).min(total);
+        if m.left == 0 {
+            self.flags[i] &= !BLENDING;
+        }
         let done = 1.0 - m.left as f32 / total as f32;
         let m = *m;
         let (pos, normal, color) = if m.collapsing {
@@ -160,6 +164,13 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
             left: self.geomorph_frames,
             collapsing,
         };
+        self.flags[i] &= !(BLENDING | COLLAPSING);
+        if self.geomorph_frames > 0 {
+            self.flags[i] |= BLENDING;
+        }
+        if collapsing {
+            self.flags[i] |= COLLAPSING;
+        }
     }
 
     fn sibling_active(&self, h: &HierarchyView<'_>, i: usize) -> bool {
@@ -199,21 +210,24 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
 
         // One pass: blends advance, the policy speaks for every vertex and every sibling pair.
         for i in 0..self.node.len() {
-            self.advance(h, i);
+            if self.flags[i] & BLENDING != 0 {
+                self.advance(h, i);
+            }
             let d = policy.demand(&self.bounds[i], view);
             let was = if self.flags[i] & VISIBLE != 0 {
                 WAS_VISIBLE
             } else {
                 0
             };
-            self.flags[i] = (self.flags[i] & BLOCKED) | was | d.visible as u8;
+            self.flags[i] =
+                (self.flags[i] & (BLOCKED | BLENDING | COLLAPSING)) | was | d.visible as u8;
             let node = self.node[i];
-            if self.morph[i].collapsing && !self.sibling_active(h, i) {
+            if self.flags[i] & COLLAPSING != 0 && !self.sibling_active(h, i) {
                 // The pair was broken up (a forced split took the sibling): blend back.
                 self.start_blend(i, false);
             }
             if d.error > t && node >= h.leaves() {
-                if self.morph[i].collapsing {
+                if self.flags[i] & COLLAPSING != 0 {
                     // Wanted again: reverse the collapse's blend; no split this frame.
                     self.start_blend(i, false);
                 } else if self.candidates.push((d.error.to_bits(), node)).is_err() {
@@ -232,29 +246,37 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
             }
             if e > t {
                 // The parent is wanted: a collapse under way blends back.
-                if self.morph[i].collapsing || self.morph[j].collapsing {
+                if (self.flags[i] | self.flags[j]) & COLLAPSING != 0 {
                     self.start_blend(i, false);
                     self.start_blend(j, false);
                 }
             }
-            if self.pairs.push((e, p)).is_err() {
+            if self.pairs.push((e, p, i as u32)).is_err() {
                 stats.queue_overflow = true;
             }
         }
 
         // Coarsen where the parent is no longer needed.
         for k in 0..self.pairs.len() {
-            let (e, p) = self.pairs[k];
+            let (e, p, first) = self.pairs[k];
             if e > t {
                 continue;
             }
-            let [c0, c1] = h.split(p).children;
-            let (Some(a), Some(b)) = (self.slot_of.get(c0), self.slot_of.get(c1)) else {
-                continue;
+            // The first child's slot from the pass, unless a collapse since moved it.
+            let a = if self.family.get(first as usize).map(|f| f[0]) == Some(p)
+                && self.pair_parent(first as usize) == Some(p)
+            {
+                first
+            } else {
+                match self.slot_of.get(h.split(p).children[0]) {
+                    Some(a) if self.pair_parent(a as usize) == Some(p) => a,
+                    _ => continue,
+                }
             };
+            let b = self.family[a as usize][2];
             let (a, b) = (a as usize, b as usize);
             let (ma, mb) = (self.morph[a], self.morph[b]);
-            let blending = ma.collapsing && mb.collapsing;
+            let blending = self.flags[a] & self.flags[b] & COLLAPSING != 0;
             if ops >= budget.max_ops {
                 stats.ops_limited = true;
                 break;
@@ -263,8 +285,12 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
             if blending && (ma.left > 0 || mb.left > 0) {
                 continue;
             }
+            let split = h.split(p);
             if !blending && frames > 0 && seen {
-                if self.collapse_legal(h, p).is_ok() {
+                if self
+                    .collapse_legal_at(h, p, &split, a as u32, b as u32)
+                    .is_ok()
+                {
                     self.start_blend(a, true);
                     self.start_blend(b, true);
                 } else {
@@ -273,7 +299,8 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
                 }
                 continue;
             }
-            if self.collapse_now(h, p) {
+            if let Ok(slots) = self.collapse_legal_at(h, p, &split, a as u32, b as u32) {
+                self.collapse_unchecked(h, p, slots);
                 stats.ecols += 1;
                 ops += 1;
             } else if !blending {
@@ -347,7 +374,7 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
                     let e = f32::from_bits(bits);
                     let mut freed = false;
                     while traded < self.pairs.len() && ops < budget.max_ops {
-                        let (pe, p) = self.pairs[traded];
+                        let (pe, p, _) = self.pairs[traded];
                         if pe >= e {
                             break;
                         }
@@ -392,7 +419,7 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         stats.triangles = tris;
         stats.vertices = self.node.len() as u32;
         stats.threshold = t;
-        stats.blending = self.morph.iter().filter(|m| m.left > 0).count() as u32;
+        stats.blending = self.flags.iter().filter(|&&f| f & BLENDING != 0).count() as u32;
         stats
     }
 
@@ -415,7 +442,7 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
                 if let Some(p) = self.pair_parent(i) {
                     let dp = policy.demand(&self.parent_bounds[i], view);
                     let e = if dp.visible { dp.error } else { -1.0 };
-                    if self.pairs.push((e, p)).is_err() {
+                    if self.pairs.push((e, p, i as u32)).is_err() {
                         stats.queue_overflow = true;
                         break;
                     }

@@ -19,7 +19,7 @@
 //!
 //! Memory: [`Cut::BYTES`] = 163 bytes per vertex slot (node, a triangle of its fan, cached
 //! bounds, parent, sibling and the parent's bounds, position, normal, colours, flags, blend state), 36 per triangle slot (corners,
-//! neighbours, id, and a node-map entry) and 20 per queue entry, plus a few words; asserted in
+//! neighbours, id, and a node-map entry) and 24 per queue entry, plus a few words; asserted in
 //! the tests. A closed mesh has about two triangles per vertex, so `F = 2 V` and
 //! `Q = V / 4` cost about 240 bytes per active vertex.
 //!
@@ -63,6 +63,10 @@ pub(crate) const WAS_VISIBLE: u8 = 2;
 /// Vertex flag, set on both children: their collapse was found illegal, and nothing around
 /// them has collapsed since (a collapse clears it on its fan), so it is not retried.
 pub(crate) const BLOCKED: u8 = 4;
+/// Vertex flag: a geomorph runs (its blend state has frames left).
+pub(crate) const BLENDING: u8 = 8;
+/// Vertex flag: the geomorph runs towards the parent, for a collapse.
+pub(crate) const COLLAPSING: u8 = 16;
 
 /// Longest fan walked around one vertex; a hierarchy with larger vertex degrees is refused
 /// rather than walked forever.
@@ -176,7 +180,8 @@ pub struct Cut<const V: usize, const F: usize, const Q: usize> {
     pub(crate) colors: Vec<[u8; 3], V>,
     /// The colour the vertex blends towards (its node's, or the depth colour).
     pub(crate) tint: Vec<[u8; 3], V>,
-    /// [`VISIBLE`], [`WAS_VISIBLE`], [`BLOCKED`].
+    /// [`VISIBLE`], [`WAS_VISIBLE`], [`BLOCKED`], [`BLENDING`], [`COLLAPSING`]: one byte per
+    /// vertex, so the per-frame pass reads the blend state only of vertices that blend.
     pub(crate) flags: Vec<u8, V>,
     pub(crate) morph: Vec<Morph, V>,
     pub(crate) slot_of: NodeMap<F>,
@@ -190,8 +195,9 @@ pub struct Cut<const V: usize, const F: usize, const Q: usize> {
     pub(crate) stack: Vec<u32, Q>,
     /// Split candidates: (error bits, node), largest error first.
     pub(crate) candidates: BinaryHeap<(u32, u32), Max, Q>,
-    /// Collapse candidates: (parent's error, parent); the error is negative when culled.
-    pub(crate) pairs: Vec<(f32, u32), Q>,
+    /// Collapse candidates: (parent's error, parent, first child's slot when found); the error
+    /// is negative when culled.
+    pub(crate) pairs: Vec<(f32, u32, u32), Q>,
     pub(crate) coloring: Coloring,
     pub(crate) threshold: f32,
     pub(crate) geomorph_frames: u16,
@@ -337,6 +343,9 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
                 }
             }
         }
+        for v in 0..self.node.len() as u32 {
+            self.link_family(h, v);
+        }
         // Adjacency by matching each directed edge with its reverse (the base mesh is small).
         let n = self.tri.len();
         for f in 0..n {
@@ -445,10 +454,13 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         let _ = self.normals.push(normal);
         let _ = self.colors.push(color);
         let _ = self.tint.push(tint);
-        let _ = self.flags.push(VISIBLE);
+        let _ = self.flags.push(VISIBLE | Self::blend_flags(&morph));
         let _ = self.morph.push(morph);
-        self.link_family(h, self.node.len() as u32 - 1);
         true
+    }
+
+    fn blend_flags(m: &Morph) -> u8 {
+        (if m.left > 0 { BLENDING } else { 0 }) | (if m.collapsing { COLLAPSING } else { 0 })
     }
 
     /// Makes slot `s` hold `node` (in place of the node it held).
@@ -460,23 +472,23 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         let _ = self.slot_of.insert(node, s as u32);
         self.node[s] = node;
         self.bounds[s] = bounds_of(&n);
-        self.flags[s] &= !BLOCKED;
-        self.link_family(h, s as u32);
         self.tint[s] = tint;
-        match start {
+        let m = match start {
             Some(m) => {
                 self.positions[s] = m.from_pos;
                 self.normals[s] = m.from_normal;
                 self.colors[s] = m.from_color;
-                self.morph[s] = m;
+                m
             }
             None => {
                 self.positions[s] = n.position;
                 self.normals[s] = n.normal;
                 self.colors[s] = tint;
-                self.morph[s] = Morph::default();
+                Morph::default()
             }
-        }
+        };
+        self.morph[s] = m;
+        self.flags[s] = (self.flags[s] & (VISIBLE | WAS_VISIBLE)) | Self::blend_flags(&m);
     }
 
     /// Active vertices.
@@ -687,12 +699,20 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
             collapsing: false,
         });
         let c1s = self.node.len() as u32;
+        let own = self.bounds[ps as usize];
+        let (family, parent_bounds) = (self.family[ps as usize], self.parent_bounds[ps as usize]);
         self.set_vertex(h, ps as usize, c0, start);
         if !self.push_vertex(h, c1, start) {
             // Only the node map can refuse here (the arena was checked): undo.
             self.set_vertex(h, ps as usize, node, None);
+            self.family[ps as usize] = family;
+            self.parent_bounds[ps as usize] = parent_bounds;
             return Err(Refused::Capacity);
         }
+        // The children's family is known: no need to read it from the file.
+        self.family[ps as usize] = [node, c1, c1s];
+        self.parent_bounds[ps as usize] = own;
+        self.family[c1s as usize] = [node, NIL, NIL];
         for &f in &moved {
             let t = &mut self.tri[f as usize];
             if let Some(k) = corner(*t, ps) {
@@ -815,6 +835,18 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         let [c0, c1] = s.children;
         let a = self.slot_of.get(c0).ok_or(Refused::NotActive)?;
         let b = self.slot_of.get(c1).ok_or(Refused::NotActive)?;
+        self.collapse_legal_at(h, node, &s, a, b)
+    }
+
+    /// [`Cut::collapse_legal`] with the children's slots `a` and `b` known.
+    pub(crate) fn collapse_legal_at(
+        &self,
+        h: &HierarchyView<'_>,
+        node: u32,
+        s: &crate::format::SplitView,
+        a: u32,
+        b: u32,
+    ) -> Result<[u32; 4], Refused> {
         let fl = self
             .find_in_fan(a, h.split_face(node, false))
             .ok_or(Refused::Illegal)?;
@@ -921,6 +953,7 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
             self.remove_triangle(lo);
         }
         self.set_vertex(h, a as usize, node, None);
+        self.link_family(h, a);
         self.slot_of.remove(self.node[b as usize]);
         let p = self
             .remove_vertex(h, b)

@@ -1,0 +1,339 @@
+//! The runtime cut, measured beside its peers in the same run.
+//!
+//! 1. **Adaptation** on the bunny over the peer orbit of `../shared/peers/README.md` (640x480,
+//!    60 degree vertical field of view, eye at `R / sin 30deg`, 20 degrees up, 200 frames per
+//!    revolution), tolerances 0.25/0.5/1/2/4 px, policy [`QRefine`] (frustum, back-face, screen
+//!    error: the test OpenMesh's VDPM and Hoppe's SrMesh use), no geomorphs, no budget. The first
+//!    frame (from the base mesh) is reported alone; the others give the median microseconds,
+//!    mean triangles and operations per frame. Ours runs before and after OpenMesh's VDPM
+//!    (`om_vdpm` from `../shared/peers/run.sh`, when built; `VDLOD_PEERS` names its directory,
+//!    default `$TMPDIR/vdlod-peers`), and the ratio compares our median of both runs with its
+//!    median, at equal tolerance and at the nearest triangle count.
+//! 2. **Adapted vs full detail** on the Loop-subdivided bunny (301,632 triangles): adapt plus
+//!    render at 640x480 against rendering every triangle, frame by frame over the merge-tree
+//!    paper's orbit, with its `shouldRefine` ([`MergeTree`]: everything in the frustum, to the
+//!    leaves) at frustum sizes 0.4, 0.2 and 0.1 (its Table 1 measured 5x, 10x and 12.5x).
+//! 3. **Image quality at equal triangles**: PSNR against the full-detail frame of the adapted
+//!    frame and of the bunny simplified uniformly by meshoptimizer (`meshopt` 0.7) to the same
+//!    triangle count, over 20 frames of the peer orbit.
+//! 4. **Memory**: the cut's bytes for the capacities used.
+//!
+//! Run: `../shared/peers/run.sh` once (builds the peers), then `cargo bench --bench lod`.
+
+use std::path::PathBuf;
+use std::process::Command;
+use std::time::Instant;
+
+use meshopt::{SimplifyOptions, VertexDataAdapter};
+use vdlod_core::adapt::Budget;
+use vdlod_core::cut::Cut;
+use vdlod_core::format::HierarchyView;
+use vdlod_core::policy::{MergeTree, QRefine};
+use vdlod_demo::camera::Orbit;
+use vdlod_demo::frame::Frame;
+use vdlod_demo::hierarchy::build_with_progress;
+use vdlod_demo::lod::{cut_mesh, policy_view, psnr, with_large_stack};
+use vdlod_demo::mesh::{load_obj_bytes, IndexedMesh, BUNNY_NAME, BUNNY_OBJ};
+use vdlod_demo::render::camera_params;
+use vdlod_raster::Shading;
+
+/// The cut of the adaptation benchmark: room for the bunny at 0.25 px with margin.
+type BunnyCut = Cut<16384, 32768, 4096>;
+/// The cut of the Loop-subdivided bunny, which refines fully inside the frustum.
+type BigCut = Cut<{ 1 << 18 }, { 1 << 19 }, { 1 << 15 }>;
+
+const TOLERANCES: [f32; 5] = [0.25, 0.5, 1.0, 2.0, 4.0];
+const FRAMES: u32 = 200;
+const W: usize = 640;
+const H: usize = 480;
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+fn mean(v: &[f64]) -> f64 {
+    v.iter().sum::<f64>() / v.len().max(1) as f64
+}
+
+/// One tolerance's figures.
+#[derive(Clone, Debug, Default)]
+struct Adapt {
+    first_us: f64,
+    first_tris: u32,
+    us: Vec<f64>,
+    tris: Vec<f64>,
+    ops: Vec<f64>,
+}
+
+fn adapt_orbit(
+    h: &HierarchyView<'_>,
+    mesh: &IndexedMesh,
+    tolerance: f32,
+    revolutions: u32,
+) -> Adapt {
+    let orbit = Orbit::peer(&mesh.bounds(), FRAMES);
+    let mut cut: Box<BunnyCut> = Box::default();
+    cut.reset(h).expect("base mesh fits");
+    let policy = QRefine::new(tolerance);
+    let mut out = Adapt::default();
+    for i in 0..FRAMES * revolutions {
+        let view = policy_view(&orbit.camera(i), W as f32 / H as f32, H, 1.0);
+        let start = Instant::now();
+        let s = cut.adapt(h, &view, &policy, &Budget::default());
+        let us = start.elapsed().as_secs_f64() * 1e6;
+        if i == 0 {
+            out.first_us = us;
+            out.first_tris = s.triangles;
+        } else if i % FRAMES != 0 {
+            out.us.push(us);
+            out.tris.push(s.triangles as f64);
+            out.ops.push((s.vsplits + s.ecols) as f64);
+        }
+    }
+    out
+}
+
+/// `key=value` pairs of each `vdpm_adapt` line of `om_vdpm`, by tolerance.
+fn run_vdpm() -> Vec<(f32, f64, f64, f64)> {
+    let dir = std::env::var_os("VDLOD_PEERS")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| std::env::temp_dir().join("vdlod-peers"));
+    let (bin, off) = (dir.join("bin/om_vdpm"), dir.join("bunny00.off"));
+    if !bin.exists() || !off.exists() {
+        println!(
+            "(OpenMesh VDPM not built in {}: run ../shared/peers/run.sh for the peer column)",
+            dir.display()
+        );
+        return Vec::new();
+    }
+    let mut cmd = Command::new(bin);
+    cmd.arg(&off)
+        .arg(dir.join("vdpm"))
+        .arg(FRAMES.to_string())
+        .arg("1");
+    cmd.args(TOLERANCES.map(|t| t.to_string()));
+    let Ok(out) = cmd.output() else {
+        return Vec::new();
+    };
+    String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .filter(|l| l.starts_with("vdpm_adapt"))
+        .filter_map(|l| {
+            let get = |k: &str| {
+                l.split_whitespace()
+                    .find_map(|kv| kv.strip_prefix(k)?.strip_prefix('='))
+                    .and_then(|v| v.parse::<f64>().ok())
+            };
+            let ops = get("vsplits_per_frame")? + get("ecols_per_frame")?;
+            Some((
+                get("tol_px")? as f32,
+                get("median_us")?,
+                get("tris_mean")?,
+                ops,
+            ))
+        })
+        .collect()
+}
+
+fn adaptation(h: &HierarchyView<'_>, mesh: &IndexedMesh) {
+    println!("\n## 1. Adaptation per frame, bunny, peer orbit (640x480, 60 deg, 200 frames)\n");
+    let before: Vec<Adapt> = TOLERANCES
+        .iter()
+        .map(|&t| adapt_orbit(h, mesh, t, 2))
+        .collect();
+    let peer = run_vdpm();
+    let after: Vec<Adapt> = TOLERANCES
+        .iter()
+        .map(|&t| adapt_orbit(h, mesh, t, 2))
+        .collect();
+    println!(
+        "| tol px | first frame | median us | mean tris | ns/active vertex | ops/frame | VDPM median us | VDPM tris | VDPM ops/frame | speed-up, same tol | VDPM at nearest tris | speed-up, nearest tris |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|");
+    for (k, &t) in TOLERANCES.iter().enumerate() {
+        let (a, b) = (&before[k], &after[k]);
+        let us = median(a.us.iter().chain(&b.us).copied().collect());
+        let tris = mean(&[a.tris.clone(), b.tris.clone()].concat());
+        let ops = mean(&[a.ops.clone(), b.ops.clone()].concat());
+        let per_vertex = us * 1e3 / (tris / 2.0);
+        let same = peer.iter().find(|p| (p.0 - t).abs() < 1e-3);
+        let nearest = peer
+            .iter()
+            .min_by(|x, y| (x.2 - tris).abs().total_cmp(&(y.2 - tris).abs()));
+        let cell = |p: Option<&(f32, f64, f64, f64)>,
+                    f: &dyn Fn(&(f32, f64, f64, f64)) -> String| {
+            p.map_or("-".to_string(), f)
+        };
+        println!(
+            "| {t} | {:.0} us, {} tris | {us:.1} | {tris:.0} | {per_vertex:.1} | {ops:.1} | {} | {} | {} | {} | {} | {} |",
+            a.first_us,
+            a.first_tris,
+            cell(same, &|p| format!("{:.0}", p.1)),
+            cell(same, &|p| format!("{:.0}", p.2)),
+            cell(same, &|p| format!("{:.1}", p.3)),
+            cell(same, &|p| format!("{:.1}x", p.1 / us)),
+            cell(nearest, &|p| format!("{:.0} us at {:.0} tris ({} px)", p.1, p.2, p.0)),
+            cell(nearest, &|p| format!("{:.1}x", p.1 / us)),
+        );
+    }
+    println!(
+        "\nOur runs before / after the peer (median us): {}",
+        TOLERANCES
+            .iter()
+            .enumerate()
+            .map(|(k, t)| format!(
+                "{t} px {:.1} / {:.1}",
+                median(before[k].us.clone()),
+                median(after[k].us.clone())
+            ))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+}
+
+fn full_vs_adapted(mesh: &IndexedMesh) {
+    println!("\n## 2. Adapted vs full detail, Loop-subdivided bunny, merge-tree orbit, 640x480\n");
+    let mut big = mesh.loop_subdivide();
+    let (_, bytes, secs) = build_with_progress(&big, &Default::default(), false).expect("builds");
+    big.reorder_for_locality();
+    println!(
+        "{} triangles; hierarchy built in {secs:.1} s\n",
+        big.triangles.len()
+    );
+    let h = HierarchyView::parse(&bytes).expect("valid");
+    println!("| frustum | mean tris | adapt + render ms (median) | full detail ms (median) | speed-up | merge-tree paper |");
+    println!("|---|---|---|---|---|---|");
+    for (frustum, paper) in [(0.4f32, "5x"), (0.2, "10x"), (0.1, "12.5x")] {
+        let orbit = Orbit::merge_tree(&big.bounds(), 100);
+        let mut cut: Box<BigCut> = Box::default();
+        cut.reset(&h).expect("fits");
+        let mut frame = Frame::new(W, H).expect("frame");
+        let (mut ours, mut full, mut tris) = (Vec::new(), Vec::new(), Vec::new());
+        let policy = MergeTree {
+            near: f32::INFINITY,
+        };
+        for i in 0..100 {
+            let camera = orbit.camera(i);
+            let view = policy_view(&camera, frame.aspect(), H, frustum);
+            let params = camera_params(&camera, frame.aspect(), Shading::Gouraud, false);
+            let start = Instant::now();
+            let s = cut.adapt(&h, &view, &policy, &Budget::default());
+            frame.draw(&cut_mesh(&cut, false), &params).expect("draws");
+            let t_ours = start.elapsed().as_secs_f64() * 1e3;
+            let start = Instant::now();
+            frame.draw(&big.as_raster_mesh(), &params).expect("draws");
+            let t_full = start.elapsed().as_secs_f64() * 1e3;
+            if i > 0 {
+                ours.push(t_ours);
+                full.push(t_full);
+                tris.push(s.triangles as f64);
+            }
+        }
+        let (o, f) = (median(ours), median(full));
+        println!(
+            "| {frustum} | {:.0} | {o:.2} | {f:.2} | {:.1}x | {paper} |",
+            mean(&tris),
+            f / o
+        );
+    }
+}
+
+fn quality(h: &HierarchyView<'_>, mesh: &IndexedMesh) {
+    println!("\n## 3. PSNR against full detail at equal triangles, peer orbit, 20 frames\n");
+    let indices: Vec<u32> = mesh.triangles.iter().flatten().copied().collect();
+    let adapter =
+        VertexDataAdapter::new(meshopt::typed_to_bytes(&mesh.positions), 12, 0).expect("positions");
+    println!("| tol px | mean tris | adapted PSNR dB | meshopt PSNR dB | difference dB |");
+    println!("|---|---|---|---|---|");
+    for tolerance in [0.5f32, 1.0, 2.0, 4.0] {
+        let orbit = Orbit::peer(&mesh.bounds(), FRAMES);
+        let mut cut: Box<BunnyCut> = Box::default();
+        cut.reset(h).expect("fits");
+        let policy = QRefine::new(tolerance);
+        let mut frame = Frame::new(W, H).expect("frame");
+        let mut reference = Frame::new(W, H).expect("frame");
+        let (mut ours, mut theirs, mut tris) = (Vec::new(), Vec::new(), Vec::new());
+        for i in 0..FRAMES {
+            let camera = orbit.camera(i);
+            let view = policy_view(&camera, frame.aspect(), H, 1.0);
+            let s = cut.adapt(h, &view, &policy, &Budget::default());
+            if i % 10 != 5 {
+                continue;
+            }
+            let params = camera_params(&camera, frame.aspect(), Shading::Gouraud, false);
+            reference
+                .draw(&mesh.as_raster_mesh(), &params)
+                .expect("draws");
+            frame.draw(&cut_mesh(&cut, false), &params).expect("draws");
+            ours.push(psnr(frame.pixels(), reference.pixels()));
+            let simplified = meshopt::simplify(
+                &indices,
+                &adapter,
+                s.triangles as usize * 3,
+                1.0,
+                SimplifyOptions::None,
+                None,
+            );
+            let triangles: Vec<[u32; 3]> = simplified
+                .chunks_exact(3)
+                .map(|t| [t[0], t[1], t[2]])
+                .collect();
+            let uniform = IndexedMesh {
+                triangles,
+                ..mesh.clone()
+            };
+            frame
+                .draw(&uniform.as_raster_mesh(), &params)
+                .expect("draws");
+            theirs.push(psnr(frame.pixels(), reference.pixels()));
+            tris.push(s.triangles as f64);
+        }
+        let (o, t) = (mean(&ours), mean(&theirs));
+        println!(
+            "| {tolerance} | {:.0} | {o:.2} | {t:.2} | {:+.2} |",
+            mean(&tris),
+            o - t
+        );
+    }
+    // The ceiling: every split done, drawn with the file's 8-bit octahedral normals.
+    let mut cut: Box<BunnyCut> = Box::default();
+    cut.reset(h).expect("fits");
+    while cut.refine_everything(h) > 0 {}
+    let orbit = Orbit::peer(&mesh.bounds(), FRAMES);
+    let camera = orbit.camera(5);
+    let mut frame = Frame::new(W, H).expect("frame");
+    let mut reference = Frame::new(W, H).expect("frame");
+    let params = camera_params(&camera, frame.aspect(), Shading::Gouraud, false);
+    reference
+        .draw(&mesh.as_raster_mesh(), &params)
+        .expect("draws");
+    frame.draw(&cut_mesh(&cut, false), &params).expect("draws");
+    println!(
+        "\nCeiling: the fully refined cut ({} tris, normals as the file stores them) scores {:.2} dB.",
+        cut.triangles().len(),
+        psnr(frame.pixels(), reference.pixels())
+    );
+}
+
+fn main() {
+    // `cargo test --benches` runs bench binaries without `--bench`: keep that quick.
+    if !std::env::args().any(|a| a == "--bench") {
+        return;
+    }
+    with_large_stack(|| {
+        let mesh = load_obj_bytes(BUNNY_NAME, BUNNY_OBJ).expect("bundled bunny");
+        let (_, bytes, _) = build_with_progress(&mesh, &Default::default(), false).expect("builds");
+        let h = HierarchyView::parse(&bytes).expect("valid");
+        println!(
+            "## 4. Memory\n\nBunny cut `Cut<16384, 32768, 4096>`: {} bytes ({:.1} MB); Loop-bunny cut `Cut<262144, 524288, 32768>`: {} bytes ({:.1} MB).",
+            BunnyCut::BYTES,
+            BunnyCut::BYTES as f64 / 1e6,
+            BigCut::BYTES,
+            BigCut::BYTES as f64 / 1e6
+        );
+        adaptation(&h, &mesh);
+        quality(&h, &mesh);
+        full_vs_adapted(&mesh);
+    });
+}
