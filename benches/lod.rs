@@ -94,8 +94,11 @@ fn adapt_orbit(
     out
 }
 
-/// `key=value` pairs of each `vdpm_adapt` line of `om_vdpm`, by tolerance.
-fn run_vdpm() -> Vec<(f32, f64, f64, f64)> {
+/// One tolerance of OpenMesh's VDPM: tolerance, median us, mean triangles, operations per frame.
+type Peer = (f32, f64, f64, f64);
+
+/// The `vdpm_adapt` lines of `om_vdpm`, by tolerance.
+fn run_vdpm() -> Vec<Peer> {
     let dir = std::env::var_os("VDLOD_PEERS")
         .map(PathBuf::from)
         .unwrap_or_else(|| std::env::temp_dir().join("vdlod-peers"));
