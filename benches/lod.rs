@@ -164,10 +164,7 @@ fn adaptation(h: &HierarchyView<'_>, mesh: &IndexedMesh) {
         let nearest = peer
             .iter()
             .min_by(|x, y| (x.2 - tris).abs().total_cmp(&(y.2 - tris).abs()));
-        let cell = |p: Option<&(f32, f64, f64, f64)>,
-                    f: &dyn Fn(&(f32, f64, f64, f64)) -> String| {
-            p.map_or("-".to_string(), f)
-        };
+        let cell = |p: Option<&Peer>, f: &dyn Fn(&Peer) -> String| p.map_or("-".to_string(), f);
         println!(
             "| {t} | {:.0} us, {} tris | {us:.1} | {tris:.0} | {per_vertex:.1} | {ops:.1} | {} | {} | {} | {} | {} | {} |",
             a.first_us,
