@@ -407,6 +407,8 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         }
 
         self.enforce_max(h, view, policy, budget, &mut stats);
+        // A cut that shrank gets a smaller node map (faster lookups).
+        self.respan_map(self.node.len());
 
         // Regulation towards the target triangle count.
         let tris = self.tri.len() as u32;

@@ -6,6 +6,10 @@
 //! active mesh, like the rest of the cut. Open addressing with linear probing and backward-shift
 //! deletion: no tombstones, so lookups stay short however long the cut runs, and nothing depends on
 //! iteration order (the map is never iterated).
+//!
+//! Only the first `span` entries of the table are in use, two to sixteen times the entries,
+//! so that a small cut's map stays small and in cache however large its capacity; the cut rebuilds the map (from its node array: no scratch memory) when the
+//! span must grow or may shrink.
 
 /// The empty-slot key (never a node id: the format reserves `u32::MAX`).
 const EMPTY: u32 = u32::MAX;
@@ -16,7 +20,11 @@ pub(crate) struct NodeMap<const M: usize> {
     keys: [u32; M],
     values: [u32; M],
     len: usize,
+    span: usize,
 }
+
+/// The smallest span used.
+const MIN_SPAN: usize = 256;
 
 impl<const M: usize> NodeMap<M> {
     pub const fn new() -> Self {
@@ -24,23 +32,46 @@ impl<const M: usize> NodeMap<M> {
             keys: [EMPTY; M],
             values: [0; M],
             len: 0,
+            span: if M < MIN_SPAN { M } else { MIN_SPAN },
         }
     }
 
     #[inline]
-    fn home(key: u32) -> usize {
-        // Fibonacci hashing, then a multiply-shift into 0..M (M need not be a power of two).
+    fn home(&self, key: u32) -> usize {
+        // Fibonacci hashing, then a multiply-shift into 0..span (no power of two needed).
         let h = key.wrapping_mul(0x9E37_79B9);
-        ((h as u64 * M as u64) >> 32) as usize
+        ((h as u64 * self.span as u64) >> 32) as usize
     }
 
     #[inline]
-    fn next(i: usize) -> usize {
-        if i + 1 == M {
+    fn next(&self, i: usize) -> usize {
+        if i + 1 == self.span {
             0
         } else {
             i + 1
         }
+    }
+
+    /// The span this many entries should use: four times as many (a quarter full, so that
+    /// many entries come and go before the next rebuild), at least [`MIN_SPAN`], at most `M`.
+    pub fn span_for(entries: usize) -> usize {
+        entries.saturating_mul(4).max(MIN_SPAN).min(M)
+    }
+
+    /// Whether `entries` entries call for another span: more than half of it, or (when it is
+    /// above the minimum) less than a sixteenth.
+    pub fn should_resize(&self, entries: usize) -> bool {
+        (entries * 2 > self.span && self.span < M)
+            || (entries * 16 < self.span && self.span > MIN_SPAN.min(M))
+    }
+
+    /// Empties the map and makes it use `span` entries (clamped to `1..=M`).
+    pub fn reset(&mut self, span: usize) {
+        let old = self.span;
+        self.span = span.clamp(1, M);
+        let used = old.max(self.span);
+        self.keys[..used].iter_mut().for_each(|k| *k = EMPTY);
+        self.len = 0;
     }
 
     /// Number of entries.
@@ -50,20 +81,19 @@ impl<const M: usize> NodeMap<M> {
 
     /// Removes every entry.
     pub fn clear(&mut self) {
-        self.keys.iter_mut().for_each(|k| *k = EMPTY);
-        self.len = 0;
+        self.reset(Self::span_for(0));
     }
 
     /// Index of `key`'s entry, or of the empty slot where it would go.
     #[inline]
     fn find(&self, key: u32) -> Option<usize> {
-        let mut i = Self::home(key);
-        for _ in 0..M {
+        let mut i = self.home(key);
+        for _ in 0..self.span {
             let k = *self.keys.get(i)?;
             if k == key || k == EMPTY {
                 return Some(i);
             }
-            i = Self::next(i);
+            i = self.next(i);
         }
         None
     }
@@ -74,7 +104,7 @@ impl<const M: usize> NodeMap<M> {
         (self.keys[i] == key && key != EMPTY).then(|| self.values[i])
     }
 
-    /// Inserts or overwrites; `false` when the map is too full (kept below 7/8) or `key` is the
+    /// Inserts or overwrites; `false` when the span is too full (kept below 7/8) or `key` is the
     /// reserved value.
     pub fn insert(&mut self, key: u32, value: u32) -> bool {
         if key == EMPTY {
@@ -84,7 +114,7 @@ impl<const M: usize> NodeMap<M> {
             return false;
         };
         if self.keys[i] == EMPTY {
-            if (self.len + 1) * 8 > M * 7 {
+            if (self.len + 1) * 8 > self.span * 7 {
                 return false;
             }
             self.len += 1;
@@ -105,13 +135,13 @@ impl<const M: usize> NodeMap<M> {
         self.len -= 1;
         // Shift back every entry of the probe run that would not be found past the hole.
         let mut j = hole;
-        for _ in 0..M {
-            j = Self::next(j);
+        for _ in 0..self.span {
+            j = self.next(j);
             let k = self.keys[j];
             if k == EMPTY {
                 return;
             }
-            let h = Self::home(k);
+            let h = self.home(k);
             // Entry j may move to the hole unless its home lies cyclically in (hole, j].
             let stays = if hole <= j {
                 hole < h && h <= j
@@ -162,5 +192,21 @@ mod tests {
         let stored = (0..8).filter(|&k| m.insert(k, k)).count();
         assert_eq!(stored, 7);
         assert!(!m.insert(u32::MAX, 0));
+    }
+
+    #[test]
+    fn spans_grow_and_shrink_with_the_entries() {
+        let mut m = NodeMap::<4096>::new();
+        assert!(!m.should_resize(100));
+        assert!(m.should_resize(200));
+        m.reset(NodeMap::<4096>::span_for(200));
+        for k in 0..200 {
+            assert!(m.insert(k * 7, k));
+        }
+        assert!((0..200).all(|k| m.get(k * 7) == Some(k)));
+        // A rebuild leaves room both ways.
+        assert!(!m.should_resize(201) && !m.should_resize(150) && !m.should_resize(60));
+        assert!(m.should_resize(10) && m.should_resize(401));
+        assert_eq!(NodeMap::<4096>::span_for(1 << 20), 4096);
     }
 }

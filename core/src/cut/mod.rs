@@ -434,9 +434,26 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         (sibling != NIL && self.node.get(slot as usize) == Some(&sibling)).then_some(p)
     }
 
+    /// Inserts into the node map, first re-spanning it when the count calls for it.
+    fn map_insert(&mut self, node: u32, slot: u32) -> bool {
+        self.respan_map(self.node.len() + 1);
+        self.slot_of.insert(node, slot)
+    }
+
+    /// Rebuilds the node map over a span fit for `entries` active vertices, if it needs another.
+    pub(crate) fn respan_map(&mut self, entries: usize) {
+        if !self.slot_of.should_resize(entries) {
+            return;
+        }
+        self.slot_of.reset(NodeMap::<F>::span_for(entries));
+        for (s, &n) in self.node.iter().enumerate() {
+            let _ = self.slot_of.insert(n, s as u32);
+        }
+    }
+
     /// Appends a vertex for `node`; `false` when full. `start` = the blend it starts with.
     fn push_vertex(&mut self, h: &HierarchyView<'_>, node: u32, start: Option<Morph>) -> bool {
-        if self.node.is_full() || !self.slot_of.insert(node, self.node.len() as u32) {
+        if self.node.is_full() || !self.map_insert(node, self.node.len() as u32) {
             return false;
         }
         let n = h.node(node);
