@@ -332,7 +332,10 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
             let before = self.node.len();
             let mut tris = self.tri.len() as u32;
             let mut spent = ops;
-            let result = self.force_split(h, v, blend, &mut |added| {
+            // The nodes split (forced ones first): their children are evaluated next.
+            let mut split = [0u32; 64];
+            let mut logged = 0usize;
+            let result = self.force_split(h, v, blend, &mut |node, added| {
                 if tris.saturating_add(added) > budget.max_triangles {
                     Err(Refused::Budget)
                 } else if spent >= budget.max_ops {
@@ -340,6 +343,10 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
                 } else {
                     tris += added;
                     spent += 1;
+                    if let Some(slot) = split.get_mut(logged) {
+                        *slot = node;
+                        logged += 1;
+                    }
                     Ok(())
                 }
             });
@@ -347,24 +354,27 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
             stats.vsplits += done;
             stats.forced += done.saturating_sub(result.is_ok() as u32);
             ops += done;
-            match result {
-                Ok(_) => {
-                    let [c0, c1] = h.split(v).children;
-                    for c in [c0, c1] {
-                        let Some(cs) = self.slot_of.get(c) else {
-                            continue;
-                        };
-                        let d = policy.demand(&self.bounds[cs as usize], view);
-                        self.flags[cs as usize] =
-                            (self.flags[cs as usize] & !VISIBLE) | d.visible as u8;
-                        if d.error > t
-                            && c >= h.leaves()
-                            && self.candidates.push((d.error.to_bits(), c)).is_err()
-                        {
-                            stats.queue_overflow = true;
-                        }
+            for &node in &split[..logged] {
+                if self.slot_of.get(node).is_some() {
+                    continue; // refused after all
+                }
+                for c in h.split(node).children {
+                    let Some(cs) = self.slot_of.get(c) else {
+                        continue;
+                    };
+                    let d = policy.demand(&self.bounds[cs as usize], view);
+                    self.flags[cs as usize] =
+                        (self.flags[cs as usize] & !VISIBLE) | d.visible as u8;
+                    if d.error > t
+                        && c >= h.leaves()
+                        && self.candidates.push((d.error.to_bits(), c)).is_err()
+                    {
+                        stats.queue_overflow = true;
                     }
                 }
+            }
+            match result {
+                Ok(_) => {}
                 Err(Refused::Budget) => {
                     // Make room from the pairs whose parent matters least, if less than this.
                     if !sorted {

@@ -765,14 +765,14 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
 
     /// Splits active `node`, first splitting whatever its split needs (Hoppe's forced split; the
     /// merge-tree paper's forced refinement, §3.6), each with a blend of `frames` frames.
-    /// `allow` is asked before each split with the number of triangles it adds, and answers why
-    /// not or `Ok` to go on. Returns the splits done; on a refusal the splits done so far stay.
+    /// `allow` is asked before each split with the node and the number of triangles it adds, and
+    /// answers why not or `Ok` to go on. Returns the splits done; on a refusal the splits done so far stay.
     pub fn force_split(
         &mut self,
         h: &HierarchyView<'_>,
         node: u32,
         frames: u16,
-        allow: &mut dyn FnMut(u32) -> Result<(), Refused>,
+        allow: &mut dyn FnMut(u32, u32) -> Result<(), Refused>,
     ) -> Result<u32, Refused> {
         if !self.is_active(node) {
             return Err(Refused::NotActive);
@@ -808,7 +808,7 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
                 continue;
             }
             let added = if h.split(v).wings[1] != NONE { 2 } else { 1 };
-            allow(added)?;
+            allow(v, added)?;
             match self.split_with(h, v, frames) {
                 Ok(_) => {
                     done += 1;
@@ -1079,7 +1079,7 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         while i < n.min(self.node.len()) {
             let v = self.node[i];
             if v >= h.leaves() {
-                if let Ok(k) = self.force_split(h, v, 0, &mut |_| Ok(())) {
+                if let Ok(k) = self.force_split(h, v, 0, &mut |_, _| Ok(())) {
                     done += k;
                 }
             }
