@@ -18,7 +18,8 @@
 //!    triangle count, over 20 frames of the peer orbit.
 //! 4. **Memory**: the cut's bytes for the capacities used.
 //!
-//! Run: `../shared/peers/run.sh` once (builds the peers), then `cargo bench --bench lod`.
+//! Run: `../shared/peers/run.sh` once (builds the peers), then `cargo bench --bench lod`
+//! (`-- adaptation`, `-- quality` or `-- full` for one section).
 
 use std::path::PathBuf;
 use std::process::Command;
@@ -28,7 +29,7 @@ use meshopt::{SimplifyOptions, VertexDataAdapter};
 use vdlod_core::adapt::Budget;
 use vdlod_core::cut::Cut;
 use vdlod_core::format::HierarchyView;
-use vdlod_core::policy::{MergeTree, QRefine};
+use vdlod_core::policy::{MergeTree, QRefine, ScreenError};
 use vdlod_demo::camera::Orbit;
 use vdlod_demo::frame::Frame;
 use vdlod_demo::hierarchy::build_with_progress;
@@ -244,13 +245,26 @@ fn quality(h: &HierarchyView<'_>, mesh: &IndexedMesh) {
     let indices: Vec<u32> = mesh.triangles.iter().flatten().copied().collect();
     let adapter =
         VertexDataAdapter::new(meshopt::typed_to_bytes(&mesh.positions), 12, 0).expect("positions");
-    println!("| tol px | mean tris | adapted PSNR dB | meshopt PSNR dB | difference dB |");
+    println!("| tolerance px (silhouette / interior) | mean tris | adapted PSNR dB | meshopt PSNR dB | difference dB |");
     println!("|---|---|---|---|---|");
-    for tolerance in [0.5f32, 1.0, 2.0, 4.0] {
+    for (silhouette, interior) in [
+        (0.5f32, 0.5f32),
+        (1.0, 1.0),
+        (2.0, 2.0),
+        (4.0, 4.0),
+        (0.5, 1.5),
+        (1.0, 3.0),
+        (2.0, 6.0),
+    ] {
         let orbit = Orbit::peer(&mesh.bounds(), FRAMES);
         let mut cut: Box<BunnyCut> = Box::default();
         cut.reset(h).expect("fits");
-        let policy = QRefine::new(tolerance);
+        let policy = QRefine {
+            error: ScreenError {
+                silhouette,
+                interior,
+            },
+        };
         let mut frame = Frame::new(W, H).expect("frame");
         let mut reference = Frame::new(W, H).expect("frame");
         let (mut ours, mut theirs, mut tris) = (Vec::new(), Vec::new(), Vec::new());
@@ -291,13 +305,13 @@ fn quality(h: &HierarchyView<'_>, mesh: &IndexedMesh) {
         }
         let (o, t) = (mean(&ours), mean(&theirs));
         println!(
-            "| {tolerance} | {:.0} | {o:.2} | {t:.2} | {:+.2} |",
+            "| {silhouette} / {interior} | {:.0} | {o:.2} | {t:.2} | {:+.2} |",
             mean(&tris),
             o - t
         );
     }
     // The ceiling: every split done, drawn with the file's 8-bit octahedral normals.
-    let mut cut: Box<BunnyCut> = Box::default();
+    let mut cut: Box<BigCut> = Box::default();
     cut.reset(h).expect("fits");
     while cut.refine_everything(h) > 0 {}
     let orbit = Orbit::peer(&mesh.bounds(), FRAMES);
@@ -332,8 +346,20 @@ fn main() {
             BigCut::BYTES,
             BigCut::BYTES as f64 / 1e6
         );
-        adaptation(&h, &mesh);
-        quality(&h, &mesh);
-        full_vs_adapted(&mesh);
+        // `cargo bench --bench lod -- quality` runs the sections whose name contains `quality`.
+        let filter: Vec<String> = std::env::args()
+            .skip(1)
+            .filter(|a| !a.starts_with("--"))
+            .collect();
+        let wanted = |name: &str| filter.is_empty() || filter.iter().any(|f| name.contains(f));
+        if wanted("adaptation") {
+            adaptation(&h, &mesh);
+        }
+        if wanted("quality") {
+            quality(&h, &mesh);
+        }
+        if wanted("full") {
+            full_vs_adapted(&mesh);
+        }
     });
 }

@@ -1,9 +1,10 @@
 //! View-dependent level of detail for memory-scarce renderers.
 //!
-//! This crate holds the parts of vdlod that run on the device, `no_std` and allocation-free (the
-//! read side of the hierarchy format, the runtime cut, the refinement policies, the triangle budget
-//! and geomorphs: still to come), and, behind the `build` feature, the offline [`build`]er that
-//! turns a triangle mesh into a vertex hierarchy (it needs `alloc`).
+//! This crate holds the parts of vdlod that run on the device, `no_std` and allocation-free: the
+//! read side of the hierarchy [`format`], the runtime [`cut`] in fixed-capacity arenas, the
+//! refinement [`policy`]s, and [`adapt`], which moves the cut each frame under a triangle budget
+//! with geomorphs. Behind the `build` feature sits the offline `build`er that turns a triangle
+//! mesh into a vertex hierarchy (it needs `alloc`).
 #![no_std]
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]

@@ -85,6 +85,9 @@ pub struct OrbitOptions {
     pub write_frames: bool,
     /// Fly the peer orbit (20 degrees up) instead of the merge-tree paper's (level).
     pub peer_orbit: bool,
+    /// Draw the written frames from an observer a quarter turn ahead and a quarter farther (the cut
+    /// still adapts to the orbit camera), to show where the detail went.
+    pub observer: bool,
 }
 
 impl Default for OrbitOptions {
@@ -105,6 +108,7 @@ impl Default for OrbitOptions {
             dump_mesh: false,
             write_frames: true,
             peer_orbit: false,
+            observer: false,
         }
     }
 }
@@ -124,6 +128,18 @@ pub struct OrbitFrame {
     pub full_render_us: f64,
     /// PSNR of the adapted frame against the full-detail frame, in dB (infinite when equal).
     pub psnr_db: f64,
+}
+
+/// A camera a quarter turn ahead of frame `i`'s and a quarter farther from the centre.
+pub fn observer(orbit: &Orbit, i: u32) -> Camera {
+    let ahead = orbit.camera(i + orbit.frames / 4);
+    let eye = orbit.center + (ahead.eye - orbit.center) * 1.25;
+    Camera {
+        eye,
+        near: (orbit.distance * 1.25 - 1.5 * orbit.radius).max(orbit.radius * 0.01),
+        far: orbit.distance * 1.25 + 1.5 * orbit.radius,
+        ..ahead
+    }
 }
 
 /// The full-detail mesh of a hierarchy: every split done, in leaf numbering.
@@ -385,7 +401,11 @@ pub fn run_orbit(
     });
     cut.reset(&h).map_err(|e| e.to_string())?;
     cut.set_geomorph_frames(opts.geomorph_frames);
+    // The comparison with full detail uses the mesh's own colours; false colours, the wireframe
+    // and the observer's view are drawn after it, for the pictures only.
+    let true_colors = h.has_colors() && !opts.depth_colors;
     let colors = opts.depth_colors || h.has_colors();
+    let picture = opts.depth_colors || opts.wireframe || opts.observer;
     let bounds = full.bounds();
     let orbit = if opts.peer_orbit {
         Orbit::peer(&bounds, opts.frames)
@@ -407,11 +427,10 @@ pub fn run_orbit(
         let start = Instant::now();
         let stats = cut.adapt(&h, &view, &&*policy, &opts.budget);
         let adapt_us = start.elapsed().as_secs_f64() * 1e6;
-        // Measured and compared without the wireframe (it is drawn after, for the pictures).
         let params = camera_params(&camera, frame.aspect(), Shading::Gouraud, false);
         let start = Instant::now();
         frame
-            .draw(&cut_mesh(&cut, colors), &params)
+            .draw(&cut_mesh(&cut, true_colors), &params)
             .map_err(|e| e.to_string())?;
         let render_us = start.elapsed().as_secs_f64() * 1e6;
         let start = Instant::now();
@@ -427,20 +446,6 @@ pub fn run_orbit(
             full_render_us,
             psnr_db: psnr(frame.pixels(), reference.pixels()),
         };
-        if opts.wireframe {
-            let wired = camera_params(&camera, frame.aspect(), Shading::Gouraud, true);
-            frame
-                .draw(&cut_mesh(&cut, colors), &wired)
-                .map_err(|e| e.to_string())?;
-        }
-        if opts.write_frames {
-            frame
-                .save_png(&out_dir.join(format!("frame_{i:04}.png")))
-                .map_err(|e| e.to_string())?;
-        }
-        if opts.dump_mesh {
-            write_obj(&out_dir.join(format!("mesh_{i:04}.obj")), &cut).map_err(io)?;
-        }
         if i == compared {
             let side = side_by_side(opts.width, opts.height, frame.pixels(), reference.pixels());
             save_png(
@@ -450,6 +455,25 @@ pub fn run_orbit(
                 &side,
             )
             .map_err(|e| e.to_string())?;
+        }
+        if picture {
+            let seen_from = if opts.observer {
+                observer(&orbit, i)
+            } else {
+                camera
+            };
+            let drawn = camera_params(&seen_from, frame.aspect(), Shading::Gouraud, opts.wireframe);
+            frame
+                .draw(&cut_mesh(&cut, colors), &drawn)
+                .map_err(|e| e.to_string())?;
+        }
+        if opts.write_frames {
+            frame
+                .save_png(&out_dir.join(format!("frame_{i:04}.png")))
+                .map_err(|e| e.to_string())?;
+        }
+        if opts.dump_mesh {
+            write_obj(&out_dir.join(format!("mesh_{i:04}.obj")), &cut).map_err(io)?;
         }
         let _ = writeln!(
             csv,

@@ -137,6 +137,10 @@ struct OrbitArgs {
     /// Fly the peer orbit (20 degrees up) of ../shared/peers instead of the level one.
     #[arg(long)]
     peer_orbit: bool,
+    /// Draw the frames from an observer a quarter turn ahead and a quarter farther away, to see where
+    /// the cut put its detail (the statistics still compare the orbit camera's view).
+    #[arg(long)]
+    observer: bool,
 }
 
 impl Default for OrbitArgs {
@@ -160,6 +164,7 @@ impl Default for OrbitArgs {
             wireframe: false,
             dump_mesh: false,
             peer_orbit: false,
+            observer: false,
         }
     }
 }
@@ -313,6 +318,7 @@ fn orbit_command(args: OrbitArgs) -> Result<(), String> {
         dump_mesh: args.dump_mesh,
         write_frames: true,
         peer_orbit: args.peer_orbit,
+        observer: args.observer,
     };
     println!(
         "{name}: {} vertices, {} triangles at full detail; {} frames at {}x{} into {}",

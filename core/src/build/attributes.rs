@@ -180,11 +180,13 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, e: Engine<'_>) -> Hierarchy {
         }
         // The error of replacing the region by the node: each leaf's offset from the coarse
         // surface, which near the node is its tangent plane, so the offset lies along the normal
-        // (Hoppe's normal deviation). A region's extent across the normal is not an error: a flat
-        // region simplifies to nothing visible however wide it is. The spheroid of equation 3 is
-        // then `a` = the largest offset, `b` = 0 (a conservative bound where the coarse fan
-        // bends away from the tangent plane).
-        let (a, b) = (along, 0.0);
+        // (Hoppe's normal deviation `delta`). A region's extent across the normal is not an
+        // error: a flat region simplifies to nothing visible however wide it is. The spheroid of
+        // equation 3 gets `a` = the largest offset and, across, the same radius `b = a` (Hoppe's
+        // uniform term `mu` = `delta`): with `b = 0` face-on regions cost nothing and lose their
+        // shading, which measured 0.6 to 1.3 dB worse PSNR at equal triangle counts
+        // (`cargo bench --bench lod -- quality`).
+        let (a, b) = (along, along);
         let [c0, c1] = c.children.map(|x| &nodes[x as usize]);
         let mono = |own: f64, f: fn(&Node) -> f32| own.max(f(c0) as f64).max(f(c1) as f64);
         let mu = mono(across, |n| n.mu);
