@@ -6,6 +6,7 @@
 pub mod camera;
 pub mod frame;
 pub mod hierarchy;
+pub mod label;
 pub mod lod;
 pub mod mesh;
 pub mod render;
