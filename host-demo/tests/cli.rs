@@ -222,3 +222,73 @@ fn build_rejects_non_manifold_meshes_in_one_line() {
         "repeats triangle 0",
     );
 }
+
+#[test]
+fn orbit_writes_frames_statistics_plot_comparison_and_meshes() {
+    let dir = scratch_dir("cli_orbit");
+    let cow = fixture("cow.obj");
+    let out = demo(&["build", cow.to_str().unwrap(), "-o", "cow.vdh"], &dir);
+    assert!(out.status.success());
+    for input in [cow.to_str().unwrap(), "cow.vdh"] {
+        let out = demo(
+            &[
+                "orbit",
+                input,
+                "--out",
+                "o",
+                "--frames",
+                "4",
+                "--width",
+                "64",
+                "--height",
+                "48",
+                "--budget",
+                "1500",
+                "--dump-mesh",
+            ],
+            &dir,
+        );
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let csv = std::fs::read_to_string(dir.join("o/stats.csv")).unwrap();
+        let mut lines = csv.lines();
+        assert!(lines
+            .next()
+            .unwrap()
+            .starts_with("frame,triangles,vsplits,ecols,adapt_us,render_us"));
+        let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+        assert_eq!(rows.len(), 4);
+        for (i, row) in rows.iter().enumerate() {
+            let triangles: usize = row[1].parse().unwrap();
+            assert!(triangles > 0 && triangles <= 1500, "{row:?}");
+            // The dumped mesh has exactly the frame's triangles, over its own vertices.
+            let obj = std::fs::read_to_string(dir.join(format!("o/mesh_{i:04}.obj"))).unwrap();
+            let faces = obj.lines().filter(|l| l.starts_with("f ")).count();
+            let vertices = obj.lines().filter(|l| l.starts_with("v ")).count();
+            assert_eq!(faces, triangles);
+            assert!(obj
+                .lines()
+                .filter(|l| l.starts_with("f "))
+                .flat_map(|l| l.split_whitespace().skip(1))
+                .all(|k| (1..=vertices).contains(&k.parse::<usize>().unwrap())));
+            assert!(dir.join(format!("o/frame_{i:04}.png")).exists());
+        }
+        let (w, h, _) = vdlod_demo::frame::load_png(&dir.join("o/side_by_side.png")).unwrap();
+        assert_eq!((w, h), (192, 48));
+        assert!(dir.join("o/plot.png").exists());
+    }
+}
+
+#[test]
+fn orbit_rejects_a_corrupted_hierarchy_in_one_line() {
+    let dir = scratch_dir("cli_orbit_bad");
+    std::fs::write(dir.join("bad.vdh"), b"VDLH not really").unwrap();
+    let out = demo(&["orbit", "bad.vdh", "--frames", "1"], &dir);
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(stderr.contains("bad.vdh: truncated"), "{stderr}");
+}
