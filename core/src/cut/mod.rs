@@ -17,7 +17,7 @@
 //! panics on any hierarchy [`HierarchyView::parse`] accepted: an operation that would overflow a
 //! capacity is refused and counted instead.
 //!
-//! Memory: [`Cut::BYTES`] = 163 bytes per vertex slot (node, a triangle of its fan, cached
+//! Memory: [`Cut::BYTES`] = 165 bytes per vertex slot (node, a triangle of its fan and their number, cached
 //! bounds, parent, sibling and the parent's bounds, position, normal, colours, flags, blend state), 36 per triangle slot (corners,
 //! neighbours, id, and a node-map entry) and 24 per queue entry, plus a few words; asserted in
 //! the tests. A closed mesh has about two triangles per vertex, so `F = 2 V` and
@@ -168,6 +168,10 @@ pub struct Cut<const V: usize, const F: usize, const Q: usize> {
     pub(crate) node: Vec<u32, V>,
     /// One triangle around the vertex (`NIL` for none).
     pub(crate) fan: Vec<u32, V>,
+    /// Triangles using the vertex, kept by every operation: a fan walk that finds this many
+    /// distinct triangles found them all, which is what makes renaming a vertex complete (and
+    /// the cut safe from hierarchies crafted to contradict the mesh).
+    pub(crate) degree: Vec<u16, V>,
     pub(crate) bounds: Vec<Bounds, V>,
     /// The parent, and when this is the parent's first child its sibling and the sibling's
     /// slot when active (else `NIL`s), so that each pair is looked at once per frame without
@@ -277,6 +281,7 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         Cut {
             node: Vec::new(),
             fan: Vec::new(),
+            degree: Vec::new(),
             bounds: Vec::new(),
             family: Vec::new(),
             parent_bounds: Vec::new(),
@@ -341,6 +346,7 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
                 if self.fan[s as usize] == NIL {
                     self.fan[s as usize] = f;
                 }
+                self.degree[s as usize] = self.degree[s as usize].saturating_add(1);
             }
         }
         for v in 0..self.node.len() as u32 {
@@ -379,6 +385,7 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
     fn clear(&mut self) {
         self.node.clear();
         self.fan.clear();
+        self.degree.clear();
         self.bounds.clear();
         self.family.clear();
         self.parent_bounds.clear();
@@ -460,6 +467,7 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         let tint = self.tint_of(&n);
         let _ = self.node.push(node);
         let _ = self.fan.push(NIL);
+        let _ = self.degree.push(0);
         let _ = self.bounds.push(bounds_of(&n));
         let _ = self.family.push([NONE, NIL, NIL]);
         let _ = self.parent_bounds.push(Bounds::default());
@@ -594,6 +602,21 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         None
     }
 
+    /// Whether walking `v`'s fan finds every triangle that uses `v`, each once.
+    fn fan_complete(&self, v: u32) -> bool {
+        let mut seen: Vec<u32, MAX_FAN> = Vec::new();
+        let mut fits = true;
+        let walked = self.for_fan(v, |f| fits &= seen.push(f).is_ok());
+        if walked.is_none() || !fits {
+            return false;
+        }
+        if self.degree.get(v as usize).map(|&d| d as usize) != Some(seen.len()) {
+            return false;
+        }
+        seen.sort_unstable();
+        seen.windows(2).all(|w| w[0] != w[1])
+    }
+
     /// The slot of the triangle with id `id` around vertex `v`.
     fn find_in_fan(&self, v: u32, id: u32) -> Option<u32> {
         let mut found = None;
@@ -655,6 +678,10 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         if self.node.is_full() || self.tri.len() + added > F {
             return Err(Refused::Capacity);
         }
+        if !self.fan_complete(ps) {
+            return Err(Refused::Inconsistent);
+        }
+
         // Wings, read off the neighbours (the nodes there now may be finer than at formation).
         let third = |f: u32, v: u32, offset: usize| -> Option<u32> {
             let t = *self.tri.get(f as usize)?;
@@ -675,6 +702,30 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         } else {
             third(ns[3], ps, 1).ok_or(Refused::Inconsistent)?
         };
+        // Each neighbour pair must meet along the edge the new triangle will take over
+        // (n0: wl -> p, n1: p -> wl, n2: wr -> p, n3: p -> wr), so the new links are mutual.
+        let across = |f: u32, a: u32, b: u32| -> Option<u32> {
+            let t = *self.tri.get(f as usize)?;
+            let k = corner(t, a)?;
+            (t[next3(k)] == b).then(|| self.adj[f as usize][k])
+        };
+        let pairs_meet = |x: u32, y: u32, w: u32| -> bool {
+            // x holds w -> p, y holds p -> w; across each lies the other (or a border).
+            let xy = if x == NIL {
+                true
+            } else {
+                across(x, w, ps) == Some(y)
+            };
+            let yx = if y == NIL {
+                true
+            } else {
+                across(y, ps, w) == Some(x)
+            };
+            xy && yx
+        };
+        if !pairs_meet(ns[0], ns[1], wl) || (second && !pairs_meet(ns[2], ns[3], wr)) {
+            return Err(Refused::Inconsistent);
+        }
         // The triangles that go to c1: counter-clockwise from n3 to n0, or up to a border and
         // then clockwise from n0 to the other border (as `Hierarchy::refine_all` does).
         let mut moved: Vec<u32, MAX_FAN> = Vec::new();
@@ -734,6 +785,15 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
             let t = &mut self.tri[f as usize];
             if let Some(k) = corner(*t, ps) {
                 t[k] = c1s;
+            }
+        }
+        let m = moved.len() as u16;
+        let d = self.degree[ps as usize];
+        self.degree[ps as usize] = d.saturating_sub(m).saturating_add(added as u16);
+        self.degree[c1s as usize] = m.saturating_add(added as u16);
+        for w in [wl, wr] {
+            if let Some(d) = self.degree.get_mut(w as usize) {
+                *d = d.saturating_add(1);
             }
         }
         let fl = self.tri.len() as u32;
@@ -904,6 +964,11 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         } else if fr != NIL {
             return Err(Refused::Inconsistent);
         }
+        // Renaming b and moving the last vertex into b's slot must reach every triangle.
+        let last = self.node.len() as u32 - 1;
+        if !self.fan_complete(a) || !self.fan_complete(b) || !self.fan_complete(last) {
+            return Err(Refused::Inconsistent);
+        }
         Ok([a, b, fl, fr])
     }
 
@@ -914,7 +979,19 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         node: u32,
         [a, b, fl, fr]: [u32; 4],
     ) -> u32 {
-        // b's triangles become a's.
+        // The removed triangles' corners lose one triangle each; then b's become a's.
+        for f in [fl, fr] {
+            if let Some(t) = self.tri.get(f as usize).copied() {
+                for v in t {
+                    if let Some(d) = self.degree.get_mut(v as usize) {
+                        *d = d.saturating_sub(1);
+                    }
+                }
+            }
+        }
+        let db = self.degree[b as usize];
+        self.degree[a as usize] = self.degree[a as usize].saturating_add(db);
+        self.degree[b as usize] = 0;
         let mut fan: Vec<u32, MAX_FAN> = Vec::new();
         let _ = self.for_fan(b, |f| {
             let _ = fan.push(f);
@@ -996,8 +1073,8 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
             let t = self.tri[last as usize];
             let adj = self.adj[last as usize];
             for g in adj {
-                if g != NIL {
-                    for e in self.adj[g as usize].iter_mut() {
+                if let Some(ga) = self.adj.get_mut(g as usize) {
+                    for e in ga.iter_mut() {
                         if *e == last {
                             *e = f;
                         }
@@ -1005,8 +1082,10 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
                 }
             }
             for v in t {
-                if self.fan[v as usize] == last {
-                    self.fan[v as usize] = f;
+                if let Some(fv) = self.fan.get_mut(v as usize) {
+                    if *fv == last {
+                        *fv = f;
+                    }
                 }
             }
             self.tri[f as usize] = t;
@@ -1036,6 +1115,7 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
             let j = last as usize;
             self.node[i] = self.node[j];
             self.fan[i] = self.fan[j];
+            self.degree[i] = self.degree[j];
             self.bounds[i] = self.bounds[j];
             self.family[i] = self.family[j];
             self.parent_bounds[i] = self.parent_bounds[j];
@@ -1058,6 +1138,7 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         });
         self.node.pop();
         self.fan.pop();
+        self.degree.pop();
         self.bounds.pop();
         self.family.pop();
         self.parent_bounds.pop();
@@ -1162,6 +1243,11 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         }
         if self.slot_of.len() != nv as usize {
             return bad("node map has extra entries", 0);
+        }
+        for v in 0..nv {
+            if !self.fan_complete(v) {
+                return bad("degree or fan wrong", v);
+            }
         }
         self.check_fans()
     }

@@ -168,10 +168,10 @@ fn refusals_leave_the_cut_as_it_was() {
 
 #[test]
 fn the_size_is_what_the_documentation_says() {
-    // 163 bytes per vertex slot (node, fan, bounds 40, parent, sibling and its slot, parent's
+    // 165 bytes per vertex slot (node, fan, degree, bounds 40, parent, sibling and its slot, parent's
     // bounds 40, position, normal, colours, flags, blend state 32), 36 per triangle slot (corners, neighbours, id, node-map entry), 24 per queue
     // entry, plus a few words.
-    let per = |v: usize, f: usize, q: usize| 163 * v + 36 * f + 24 * q;
+    let per = |v: usize, f: usize, q: usize| 165 * v + 36 * f + 24 * q;
     let small = Cut::<1024, 2048, 256>::BYTES;
     let big = Cut::<2048, 4096, 512>::BYTES;
     assert_eq!(big - small, per(1024, 2048, 256));

@@ -1,0 +1,43 @@
+//! Hostile hierarchies into the runtime cut: whatever `HierarchyView::parse` accepts can be reset,
+//! refined, adapted over a few frames under a budget and coarsened without a panic.
+//!
+//! Each input is tried with its checksum recomputed, so that mutations of valid files (the seeds
+//! in `seeds/hierarchy`) reach the cut.
+#![no_main]
+
+use libfuzzer_sys::fuzz_target;
+use vdlod_core::adapt::Budget;
+use vdlod_core::cut::Cut;
+use vdlod_core::format::{crc32, HierarchyView, HEADER_SIZE};
+use vdlod_core::policy::{QRefine, View};
+
+fuzz_target!(|data: &[u8]| {
+    if data.len() < HEADER_SIZE {
+        return;
+    }
+    let mut sealed = data.to_vec();
+    let crc = crc32(&sealed[HEADER_SIZE..]);
+    sealed[24..28].copy_from_slice(&crc.to_le_bytes());
+    let Ok(view) = HierarchyView::parse(&sealed) else {
+        return;
+    };
+    let mut cut: Box<Cut<256, 512, 64>> = Box::default();
+    if cut.reset(&view).is_err() {
+        return;
+    }
+    cut.set_geomorph_frames(2);
+    let _ = cut.refine_everything(&view);
+    for i in 0..4 {
+        let a = i as f32;
+        let eye = [3.0 * a.cos(), 0.5, 3.0 * a.sin()];
+        let v = View::look_at(eye, [0.0; 3], [0.0, 1.0, 0.0], 1.0, 1.3, 240.0);
+        let budget = Budget {
+            max_triangles: 40 + 100 * (i % 2),
+            ..Budget::default()
+        };
+        let _ = cut.adapt(&view, &v, &QRefine::new(0.25 + a), &budget);
+    }
+    for p in view.leaves()..view.nodes().min(view.leaves() + 512) {
+        let _ = cut.collapse(&view, p);
+    }
+});
