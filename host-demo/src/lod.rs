@@ -13,7 +13,7 @@ use vdlod_core::policy::{Frustum, Importance, MergeTree, Policy, QRefine, Screen
 use vdlod_raster::{Mesh, Rgba8, Shading};
 
 use crate::camera::{Camera, Orbit};
-use crate::frame::{save_png, Frame, FrameError};
+use crate::frame::{encode_png, Frame, FrameError};
 use crate::label;
 use crate::mesh::{vertex_normals, Bounds, IndexedMesh};
 use crate::render::camera_params;
@@ -387,6 +387,28 @@ pub fn plot(frames: &[OrbitFrame]) -> Result<Vec<u8>, FrameError> {
         .map_err(|e| FrameError::Png(e.to_string()))
 }
 
+/// The three panels of [`side_by_side`] as a PNG, each with its caption along the top.
+fn captioned(
+    width: usize,
+    height: usize,
+    pixels: &[Rgba8],
+    captions: &[String; 3],
+) -> Result<Vec<u8>, String> {
+    let mut bytes = encode_png(width * 3, height, pixels).map_err(|e| e.to_string())?;
+    let mut pixmap = tiny_skia::Pixmap::decode_png(&bytes).map_err(|e| e.to_string())?;
+    let scale = if width >= 320 { 2.0 } else { 1.0 };
+    for (k, text) in captions.iter().enumerate() {
+        let ink = if k == 2 {
+            (150, 20, 20)
+        } else {
+            (225, 225, 225)
+        };
+        label::draw(&mut pixmap, text, (k * width) as f32 + 6.0, 6.0, scale, ink);
+    }
+    bytes = pixmap.encode_png().map_err(|e| e.to_string())?;
+    Ok(bytes)
+}
+
 /// Writes the cut's mesh as an OBJ file (positions as blended, 1-based faces).
 pub fn write_obj(path: &Path, cut: &DemoCut) -> std::io::Result<()> {
     let mut s = String::with_capacity(cut.vertices() * 40 + cut.triangles().len() * 24);
@@ -498,13 +520,13 @@ pub fn run_orbit(
         };
         if i == compared {
             let side = side_by_side(opts.width, opts.height, frame.pixels(), reference.pixels());
-            save_png(
-                &out_dir.join("side_by_side.png"),
-                opts.width * 3,
-                opts.height,
-                &side,
-            )
-            .map_err(|e| e.to_string())?;
+            let captions = [
+                format!("adapted: {} triangles", stats.triangles),
+                format!("full detail: {} triangles", full.triangles.len()),
+                format!("difference x4: psnr {:.2} db", f.psnr_db),
+            ];
+            let png = captioned(opts.width, opts.height, &side, &captions)?;
+            std::fs::write(out_dir.join("side_by_side.png"), png).map_err(io)?;
         }
         if picture {
             let seen_from = if opts.observer {
