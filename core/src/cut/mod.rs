@@ -602,30 +602,25 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         None
     }
 
-    /// Whether walking `v`'s fan finds every triangle that uses `v`, each once.
-    fn fan_complete(&self, v: u32) -> bool {
-        let mut seen: Vec<u32, MAX_FAN> = Vec::new();
+    /// Collects `v`'s triangles into `out` (sorted by slot) and says whether the walk found every
+    /// triangle that uses `v`, each once.
+    fn complete_fan(&self, v: u32, out: &mut Vec<u32, MAX_FAN>) -> bool {
+        out.clear();
         let mut fits = true;
-        let walked = self.for_fan(v, |f| fits &= seen.push(f).is_ok());
+        let walked = self.for_fan(v, |f| fits &= out.push(f).is_ok());
         if walked.is_none() || !fits {
             return false;
         }
-        if self.degree.get(v as usize).map(|&d| d as usize) != Some(seen.len()) {
+        if self.degree.get(v as usize).map(|&d| d as usize) != Some(out.len()) {
             return false;
         }
-        seen.sort_unstable();
-        seen.windows(2).all(|w| w[0] != w[1])
+        out.sort_unstable();
+        out.windows(2).all(|w| w[0] != w[1])
     }
 
-    /// The slot of the triangle with id `id` around vertex `v`.
-    fn find_in_fan(&self, v: u32, id: u32) -> Option<u32> {
-        let mut found = None;
-        self.for_fan(v, |f| {
-            if self.fid[f as usize] == id {
-                found = Some(f);
-            }
-        })?;
-        found
+    /// Whether walking `v`'s fan finds every triangle that uses `v`, each once.
+    fn fan_complete(&self, v: u32) -> bool {
+        self.complete_fan(v, &mut Vec::new())
     }
 
     /// Points the edge `a -> b` of triangle `f` at `to`.
@@ -658,17 +653,20 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         let [c0, c1] = s.children;
         let n = s.neighbours;
         let second = s.wings[1] != NONE;
-        // The neighbour triangles must all be around the vertex.
+        // The neighbour triangles must all be around the vertex (whose fan must be whole).
+        let mut fan: Vec<u32, MAX_FAN> = Vec::new();
+        if !self.complete_fan(ps, &mut fan) {
+            return Err(Refused::Inconsistent);
+        }
         let mut ns = [NIL; 4];
-        self.for_fan(ps, |f| {
+        for &f in &fan {
             let id = self.fid[f as usize];
             for k in 0..4 {
                 if n[k] == id {
                     ns[k] = f;
                 }
             }
-        })
-        .ok_or(Refused::Inconsistent)?;
+        }
         for k in 0..4 {
             if n[k] != NONE && ns[k] == NIL {
                 return Err(Refused::Missing(n[k]));
@@ -677,9 +675,6 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         let added = 1 + second as usize;
         if self.node.is_full() || self.tri.len() + added > F {
             return Err(Refused::Capacity);
-        }
-        if !self.fan_complete(ps) {
-            return Err(Refused::Inconsistent);
         }
 
         // Wings, read off the neighbours (the nodes there now may be finer than at formation).
@@ -924,8 +919,15 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         a: u32,
         b: u32,
     ) -> Result<[u32; 4], Refused> {
-        let fl = self
-            .find_in_fan(a, h.split_face(node, false))
+        let mut fan: Vec<u32, MAX_FAN> = Vec::new();
+        if !self.complete_fan(a, &mut fan) {
+            return Err(Refused::Inconsistent);
+        }
+        let id = h.split_face(node, false);
+        let fl = fan
+            .iter()
+            .copied()
+            .find(|&f| self.fid[f as usize] == id)
             .ok_or(Refused::Illegal)?;
         let t = self.tri[fl as usize];
         let k = corner(t, a).ok_or(Refused::Inconsistent)?;
@@ -966,7 +968,7 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         }
         // Renaming b and moving the last vertex into b's slot must reach every triangle.
         let last = self.node.len() as u32 - 1;
-        if !self.fan_complete(a) || !self.fan_complete(b) || !self.fan_complete(last) {
+        if !self.fan_complete(b) || !self.fan_complete(last) {
             return Err(Refused::Inconsistent);
         }
         Ok([a, b, fl, fr])
