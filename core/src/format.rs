@@ -420,7 +420,7 @@ impl<'a> HierarchyView<'a> {
             if a >= p || b >= p || a == b {
                 return bad("children out of range");
             }
-            if self.node(a).parent != p || self.node(b).parent != p {
+            if self.parent(a) != p || self.parent(b) != p {
                 return bad("children do not point back");
             }
             let [w0, w1] = s.wings;

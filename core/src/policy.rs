@@ -77,9 +77,11 @@ pub struct View {
     pub eye: [f32; 3],
     /// Unit viewing direction.
     pub forward: [f32; 3],
-    /// Frustum planes `(n, d)` with inward unit normals: a point `x` is inside when
-    /// `n . x + d >= 0`. Left, right, bottom, top, near (far is not tested).
-    pub planes: [[f32; 4]; 5],
+    /// Frustum planes (left, right, bottom, top, near; the far plane is not tested), transposed:
+    /// `lanes[k][i]` is component `k` of plane `i`'s `(n, d)` with inward unit normal `n`, so a
+    /// point `x` is inside plane `i` when `n . x + d >= 0`. Eight lanes, the last three planes
+    /// that never cull, so the test runs as two four-wide vector operations.
+    lanes: [[f32; 8]; 4],
     /// Vertical field of view in radians.
     pub fov_y: f32,
     /// Pixels covered by one unit of length at distance one, across the view:
@@ -156,16 +158,25 @@ impl View {
                 forward[2] * t + side[2] * sign,
             ]
         };
+        let planes = [
+            plane(comb(tx, right, 1.0)),
+            plane(comb(tx, right, -1.0)),
+            plane(comb(ty, true_up, 1.0)),
+            plane(comb(ty, true_up, -1.0)),
+            plane(forward),
+        ];
+        // Unused lanes: n = 0, d = MAX, never culling (centres are finite).
+        let mut lanes = [[0.0f32; 8]; 4];
+        lanes[3] = [f32::MAX; 8];
+        for (i, p) in planes.iter().enumerate() {
+            for k in 0..4 {
+                lanes[k][i] = p[k];
+            }
+        }
         View {
             eye,
             forward,
-            planes: [
-                plane(comb(tx, right, 1.0)),
-                plane(comb(tx, right, -1.0)),
-                plane(comb(ty, true_up, 1.0)),
-                plane(comb(ty, true_up, -1.0)),
-                plane(forward),
-            ],
+            lanes,
             fov_y,
             pixels_per_unit: height / (2.0 * tan_y),
         }
@@ -174,13 +185,19 @@ impl View {
     /// Whether the sphere `(center, radius)` reaches into the frustum.
     #[inline]
     pub fn sphere_visible(&self, center: [f32; 3], radius: f32) -> bool {
-        // Branch-free: the nearest plane decides.
-        let mut nearest = f32::INFINITY;
-        for p in &self.planes {
-            let d = p[0] * center[0] + p[1] * center[1] + p[2] * center[2] + p[3];
-            nearest = nearest.min(d);
+        // Branch-free over all planes at once (each lane computes what a scalar loop would).
+        let [x, y, z, d] = &self.lanes;
+        let mut outside = false;
+        for i in 0..8 {
+            let dist = x[i] * center[0] + y[i] * center[1] + z[i] * center[2] + d[i];
+            outside |= dist < -radius;
         }
-        nearest >= -radius
+        !outside
+    }
+
+    /// Frustum plane `i` (left, right, bottom, top, near) as `(n, d)`; `None` past the fifth.
+    pub fn plane(&self, i: usize) -> Option<[f32; 4]> {
+        (i < 5).then(|| [0, 1, 2, 3].map(|k| self.lanes[k][i]))
     }
 }
 
