@@ -348,7 +348,7 @@ impl QRefine {
 }
 
 impl Policy for QRefine {
-    #[inline]
+    #[inline(always)]
     fn demand(&self, b: &Bounds, view: &View) -> Demand {
         if !view.sphere_visible(b.center, b.radius) {
             return Demand::CULLED;
