@@ -22,6 +22,40 @@
 //!
 //! Full capacity, a full queue, the budget and the operation limit keep the cut coarser and are
 //! reported in [`FrameStats`]; nothing panics.
+//!
+//! ```
+//! # #[cfg(feature = "build")] {
+//! use vdlod_core::adapt::Budget;
+//! use vdlod_core::build::{build, BuildOptions, InputMesh};
+//! use vdlod_core::cut::Cut;
+//! use vdlod_core::format::HierarchyView;
+//! use vdlod_core::policy::{QRefine, View};
+//! // A bumpy 16 x 16 grid, its hierarchy, and a cut of it seen from above.
+//! let n = 16;
+//! let positions: Vec<[f32; 3]> = (0..=n * n + 2 * n)
+//!     .map(|i| [(i % (n + 1)) as f32, (i / (n + 1)) as f32, ((i * 7) % 5) as f32 * 0.05])
+//!     .collect();
+//! let mut triangles = Vec::new();
+//! for y in 0..n {
+//!     for x in 0..n {
+//!         let v = y * (n + 1) + x;
+//!         triangles.push([v, v + 1, v + n + 2]);
+//!         triangles.push([v, v + n + 2, v + n + 1]);
+//!     }
+//! }
+//! let mesh = InputMesh { positions: &positions, colors: None, triangles: &triangles };
+//! let bytes = build(&mesh, &BuildOptions::default(), &mut |_| {}).unwrap().to_bytes(false);
+//! let h = HierarchyView::parse(&bytes).unwrap();
+//! let mut cut = Box::new(Cut::<512, 1024, 256>::new());
+//! cut.reset(&h).unwrap();
+//! let view = View::look_at([8.0, 8.0, 12.0], [8.0, 8.0, 0.0], [0.0, 1.0, 0.0], 1.0, 1.0, 480.0);
+//! let budget = Budget { max_triangles: 200, ..Budget::default() };
+//! let stats = cut.adapt(&h, &view, &QRefine::new(1.0), &budget);
+//! assert!(stats.vsplits > 0 && stats.triangles <= 200);
+//! assert_eq!(stats.triangles as usize, cut.triangles().len());
+//! assert!(cut.check(&h).is_ok());
+//! # }
+//! ```
 
 use crate::cut::{Cut, Morph, Refused, BLENDING, BLOCKED, COLLAPSING, VISIBLE, WAS_VISIBLE};
 use crate::format::{HierarchyView, NONE};
