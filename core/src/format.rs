@@ -271,9 +271,29 @@ fn u32_at(b: &[u8], o: usize) -> u32 {
     }
 }
 
+/// What an out-of-range node id reads as: zeros, no parent.
+const OUT_OF_RANGE_NODE: [u8; NODE_SIZE] = {
+    let mut r = [0u8; NODE_SIZE];
+    r[30] = 0xFF;
+    r[31] = 0xFF;
+    r[32] = 0xFF;
+    r[33] = 0xFF;
+    r
+};
+
 #[inline]
-fn f32_at(b: &[u8], o: usize) -> f32 {
-    f32::from_bits(u32_at(b, o))
+fn ru32<const N: usize>(r: &[u8; N], o: usize) -> u32 {
+    u32::from_le_bytes([r[o], r[o + 1], r[o + 2], r[o + 3]])
+}
+
+#[inline]
+fn rf32<const N: usize>(r: &[u8; N], o: usize) -> f32 {
+    f32::from_bits(ru32(r, o))
+}
+
+#[inline]
+fn rf16<const N: usize>(r: &[u8; N], o: usize) -> f32 {
+    f16_to_f32(u16::from_le_bytes([r[o], r[o + 1]]))
 }
 
 /// Encodes a unit vector as octahedral coordinates in `[-127, 127]` (nearest).
@@ -512,10 +532,8 @@ impl<'a> HierarchyView<'a> {
     /// Node `i`'s parent, or [`NONE`] (cheaper than [`HierarchyView::node`]).
     #[inline]
     pub fn parent(&self, i: u32) -> u32 {
-        u32_at(
-            self.bytes,
-            record(self.offsets()[0], i, NODE_SIZE).saturating_add(30),
-        )
+        let o = record(self.offsets[0], i, NODE_SIZE).saturating_add(30);
+        self.fixed::<4>(o).map_or(NONE, u32::from_le_bytes)
     }
 
     /// Whether the nodes carry meaningful colours.
@@ -528,47 +546,47 @@ impl<'a> HierarchyView<'a> {
         self.bytes.len()
     }
 
-    /// Node `i` (`i < nodes()`; out-of-range ids read as zeros, never panic).
+    /// The `N` bytes at `o`, if they are inside the file.
+    #[inline]
+    fn fixed<const N: usize>(&self, o: usize) -> Option<[u8; N]> {
+        let end = o.checked_add(N)?;
+        self.bytes.get(o..end)?.try_into().ok()
+    }
+
+    /// Node `i`'s record (an out-of-range id reads as zeros with no parent).
+    #[inline]
+    fn node_record(&self, i: u32) -> [u8; NODE_SIZE] {
+        self.fixed(record(self.offsets[0], i, NODE_SIZE))
+            .unwrap_or(OUT_OF_RANGE_NODE)
+    }
+
+    /// Node `i` (`i < nodes()`; out-of-range ids read as zeros with no parent, never panic).
     pub fn node(&self, i: u32) -> NodeView {
-        let o = record(self.offsets()[0], i, NODE_SIZE);
-        let b = self.bytes;
-        let h = |k: usize| f16_to_f32(u16_at(b, o.saturating_add(12 + 2 * k)));
-        let byte = |k: usize| b.get(o.saturating_add(k)).copied().unwrap_or(0);
+        let r = self.node_record(i);
         NodeView {
-            position: [
-                f32_at(b, o),
-                f32_at(b, o.saturating_add(4)),
-                f32_at(b, o.saturating_add(8)),
-            ],
-            radius: h(0),
-            mu: h(1),
-            delta: h(2),
-            spheroid: [h(3), h(4)],
-            normal: oct_decode(byte(22) as i8, byte(23) as i8),
-            cone_sin: byte(24) as f32 / 255.0,
-            color: [byte(25), byte(26), byte(27)],
-            depth: u16_at(b, o.saturating_add(28)),
-            parent: u32_at(b, o.saturating_add(30)),
+            position: [rf32(&r, 0), rf32(&r, 4), rf32(&r, 8)],
+            radius: rf16(&r, 12),
+            mu: rf16(&r, 14),
+            delta: rf16(&r, 16),
+            spheroid: [rf16(&r, 18), rf16(&r, 20)],
+            normal: oct_decode(r[22] as i8, r[23] as i8),
+            cone_sin: r[24] as f32 / 255.0,
+            color: [r[25], r[26], r[27]],
+            depth: u16::from_le_bytes([r[28], r[29]]),
+            parent: ru32(&r, 30),
         }
     }
 
     /// What the refinement policies need of node `i`, decoded without the rest of the record.
     #[inline]
     pub fn bounds(&self, i: u32) -> crate::policy::Bounds {
-        let o = record(self.offsets[0], i, NODE_SIZE);
-        let b = self.bytes;
-        let h = |k: usize| f16_to_f32(u16_at(b, o.saturating_add(12 + 2 * k)));
-        let byte = |k: usize| b.get(o.saturating_add(k)).copied().unwrap_or(0);
-        let (sa, sb) = (h(3), h(4));
+        let r = self.node_record(i);
+        let (sa, sb) = (rf16(&r, 18), rf16(&r, 20));
         crate::policy::Bounds {
-            center: [
-                f32_at(b, o),
-                f32_at(b, o.saturating_add(4)),
-                f32_at(b, o.saturating_add(8)),
-            ],
-            radius: h(0),
-            axis: oct_decode(byte(22) as i8, byte(23) as i8),
-            cone_sin: byte(24) as f32 / 255.0,
+            center: [rf32(&r, 0), rf32(&r, 4), rf32(&r, 8)],
+            radius: rf16(&r, 12),
+            axis: oct_decode(r[22] as i8, r[23] as i8),
+            cone_sin: r[24] as f32 / 255.0,
             a2: sa * sa,
             b2: sb * sb,
         }
@@ -576,14 +594,18 @@ impl<'a> HierarchyView<'a> {
 
     /// The split record of parent `p` (`leaves() <= p < nodes()`; anything else reads as
     /// [`NONE`]s).
+    #[inline]
     pub fn split(&self, p: u32) -> SplitView {
-        let o = record(self.offsets()[1], p.wrapping_sub(self.leaves), SPLIT_SIZE);
-        let o = if p < self.leaves { usize::MAX } else { o };
-        let at = |k: usize| u32_at(self.bytes, o.saturating_add(4 * k));
+        let o = if p < self.leaves {
+            usize::MAX
+        } else {
+            record(self.offsets[1], p - self.leaves, SPLIT_SIZE)
+        };
+        let r: [u8; SPLIT_SIZE] = self.fixed(o).unwrap_or([0xFF; SPLIT_SIZE]);
         SplitView {
-            children: [at(0), at(1)],
-            wings: [at(2), at(3)],
-            neighbours: [at(4), at(5), at(6), at(7)],
+            children: [ru32(&r, 0), ru32(&r, 4)],
+            wings: [ru32(&r, 8), ru32(&r, 12)],
+            neighbours: [ru32(&r, 16), ru32(&r, 20), ru32(&r, 24), ru32(&r, 28)],
         }
     }
 

@@ -602,20 +602,51 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         None
     }
 
-    /// Collects `v`'s triangles into `out` (sorted by slot) and says whether the walk found every
-    /// triangle that uses `v`, each once.
+    /// Collects `v`'s triangles into `out` and says whether the walk found every triangle that
+    /// uses `v`, each once. Each step of a walk is a function of the triangle it stands on, so a
+    /// walk that comes back to its start (or reaches a border) without exceeding [`MAX_FAN`]
+    /// steps repeats nothing; only the two halves of a border fan can overlap, which is checked,
+    /// and the count must match the vertex's triangle count.
     fn complete_fan(&self, v: u32, out: &mut Vec<u32, MAX_FAN>) -> bool {
         out.clear();
-        let mut fits = true;
-        let walked = self.for_fan(v, |f| fits &= out.push(f).is_ok());
-        if walked.is_none() || !fits {
+        let Some(&start) = self.fan.get(v as usize) else {
             return false;
+        };
+        let degree = self
+            .degree
+            .get(v as usize)
+            .map_or(usize::MAX, |&d| d as usize);
+        if start == NIL {
+            return degree == 0;
         }
-        if self.degree.get(v as usize).map(|&d| d as usize) != Some(out.len()) {
-            return false;
+        let mut f = start;
+        loop {
+            if out.push(f).is_err() {
+                return false;
+            }
+            match self.ccw(f, v) {
+                Some(g) if g == start => return out.len() == degree,
+                Some(NIL) => break,
+                Some(g) => f = g,
+                None => return false,
+            }
         }
-        out.sort_unstable();
-        out.windows(2).all(|w| w[0] != w[1])
+        // A border: the rest lies clockwise of the start, and must not meet the first half.
+        let ccw_part = out.len();
+        let mut g = match self.cw(start, v) {
+            Some(g) => g,
+            None => return false,
+        };
+        while g != NIL {
+            if out[..ccw_part].contains(&g) || out.push(g).is_err() {
+                return false;
+            }
+            g = match self.cw(g, v) {
+                Some(g) => g,
+                None => return false,
+            };
+        }
+        out.len() == degree
     }
 
     /// Whether walking `v`'s fan finds every triangle that uses `v`, each once.
