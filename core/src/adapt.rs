@@ -57,7 +57,9 @@
 //! # }
 //! ```
 
-use crate::cut::{Cut, Morph, Refused, BLENDING, BLOCKED, COLLAPSING, VISIBLE, WAS_VISIBLE};
+use crate::cut::{
+    Cut, Morph, PairFans, Refused, BLENDING, BLOCKED, COLLAPSING, VISIBLE, WAS_VISIBLE,
+};
 use crate::format::{HierarchyView, NONE};
 use crate::policy::{Policy, View};
 
@@ -218,9 +220,10 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
 
     /// Collapses `parent` now if legal; `true` when done.
     fn collapse_now(&mut self, h: &HierarchyView<'_>, parent: u32) -> bool {
-        match self.collapse_legal(h, parent) {
+        let mut fans = PairFans::default();
+        match self.collapse_legal(h, parent, &mut fans) {
             Ok(slots) => {
-                self.collapse_unchecked(h, parent, slots);
+                self.collapse_unchecked(h, parent, slots, &fans);
                 true
             }
             Err(_) => false,
@@ -320,9 +323,10 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
                 continue;
             }
             let split = h.split(p);
+            let mut fans = PairFans::default();
             if !blending && frames > 0 && seen {
                 if self
-                    .collapse_legal_at(h, p, &split, a as u32, b as u32)
+                    .collapse_legal_at(h, p, &split, a as u32, b as u32, &mut fans)
                     .is_ok()
                 {
                     self.start_blend(a, true);
@@ -333,8 +337,8 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
                 }
                 continue;
             }
-            if let Ok(slots) = self.collapse_legal_at(h, p, &split, a as u32, b as u32) {
-                self.collapse_unchecked(h, p, slots);
+            if let Ok(slots) = self.collapse_legal_at(h, p, &split, a as u32, b as u32, &mut fans) {
+                self.collapse_unchecked(h, p, slots, &fans);
                 stats.ecols += 1;
                 ops += 1;
             } else if !blending {

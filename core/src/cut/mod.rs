@@ -72,6 +72,10 @@ pub(crate) const COLLAPSING: u8 = 16;
 /// rather than walked forever.
 pub const MAX_FAN: usize = 1024;
 
+/// The triangles around the two vertices of a collapse, found while proving it legal and used
+/// again to do it.
+pub(crate) type PairFans = [Vec<u32, MAX_FAN>; 2];
+
 /// Why the cut could not be set up.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum CutError {
@@ -921,8 +925,9 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
     /// Collapses active siblings into their parent `node` if Hoppe's condition holds. Returns the
     /// parent's slot.
     pub fn collapse(&mut self, h: &HierarchyView<'_>, node: u32) -> Result<u32, Refused> {
-        let ok = self.collapse_legal(h, node)?;
-        Ok(self.collapse_unchecked(h, node, ok))
+        let mut fans = PairFans::default();
+        let ok = self.collapse_legal(h, node, &mut fans)?;
+        Ok(self.collapse_unchecked(h, node, ok, &fans))
     }
 
     /// The slots `[a, b, fl, fr]` of a legal collapse of `node`.
@@ -930,6 +935,7 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         &self,
         h: &HierarchyView<'_>,
         node: u32,
+        fans: &mut PairFans,
     ) -> Result<[u32; 4], Refused> {
         if node < h.leaves() || node >= h.nodes() {
             return Err(Refused::NoSuchOperation);
@@ -938,7 +944,7 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         let [c0, c1] = s.children;
         let a = self.slot_of.get(c0).ok_or(Refused::NotActive)?;
         let b = self.slot_of.get(c1).ok_or(Refused::NotActive)?;
-        self.collapse_legal_at(h, node, &s, a, b)
+        self.collapse_legal_at(h, node, &s, a, b, fans)
     }
 
     /// [`Cut::collapse_legal`] with the children's slots `a` and `b` known.
@@ -949,13 +955,14 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         s: &crate::format::SplitView,
         a: u32,
         b: u32,
+        fans: &mut PairFans,
     ) -> Result<[u32; 4], Refused> {
-        let mut fan: Vec<u32, MAX_FAN> = Vec::new();
-        if !self.complete_fan(a, &mut fan) {
+        let [fan_a, fan_b] = fans;
+        if !self.complete_fan(a, fan_a) {
             return Err(Refused::Inconsistent);
         }
         let id = h.split_face(node, false);
-        let fl = fan
+        let fl = fan_a
             .iter()
             .copied()
             .find(|&f| self.fid[f as usize] == id)
@@ -999,19 +1006,28 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         }
         // Renaming b and moving the last vertex into b's slot must reach every triangle.
         let last = self.node.len() as u32 - 1;
-        if !self.fan_complete(b) || !self.fan_complete(last) {
+        if !self.complete_fan(b, fan_b) || !self.fan_complete(last) {
             return Err(Refused::Inconsistent);
         }
         Ok([a, b, fl, fr])
     }
 
-    /// Performs a collapse [`Cut::collapse_legal`] approved; returns the parent's slot.
+    /// Performs a collapse [`Cut::collapse_legal`] approved, with the fans it found; returns the
+    /// parent's slot.
     pub(crate) fn collapse_unchecked(
         &mut self,
         h: &HierarchyView<'_>,
         node: u32,
         [a, b, fl, fr]: [u32; 4],
+        [fan_a, fan_b]: &PairFans,
     ) -> u32 {
+        // Collapses around here may become legal: clear the marks on every corner of the
+        // triangles around both vertices (the parent's fan and its neighbours).
+        for &f in fan_a.iter().chain(fan_b.iter()) {
+            for v in self.tri[f as usize] {
+                self.flags[v as usize] &= !BLOCKED;
+            }
+        }
         // The removed triangles' corners lose one triangle each; then b's become a's.
         for f in [fl, fr] {
             if let Some(t) = self.tri.get(f as usize).copied() {
@@ -1025,11 +1041,7 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         let db = self.degree[b as usize];
         self.degree[a as usize] = self.degree[a as usize].saturating_add(db);
         self.degree[b as usize] = 0;
-        let mut fan: Vec<u32, MAX_FAN> = Vec::new();
-        let _ = self.for_fan(b, |f| {
-            let _ = fan.push(f);
-        });
-        for &f in &fan {
+        for &f in fan_b.iter() {
             if f == fl || f == fr {
                 continue;
             }
@@ -1082,21 +1094,9 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         self.set_vertex(h, a as usize, node, None);
         self.link_family(h, a);
         self.slot_of.remove(self.node[b as usize]);
-        let p = self
-            .remove_vertex(h, b)
+        self.remove_vertex(h, b)
             .map(|moved_to| if moved_to == a { b } else { a })
-            .unwrap_or(a);
-        // Collapses around here may have become legal.
-        let mut fan: Vec<u32, MAX_FAN> = Vec::new();
-        let _ = self.for_fan(p, |f| {
-            let _ = fan.push(f);
-        });
-        for &f in &fan {
-            for v in self.tri[f as usize] {
-                self.flags[v as usize] &= !BLOCKED;
-            }
-        }
-        p
+            .unwrap_or(a)
     }
 
     /// Swap-removes triangle slot `f`, re-pointing whatever pointed at the moved one.

@@ -256,7 +256,7 @@ mod adapt {
                 max_unsplit = max_unsplit.max(policy.demand(&h.bounds(n), &view).error);
             }
             if let Some(p) = cut.pair_parent(i) {
-                if cut.collapse_legal(&h, p).is_ok() {
+                if cut.collapse_legal(&h, p, &mut Default::default()).is_ok() {
                     let e = policy.demand(&h.bounds(p), &view).error;
                     min_collapsible = min_collapsible.min(e);
                 }
