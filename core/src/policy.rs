@@ -84,6 +84,8 @@ pub struct View {
     lanes: [[f32; 8]; 4],
     /// Vertical field of view in radians.
     pub fov_y: f32,
+    /// `tan(fov_y)`, for the importance policy (kept away from zero).
+    tan_fov: f32,
     /// Pixels covered by one unit of length at distance one, across the view:
     /// `height / (2 tan(fov_y / 2))`.
     pub pixels_per_unit: f32,
@@ -97,6 +99,45 @@ fn dot(a: [f32; 3], b: [f32; 3]) -> f32 {
 #[inline]
 fn sub(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+/// What every view-dependent test of a vertex starts from: the squared distance from the eye
+/// and the eye vector's component along the cone axis.
+#[derive(Clone, Copy)]
+struct Eye {
+    d2: f32,
+    rn: f32,
+}
+
+impl Eye {
+    #[inline(always)]
+    fn of(b: &Bounds, view: &View) -> Eye {
+        let r = sub(b.center, view.eye);
+        Eye {
+            d2: dot(r, r),
+            rn: dot(r, b.axis),
+        }
+    }
+
+    /// Hoppe's `oriented_away`, with the cone's apex moved towards the eye by the radius.
+    #[inline(always)]
+    fn faces_away(self, b: &Bounds) -> bool {
+        let s = self.rn - b.radius;
+        s > 0.0 && s * s > self.d2 * (b.cone_sin * b.cone_sin)
+    }
+
+    /// Whether the normal cone holds a direction perpendicular to the view (a silhouette).
+    #[inline(always)]
+    fn on_silhouette(self, b: &Bounds) -> bool {
+        self.rn * self.rn <= self.d2 * (b.cone_sin * b.cone_sin)
+    }
+
+    /// The spheroid's squared projected radius times `d^4`: equation 4 (seen at an angle) and
+    /// equation 5 (its cross-section, seen from any direction).
+    #[inline(always)]
+    fn spheroid(self, b: &Bounds) -> f32 {
+        (b.a2 * self.d2 + (b.b2 - b.a2) * self.rn * self.rn).max(b.b2 * self.d2)
+    }
 }
 
 fn cross(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
@@ -178,6 +219,7 @@ impl View {
             forward,
             lanes,
             fov_y,
+            tan_fov: libm::tanf(fov_y).abs().max(1e-6),
             pixels_per_unit: height / (2.0 * tan_y),
         }
     }
@@ -256,10 +298,7 @@ pub struct BackFace;
 impl Policy for BackFace {
     #[inline]
     fn demand(&self, b: &Bounds, view: &View) -> Demand {
-        let r = sub(b.center, view.eye);
-        let s = dot(b.axis, r) - b.radius;
-        let d2 = dot(r, r);
-        if s > 0.0 && s * s > d2 * b.cone_sin * b.cone_sin {
+        if Eye::of(b, view).faces_away(b) {
             Demand::CULLED
         } else {
             Demand::NONE
@@ -291,41 +330,36 @@ impl ScreenError {
     /// The projected error radius of `b` in pixels (for tests and pictures; the policy itself
     /// needs no square root).
     pub fn pixels(b: &Bounds, view: &View) -> f32 {
-        let r = sub(b.center, view.eye);
-        let d2 = dot(r, r);
-        let rn = dot(r, b.axis);
-        let lhs = (b.a2 * d2 + (b.b2 - b.a2) * rn * rn).max(b.b2 * d2);
-        libm::sqrtf(lhs / (d2 * d2)) * view.pixels_per_unit
+        let e = Eye::of(b, view);
+        libm::sqrtf(e.spheroid(b) / (e.d2 * e.d2)) * view.pixels_per_unit
+    }
+
+    /// `(projected radius / tolerance)^2 = lhs ppu^2 / (tol^2 d^4)`, with one division.
+    #[inline(always)]
+    fn ratio(&self, b: &Bounds, e: Eye, view: &View) -> f32 {
+        let lhs = e.spheroid(b);
+        let tol = if e.on_silhouette(b) {
+            self.silhouette
+        } else {
+            self.interior
+        };
+        let rhs = tol * tol * e.d2 * e.d2;
+        if rhs > 0.0 {
+            lhs * (view.pixels_per_unit * view.pixels_per_unit) / rhs
+        } else if lhs > 0.0 {
+            f32::MAX
+        } else {
+            0.0
+        }
     }
 }
 
 impl Policy for ScreenError {
     #[inline]
     fn demand(&self, b: &Bounds, view: &View) -> Demand {
-        let r = sub(b.center, view.eye);
-        let d2 = dot(r, r);
-        let rn = dot(r, b.axis);
-        // Squared projected radius times d^4: equation 4 (the spheroid seen at an angle) and
-        // equation 5 (its cross-section, seen from any direction).
-        let lhs = (b.a2 * d2 + (b.b2 - b.a2) * rn * rn).max(b.b2 * d2);
-        let silhouette = rn * rn <= d2 * b.cone_sin * b.cone_sin;
-        let tol = if silhouette {
-            self.silhouette
-        } else {
-            self.interior
-        };
-        // (projected radius / tolerance)^2 = lhs ppu^2 / (tol^2 d^4), with one division.
-        let rhs = tol * tol * d2 * d2;
-        let error = if rhs > 0.0 {
-            lhs * (view.pixels_per_unit * view.pixels_per_unit) / rhs
-        } else if lhs > 0.0 {
-            f32::MAX
-        } else {
-            0.0
-        };
         Demand {
             visible: true,
-            error,
+            error: self.ratio(b, Eye::of(b, view), view),
         }
     }
 }
@@ -353,31 +387,13 @@ impl Policy for QRefine {
         if !view.sphere_visible(b.center, b.radius) {
             return Demand::CULLED;
         }
-        let r = sub(b.center, view.eye);
-        let d2 = dot(r, r);
-        let rn = dot(r, b.axis);
-        let cs2 = b.cone_sin * b.cone_sin;
-        let s = rn - b.radius;
-        if s > 0.0 && s * s > d2 * cs2 {
+        let e = Eye::of(b, view);
+        if e.faces_away(b) {
             return Demand::CULLED;
         }
-        let lhs = (b.a2 * d2 + (b.b2 - b.a2) * rn * rn).max(b.b2 * d2);
-        let tol = if rn * rn <= d2 * cs2 {
-            self.error.silhouette
-        } else {
-            self.error.interior
-        };
-        let rhs = tol * tol * d2 * d2;
-        let error = if rhs > 0.0 {
-            lhs * (view.pixels_per_unit * view.pixels_per_unit) / rhs
-        } else if lhs > 0.0 {
-            f32::MAX
-        } else {
-            0.0
-        };
         Demand {
             visible: true,
-            error,
+            error: self.error.ratio(b, e, view),
         }
     }
 }
@@ -427,8 +443,7 @@ impl Policy for Importance {
         let d = libm::sqrtf(dot(r, r)).max(f32::MIN_POSITIVE);
         let cos = (dot(b.axis, r) / d).clamp(-1.0, 1.0);
         let sin = libm::sqrtf(1.0 - cos * cos);
-        let tan_fov = libm::tanf(view.fov_y).abs().max(1e-6);
-        let importance = b.radius * b.radius / (d * tan_fov) * (-cos).max(sin);
+        let importance = b.radius * b.radius / (d * view.tan_fov) * (-cos).max(sin);
         Demand {
             visible: true,
             error: if self.threshold > 0.0 {
