@@ -340,10 +340,6 @@ impl<'a> HierarchyView<'a> {
         [n, s, b, end]
     }
 
-    fn offsets(&self) -> [usize; 3] {
-        self.offsets
-    }
-
     /// Validates `bytes` and returns a view of them.
     pub fn parse(bytes: &'a [u8]) -> Result<HierarchyView<'a>, FormatError> {
         if bytes.len() < HEADER_SIZE {
@@ -611,7 +607,7 @@ impl<'a> HierarchyView<'a> {
 
     /// Base triangle `t`.
     pub fn base_triangle(&self, t: u32) -> [u32; 3] {
-        let o = record(self.offsets()[2], t, 12);
+        let o = record(self.offsets[2], t, 12);
         [0, 4, 8].map(|k| u32_at(self.bytes, o.saturating_add(k)))
     }
 }

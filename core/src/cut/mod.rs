@@ -576,36 +576,6 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         Some(self.adj[f as usize][k])
     }
 
-    /// Calls `visit` on each triangle around vertex `v`; `None` when the fan is broken or longer
-    /// than [`MAX_FAN`].
-    fn for_fan(&self, v: u32, mut visit: impl FnMut(u32)) -> Option<()> {
-        let start = *self.fan.get(v as usize)?;
-        if start == NIL {
-            return Some(());
-        }
-        let mut f = start;
-        for _ in 0..MAX_FAN {
-            visit(f);
-            f = self.ccw(f, v)?;
-            if f == start {
-                return Some(());
-            }
-            if f == NIL {
-                // A border: the rest lies clockwise of the start.
-                let mut g = self.cw(start, v)?;
-                for _ in 0..MAX_FAN {
-                    if g == NIL {
-                        return Some(());
-                    }
-                    visit(g);
-                    g = self.cw(g, v)?;
-                }
-                return None;
-            }
-        }
-        None
-    }
-
     /// Collects `v`'s triangles into `out` and says whether the walk found every triangle that
     /// uses `v`, each once. Each step of a walk is a function of the triangle it stands on, so a
     /// walk that comes back to its start (or reaches a border) without exceeding [`MAX_FAN`]
@@ -1136,9 +1106,8 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         let last = self.node.len() as u32 - 1;
         let moved = (v != last).then(|| {
             let mut fan: Vec<u32, MAX_FAN> = Vec::new();
-            let _ = self.for_fan(last, |f| {
-                let _ = fan.push(f);
-            });
+            // Proven whole before the collapse that removes `v`.
+            let _ = self.complete_fan(last, &mut fan);
             for &f in &fan {
                 if let Some(k) = corner(self.tri[f as usize], last) {
                     self.tri[f as usize][k] = v;
@@ -1202,27 +1171,24 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         done
     }
 
+    /// Every vertex's fan walk finds all its triangles, each once, and the counts add up to
+    /// three corners per triangle: each vertex's triangles form one fan (a manifold).
     fn check_fans(&self) -> Result<(), Defect> {
-        let bad = |what, slot| Err(Defect { what, slot });
-        // Each vertex's triangles, found by walking its fan, are exactly the triangles that use it.
-        let mut uses = 0usize;
+        let mut corners = 0usize;
         for v in 0..self.node.len() as u32 {
-            let mut count = 0usize;
-            let mut ok = true;
-            if self
-                .for_fan(v, |f| {
-                    count += 1;
-                    ok &= corner(self.tri[f as usize], v).is_some();
-                })
-                .is_none()
-                || !ok
-            {
-                return bad("broken fan", v);
+            if !self.fan_complete(v) {
+                return Err(Defect {
+                    what: "a vertex's triangles are not one fan, or its count is wrong",
+                    slot: v,
+                });
             }
-            uses += count;
+            corners += self.degree[v as usize] as usize;
         }
-        if uses != 3 * self.tri.len() {
-            return bad("a vertex's triangles are not one fan (not a manifold)", 0);
+        if corners != 3 * self.tri.len() {
+            return Err(Defect {
+                what: "triangle counts do not add up",
+                slot: 0,
+            });
         }
         Ok(())
     }
@@ -1276,11 +1242,6 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         }
         if self.slot_of.len() != nv as usize {
             return bad("node map has extra entries", 0);
-        }
-        for v in 0..nv {
-            if !self.fan_complete(v) {
-                return bad("degree or fan wrong", v);
-            }
         }
         self.check_fans()
     }
