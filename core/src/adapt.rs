@@ -130,6 +130,17 @@ fn lerp3(a: [f32; 3], b: [f32; 3], s: f32) -> [f32; 3] {
     ]
 }
 
+/// A pair's parent's error as the collapse candidates keep it: negative when culled, so that
+/// culled pairs collapse first and without a blend.
+#[inline]
+fn pair_error(d: crate::policy::Demand) -> f32 {
+    if d.visible {
+        d.error
+    } else {
+        -1.0
+    }
+}
+
 /// Sorts `(error, id)` pairs by error, then id (a total order: the result never depends on the
 /// order they were found in).
 fn sort_pairs(pairs: &mut [(f32, u32, u32)]) {
@@ -218,6 +229,12 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         }
     }
 
+    /// Marks the pair at slots `a` and `b` as found illegal (see [`crate::cut`]'s `BLOCKED`).
+    fn block(&mut self, a: usize, b: usize) {
+        self.flags[a] |= BLOCKED;
+        self.flags[b] |= BLOCKED;
+    }
+
     /// Collapses `parent` now if legal; `true` when done.
     fn collapse_now(&mut self, h: &HierarchyView<'_>, parent: u32) -> bool {
         let mut fans = PairFans::default();
@@ -275,8 +292,7 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
             let Some(p) = self.pair_parent(i) else {
                 continue;
             };
-            let dp = policy.demand(&self.parent_bounds[i], view);
-            let e = if dp.visible { dp.error } else { -1.0 };
+            let e = pair_error(policy.demand(&self.parent_bounds[i], view));
             let j = self.family[i][2] as usize;
             if e <= t && self.flags[i] & self.flags[j] & BLOCKED != 0 {
                 continue;
@@ -332,8 +348,7 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
                     self.start_blend(a, true);
                     self.start_blend(b, true);
                 } else {
-                    self.flags[a] |= BLOCKED;
-                    self.flags[b] |= BLOCKED;
+                    self.block(a, b);
                 }
                 continue;
             }
@@ -342,8 +357,7 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
                 stats.ecols += 1;
                 ops += 1;
             } else if !blending {
-                self.flags[a] |= BLOCKED;
-                self.flags[b] |= BLOCKED;
+                self.block(a, b);
             } else {
                 // Arrived, but the neighbourhood changed meanwhile: blend back.
                 self.start_blend(a, false);
@@ -370,7 +384,8 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
             let before = self.node.len();
             let mut tris = self.tri.len() as u32;
             let mut spent = ops;
-            // The nodes split (forced ones first): their children are evaluated next.
+            // The nodes split (forced ones first): their children are evaluated next (past 64
+            // forced splits, the rest wait for the next frame's pass).
             let mut split = [0u32; 64];
             let mut logged = 0usize;
             let result = self.force_split(h, v, blend, &mut |node, added| {
@@ -490,8 +505,7 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
             self.pairs.clear();
             for i in 0..self.node.len() {
                 if let Some(p) = self.pair_parent(i) {
-                    let dp = policy.demand(&self.parent_bounds[i], view);
-                    let e = if dp.visible { dp.error } else { -1.0 };
+                    let e = pair_error(policy.demand(&self.parent_bounds[i], view));
                     if self.pairs.push((e, p, i as u32)).is_err() {
                         stats.queue_overflow = true;
                         break;
