@@ -33,15 +33,15 @@ use vdlod_core::policy::{MergeTree, QRefine, ScreenError};
 use vdlod_demo::camera::Orbit;
 use vdlod_demo::frame::Frame;
 use vdlod_demo::hierarchy::build_with_progress;
-use vdlod_demo::lod::{cut_mesh, policy_view, psnr, with_large_stack};
+use vdlod_demo::lod::{policy_view, psnr, CutVertices};
 use vdlod_demo::mesh::{load_obj_bytes, IndexedMesh, BUNNY_NAME, BUNNY_OBJ};
 use vdlod_demo::render::camera_params;
 use vdlod_raster::Shading;
 
 /// The cut of the adaptation benchmark: room for the bunny at 0.25 px with margin.
-type BunnyCut = Cut<16384, 32768, 4096>;
+type BunnyCut = Cut<16384, 32768, 2048>;
 /// The cut of the Loop-subdivided bunny, which refines fully inside the frustum.
-type BigCut = Cut<{ 1 << 18 }, { 1 << 19 }, { 1 << 15 }>;
+type BigCut = Cut<{ 1 << 18 }, { 1 << 19 }, { 1 << 15 }, u32>;
 
 const TOLERANCES: [f32; 5] = [0.25, 0.5, 1.0, 2.0, 4.0];
 const FRAMES: u32 = 200;
@@ -74,7 +74,7 @@ fn adapt_orbit(
     revolutions: u32,
 ) -> Adapt {
     let orbit = Orbit::peer(&mesh.bounds(), FRAMES);
-    let mut cut: Box<BunnyCut> = Box::default();
+    let mut cut = BunnyCut::boxed();
     cut.reset(h).expect("base mesh fits");
     let policy = QRefine::new(tolerance);
     let mut out = Adapt::default();
@@ -207,9 +207,10 @@ fn full_vs_adapted(mesh: &IndexedMesh) {
     println!("|---|---|---|---|---|---|");
     for (frustum, paper) in [(0.4f32, "5x"), (0.2, "10x"), (0.1, "12.5x")] {
         let orbit = Orbit::merge_tree(&big.bounds(), 100);
-        let mut cut: Box<BigCut> = Box::default();
+        let mut cut = BigCut::boxed();
         cut.reset(&h).expect("fits");
         let mut frame = Frame::new(W, H).expect("frame");
+        let mut vertices = CutVertices::default();
         let (mut ours, mut full, mut tris) = (Vec::new(), Vec::new(), Vec::new());
         let policy = MergeTree {
             near: f32::INFINITY,
@@ -220,7 +221,10 @@ fn full_vs_adapted(mesh: &IndexedMesh) {
             let params = camera_params(&camera, frame.aspect(), Shading::Gouraud, false);
             let start = Instant::now();
             let s = cut.adapt(&h, &view, &policy, &Budget::default());
-            frame.draw(&cut_mesh(&cut, false), &params).expect("draws");
+            vertices.gather(&cut, &h);
+            frame
+                .draw(&vertices.mesh(&cut, false), &params)
+                .expect("draws");
             let t_ours = start.elapsed().as_secs_f64() * 1e3;
             let start = Instant::now();
             frame.draw(&big.as_raster_mesh(), &params).expect("draws");
@@ -257,7 +261,7 @@ fn quality(h: &HierarchyView<'_>, mesh: &IndexedMesh) {
         (2.0, 6.0),
     ] {
         let orbit = Orbit::peer(&mesh.bounds(), FRAMES);
-        let mut cut: Box<BunnyCut> = Box::default();
+        let mut cut = BunnyCut::boxed();
         cut.reset(h).expect("fits");
         let policy = QRefine {
             error: ScreenError {
@@ -266,6 +270,7 @@ fn quality(h: &HierarchyView<'_>, mesh: &IndexedMesh) {
             },
         };
         let mut frame = Frame::new(W, H).expect("frame");
+        let mut vertices = CutVertices::default();
         let mut reference = Frame::new(W, H).expect("frame");
         let (mut ours, mut theirs, mut tris) = (Vec::new(), Vec::new(), Vec::new());
         for i in 0..FRAMES {
@@ -279,7 +284,10 @@ fn quality(h: &HierarchyView<'_>, mesh: &IndexedMesh) {
             reference
                 .draw(&mesh.as_raster_mesh(), &params)
                 .expect("draws");
-            frame.draw(&cut_mesh(&cut, false), &params).expect("draws");
+            vertices.gather(&cut, h);
+            frame
+                .draw(&vertices.mesh(&cut, false), &params)
+                .expect("draws");
             ours.push(psnr(frame.pixels(), reference.pixels()));
             let simplified = meshopt::simplify(
                 &indices,
@@ -311,7 +319,7 @@ fn quality(h: &HierarchyView<'_>, mesh: &IndexedMesh) {
         );
     }
     // The ceiling: every split done, drawn with the file's 8-bit octahedral normals.
-    let mut cut: Box<BigCut> = Box::default();
+    let mut cut = BigCut::boxed();
     cut.reset(h).expect("fits");
     while cut.refine_everything(h) > 0 {}
     let orbit = Orbit::peer(&mesh.bounds(), FRAMES);
@@ -322,7 +330,11 @@ fn quality(h: &HierarchyView<'_>, mesh: &IndexedMesh) {
     reference
         .draw(&mesh.as_raster_mesh(), &params)
         .expect("draws");
-    frame.draw(&cut_mesh(&cut, false), &params).expect("draws");
+    let mut vertices = CutVertices::default();
+    vertices.gather(&cut, h);
+    frame
+        .draw(&vertices.mesh(&cut, false), &params)
+        .expect("draws");
     println!(
         "\nCeiling: the fully refined cut ({} tris, normals as the file stores them) scores {:.2} dB.",
         cut.triangles().len(),
@@ -335,12 +347,12 @@ fn main() {
     if !std::env::args().any(|a| a == "--bench") {
         return;
     }
-    with_large_stack(|| {
+    {
         let mesh = load_obj_bytes(BUNNY_NAME, BUNNY_OBJ).expect("bundled bunny");
         let (_, bytes, _) = build_with_progress(&mesh, &Default::default(), false).expect("builds");
         let h = HierarchyView::parse(&bytes).expect("valid");
         println!(
-            "## 4. Memory\n\nBunny cut `Cut<16384, 32768, 4096>`: {} bytes ({:.1} MB); Loop-bunny cut `Cut<262144, 524288, 32768>`: {} bytes ({:.1} MB).",
+            "## 4. Memory\n\nBunny cut `Cut<16384, 32768, 2048>`: {} bytes ({:.1} MB); Loop-bunny cut `Cut<262144, 524288, 32768, u32>`: {} bytes ({:.1} MB).",
             BunnyCut::BYTES,
             BunnyCut::BYTES as f64 / 1e6,
             BigCut::BYTES,
@@ -361,5 +373,5 @@ fn main() {
         if wanted("full") {
             full_vs_adapted(&mesh);
         }
-    });
+    }
 }

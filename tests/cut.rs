@@ -14,10 +14,9 @@ use vdlod_core::build::{build, BuildOptions, InputMesh};
 use vdlod_core::cut::Cut;
 use vdlod_core::format::HierarchyView;
 use vdlod_core::policy::{BackFace, Frustum, ScreenError, View};
-use vdlod_demo::lod::with_large_stack;
 use vdlod_demo::mesh::IndexedMesh;
 
-type TestCut = Cut<{ 1 << 16 }, { 1 << 17 }, { 1 << 14 }>;
+type TestCut = Cut<{ 1 << 16 }, { 1 << 17 }, { 1 << 13 }, u32>;
 
 fn hierarchy_bytes(mesh: &IndexedMesh) -> Vec<u8> {
     let input = InputMesh {
@@ -102,7 +101,7 @@ fn fly(bytes: &[u8], mesh: &IndexedMesh, frames: u32, seed: u64) -> Vec<u64> {
     let expected = topology(&mesh.triangles);
     let b = mesh.bounds();
     let (c, r) = (b.center().to_array(), b.radius());
-    let mut cut: Box<TestCut> = Box::default();
+    let mut cut: Box<TestCut> = Cut::boxed();
     cut.reset(&h).unwrap();
     let mut path = Path::new(seed);
     let mut prints = Vec::new();
@@ -137,12 +136,9 @@ fn fly(bytes: &[u8], mesh: &IndexedMesh, frames: u32, seed: u64) -> Vec<u64> {
             );
         }
         let mut fp = 0xcbf2_9ce4_8422_2325u64;
-        for v in tris
-            .iter()
-            .flatten()
-            .copied()
-            .chain(cut.positions().iter().flatten().map(|x| x.to_bits()))
-        {
+        for v in tris.iter().flatten().copied().chain(
+            (0..cut.vertex_count()).flat_map(|s| cut.vertex(&h, s).position.map(f32::to_bits)),
+        ) {
             fp = (fp ^ v as u64).wrapping_mul(0x100_0000_01b3);
         }
         prints.push(fp);
@@ -153,11 +149,8 @@ fn fly(bytes: &[u8], mesh: &IndexedMesh, frames: u32, seed: u64) -> Vec<u64> {
 fn long_path(name: &str, frames: u32) {
     let mesh = fixture(name);
     let bytes = hierarchy_bytes(&mesh);
-    let first = with_large_stack({
-        let (bytes, mesh) = (bytes.clone(), mesh.clone());
-        move || fly(&bytes, &mesh, frames, 7)
-    });
-    let second = with_large_stack(move || fly(&bytes, &mesh, frames, 7));
+    let first = fly(&bytes, &mesh, frames, 7);
+    let second = fly(&bytes, &mesh, frames, 7);
     assert_eq!(first, second, "{name}: a second run differs");
     // The path moved the cut.
     let mut distinct = first.clone();
@@ -199,15 +192,15 @@ fn full_refinement_reproduces_every_fixture() {
     for name in ["bunny.obj", "cow.obj", "head.obj", "elk.obj", "fandisk.obj"] {
         let mesh = fixture(name);
         let bytes = hierarchy_bytes(&mesh);
-        let (ok, base) = with_large_stack(move || {
+        let (ok, base) = {
             let h = HierarchyView::parse(&bytes).unwrap();
-            let mut cut: Box<TestCut> = Box::default();
+            let mut cut: Box<TestCut> = Cut::boxed();
             cut.reset(&h).unwrap();
             let base = cut.triangles().len();
             while cut.refine_everything(&h) > 0 {}
             cut.check(&h).unwrap();
             (node_triangles(&cut) == sorted(&mesh.triangles), base)
-        });
+        };
         assert!(ok, "{name}: full refinement is not the input");
         assert!(base > 0);
     }
@@ -218,7 +211,7 @@ fn a_small_cut_reports_capacity_instead_of_failing() {
     let mesh = fixture("cow.obj");
     let bytes = hierarchy_bytes(&mesh);
     let h = HierarchyView::parse(&bytes).unwrap();
-    let mut cut: Box<Cut<256, 512, 64>> = Box::default();
+    let mut cut: Box<Cut<256, 512, 64>> = Cut::boxed();
     cut.reset(&h).unwrap();
     let b = mesh.bounds();
     let mut path = Path::new(3);
@@ -228,7 +221,7 @@ fn a_small_cut_reports_capacity_instead_of_failing() {
         let s = cut.adapt(&h, &view, &ScreenError::new(0.25), &Budget::default());
         cut.check(&h).unwrap();
         limited |= s.capacity_limited || s.queue_overflow;
-        assert!(cut.vertices() <= 256 && cut.triangles().len() <= 512);
+        assert!(cut.vertex_count() <= 256 && cut.triangles().len() <= 512);
     }
     assert!(limited);
 }

@@ -57,7 +57,7 @@ fn walk(view: &HierarchyView<'_>) {
 /// A small cut over whatever parsed: refinement, a few frames from around and inside, coarsening.
 /// Hostile files may be refused or leave the cut coarse, but nothing may panic.
 fn fly(view: &HierarchyView<'_>) {
-    let mut cut: Box<Cut<512, 1024, 128>> = Box::default();
+    let mut cut = Cut::<512, 1024, 128>::boxed();
     if cut.reset(view).is_err() {
         return;
     }

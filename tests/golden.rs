@@ -148,13 +148,13 @@ fn lod_frames(indices: &'static [u32], depth: bool) -> Vec<Vec<Rgba8>> {
     use vdlod_core::format::HierarchyView;
     use vdlod_core::policy::{BackFace, Frustum, ScreenError};
     use vdlod_demo::camera::Orbit;
-    use vdlod_demo::lod::{cut_mesh, policy_view, with_large_stack};
-    with_large_stack(move || {
+    use vdlod_demo::lod::{policy_view, CutVertices};
+    {
         let mesh = bunny();
         let (_, bytes, _) =
             vdlod_demo::hierarchy::build_with_progress(&mesh, &Default::default(), false).unwrap();
         let h = HierarchyView::parse(&bytes).unwrap();
-        let mut cut: Box<Cut<{ 1 << 16 }, { 1 << 17 }, { 1 << 14 }>> = Box::default();
+        let mut cut = Cut::<32_000, 64_000, 4_000>::boxed();
         cut.set_coloring(if depth {
             Coloring::Depth
         } else {
@@ -172,12 +172,14 @@ fn lod_frames(indices: &'static [u32], depth: bool) -> Vec<Vec<Rgba8>> {
             cut.adapt(&h, &view, &policy, &Budget::default());
             if indices.contains(&i) {
                 let params = camera_params(&camera, frame.aspect(), Shading::Gouraud, false);
-                frame.draw(&cut_mesh(&cut, depth), &params).unwrap();
+                let mut vertices = CutVertices::default();
+                vertices.gather(&cut, &h);
+                frame.draw(&vertices.mesh(&cut, depth), &params).unwrap();
                 out.push(frame.pixels().to_vec());
             }
         }
         out
-    })
+    }
 }
 
 #[test]

@@ -46,7 +46,7 @@
 //! let mesh = InputMesh { positions: &positions, colors: None, triangles: &triangles };
 //! let bytes = build(&mesh, &BuildOptions::default(), &mut |_| {}).unwrap().to_bytes(false);
 //! let h = HierarchyView::parse(&bytes).unwrap();
-//! let mut cut = Box::new(Cut::<512, 1024, 256>::new());
+//! let mut cut = Cut::<512, 1024, 256>::boxed();
 //! cut.reset(&h).unwrap();
 //! let view = View::look_at([8.0, 8.0, 12.0], [8.0, 8.0, 0.0], [0.0, 1.0, 0.0], 1.0, 1.0, 480.0);
 //! let budget = Budget { max_triangles: 200, ..Budget::default() };
@@ -58,10 +58,10 @@
 //! ```
 
 use crate::cut::{
-    Cut, Morph, PairFans, Refused, BLENDING, BLOCKED, COLLAPSING, VISIBLE, WAS_VISIBLE,
+    Cut, Pair, PairFans, Refused, SlotIndex, BLENDING, BLOCKED, COLLAPSING, VISIBLE, WAS_VISIBLE,
 };
-use crate::format::{HierarchyView, NONE};
-use crate::policy::{Policy, View};
+use crate::format::HierarchyView;
+use crate::policy::{Demand, Policy, View};
 
 /// Limits on one frame's cut.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -116,24 +116,43 @@ pub struct FrameStats {
     pub capacity_limited: bool,
     /// A work queue overflowed: some split or collapse candidates waited for a later frame.
     pub queue_overflow: bool,
+    /// The blend arena was full: some collapses happened without a geomorph.
+    pub blend_limited: bool,
     /// More triangles than [`Budget::max_triangles`] remain (collapses the budget needed were
     /// not legal yet, or the base mesh alone is larger).
     pub over_budget: bool,
 }
 
-#[inline]
-fn lerp3(a: [f32; 3], b: [f32; 3], s: f32) -> [f32; 3] {
-    [
-        a[0] + (b[0] - a[0]) * s,
-        a[1] + (b[1] - a[1]) * s,
-        a[2] + (b[2] - a[2]) * s,
-    ]
+impl Budget {
+    /// Whether a cut of `triangles` may grow by `added` triangles.
+    #[inline]
+    #[must_use]
+    pub fn admits(&self, triangles: u32, added: u32) -> bool {
+        triangles.saturating_add(added) <= self.max_triangles
+    }
+
+    /// The error threshold for the next frame, after a frame of `triangles` at `threshold`:
+    /// scaled by the ratio to [`Budget::target_triangles`] (at most 2x either way) when it is
+    /// outside [`Budget::target_band`] (the LOD lecture's regulation); unchanged without a
+    /// target.
+    #[must_use]
+    pub fn regulate(&self, threshold: f32, triangles: u32) -> f32 {
+        if self.target_triangles == 0 {
+            return threshold;
+        }
+        let ratio = triangles.max(1) as f32 / self.target_triangles as f32;
+        if (ratio - 1.0).abs() > self.target_band {
+            (threshold * ratio.clamp(0.5, 2.0)).clamp(1e-6, 1e6)
+        } else {
+            threshold
+        }
+    }
 }
 
 /// A pair's parent's error as the collapse candidates keep it: negative when culled, so that
 /// culled pairs collapse first and without a blend.
 #[inline]
-fn pair_error(d: crate::policy::Demand) -> f32 {
+fn pair_error(d: Demand) -> f32 {
     if d.visible {
         d.error
     } else {
@@ -141,106 +160,46 @@ fn pair_error(d: crate::policy::Demand) -> f32 {
     }
 }
 
-/// Sorts `(error, id)` pairs by error, then id (a total order: the result never depends on the
-/// order they were found in).
-fn sort_pairs(pairs: &mut [(f32, u32, u32)]) {
-    pairs.sort_unstable_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+/// Sorts pairs by error, then parent (a total order: the result never depends on the order
+/// they were found in).
+fn sort_pairs(pairs: &mut [Pair]) {
+    pairs.sort_unstable_by(|x, y| x.error.total_cmp(&y.error).then(x.parent.cmp(&y.parent)));
 }
 
-impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
+/// The running totals of one frame.
+struct Frame {
+    stats: FrameStats,
+    /// The error threshold of this frame.
+    threshold: f32,
+    /// Splits plus collapses so far.
+    ops: u32,
+}
+
+impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, I> {
     /// Splits and collapses blend over `frames` frames (0: no geomorphs, the default).
     pub fn set_geomorph_frames(&mut self, frames: u16) {
         self.geomorph_frames = frames;
     }
 
-    /// The regulated error threshold (1 unless [`Budget::target_triangles`] moved it).
+    /// The regulated error threshold (1 after [`Cut::reset`] unless
+    /// [`Budget::target_triangles`] moved it).
+    #[must_use]
     pub fn threshold(&self) -> f32 {
         self.threshold
     }
 
-    /// Advances vertex `i`'s blend by one frame.
-    fn advance(&mut self, h: &HierarchyView<'_>, i: usize) {
-        let m = &mut self.morph[i];
-        if m.left == 0 {
-            self.flags[i] &= !BLENDING;
-            return;
-        }
-        let total = self.geomorph_frames.max(1);
-        m.left = (m.left - 1).min(total);
-        if m.left == 0 {
-            self.flags[i] &= !BLENDING;
-        }
-        let done = 1.0 - m.left as f32 / total as f32;
-        let m = *m;
-        let (pos, normal, color) = if m.collapsing {
-            let p = h.node(h.parent(self.node[i]));
-            (p.position, p.normal, self.tint_of(&p))
-        } else {
-            let b = self.bounds[i];
-            (b.center, b.axis, self.tint[i])
-        };
-        if m.left == 0 {
-            // Arrived: exactly the target (a + (b - a) need not round to b).
-            self.positions[i] = pos;
-            self.normals[i] = normal;
-            self.colors[i] = color;
-            return;
-        }
-        self.positions[i] = lerp3(m.from_pos, pos, done);
-        let n = lerp3(m.from_normal, normal, done);
-        let l = libm::sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-        self.normals[i] = if l > 1e-12 {
-            [n[0] / l, n[1] / l, n[2] / l]
-        } else {
-            normal
-        };
-        let c = |k: usize| {
-            let (a, b) = (m.from_color[k] as f32, color[k] as f32);
-            (a + (b - a) * done + 0.5) as u8
-        };
-        self.colors[i] = [c(0), c(1), c(2)];
-    }
-
-    /// Starts (or reverses) a blend of slot `i`: towards the parent when `collapsing`, else
-    /// towards its own node, from where it is now.
-    fn start_blend(&mut self, i: usize, collapsing: bool) {
-        self.morph[i] = Morph {
-            from_pos: self.positions[i],
-            from_normal: self.normals[i],
-            from_color: self.colors[i],
-            left: self.geomorph_frames,
-            collapsing,
-        };
-        self.flags[i] &= !(BLENDING | COLLAPSING);
-        if self.geomorph_frames > 0 {
-            self.flags[i] |= BLENDING;
-        }
-        if collapsing {
-            self.flags[i] |= COLLAPSING;
-        }
-    }
-
-    fn sibling_active(&self, h: &HierarchyView<'_>, i: usize) -> bool {
-        let p = self.family[i][0];
-        p != NONE && {
-            let [c0, c1] = h.split(p).children;
-            let other = if c0 == self.node[i] { c1 } else { c0 };
-            self.slot_of.get(other).is_some()
-        }
-    }
-
     /// Marks the pair at slots `a` and `b` as found illegal (see [`crate::cut`]'s `BLOCKED`).
     fn block(&mut self, a: usize, b: usize) {
-        self.flags[a] |= BLOCKED;
-        self.flags[b] |= BLOCKED;
+        self.v.flags[a] |= BLOCKED;
+        self.v.flags[b] |= BLOCKED;
     }
 
     /// Collapses `parent` now if legal; `true` when done.
     fn collapse_now(&mut self, h: &HierarchyView<'_>, parent: u32) -> bool {
         let mut fans = PairFans::default();
         match self.collapse_legal(h, parent, &mut fans) {
-            Ok(slots) => {
-                self.collapse_unchecked(h, parent, slots, &fans);
+            Ok(plan) => {
+                self.apply_collapse(h, parent, plan, &fans);
                 true
             }
             Err(_) => false,
@@ -255,141 +214,222 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         policy: &P,
         budget: &Budget,
     ) -> FrameStats {
-        let mut stats = FrameStats::default();
-        let t = self.threshold;
-        let frames = self.geomorph_frames;
-        let mut ops = 0u32;
+        let mut frame = Frame {
+            stats: FrameStats::default(),
+            threshold: self.threshold,
+            ops: 0,
+        };
+        self.evaluate(h, view, policy, &mut frame);
+        self.coarsen(h, budget, &mut frame);
+        self.refine(h, view, policy, budget, &mut frame);
+        self.enforce_max(h, view, policy, budget, &mut frame.stats);
+        // A cut that shrank gets a smaller node map (faster lookups).
+        self.respan_map(self.v.len());
+        let triangles = self.t.len() as u32;
+        self.threshold = budget.regulate(self.threshold, triangles);
+        let mut stats = frame.stats;
+        stats.triangles = triangles;
+        stats.vertices = self.v.len() as u32;
+        stats.threshold = frame.threshold;
+        stats.blending = self.blending();
+        stats
+    }
+
+    /// One pass over the active vertices: blends advance, the policy speaks for every vertex
+    /// (split candidates go to the heap) and every sibling pair (collapse candidates to the
+    /// pair list).
+    fn evaluate<P: Policy>(
+        &mut self,
+        h: &HierarchyView<'_>,
+        view: &View,
+        policy: &P,
+        frame: &mut Frame,
+    ) {
+        let t = frame.threshold;
         self.candidates.clear();
         self.pairs.clear();
-
-        // One pass: blends advance, the policy speaks for every vertex and every sibling pair.
-        for i in 0..self.node.len() {
-            if self.flags[i] & BLENDING != 0 {
-                self.advance(h, i);
+        for i in 0..self.v.len() {
+            if self.v.flags[i] & BLENDING != 0 {
+                self.advance(i);
             }
-            let d = policy.demand(&self.bounds[i], view);
-            let was = if self.flags[i] & VISIBLE != 0 {
-                WAS_VISIBLE
-            } else {
-                0
-            };
-            self.flags[i] =
-                (self.flags[i] & (BLOCKED | BLENDING | COLLAPSING)) | was | d.visible as u8;
-            let node = self.node[i];
-            if self.flags[i] & COLLAPSING != 0 && !self.sibling_active(h, i) {
+            let node = self.v.node[i];
+            let d = policy.demand(&h.bounds(node), view);
+            let flags = self.v.flags[i];
+            let was = if flags & VISIBLE != 0 { WAS_VISIBLE } else { 0 };
+            self.v.flags[i] = (flags & !(VISIBLE | WAS_VISIBLE)) | was | d.visible as u8;
+            let collapsing = flags & COLLAPSING != 0;
+            if collapsing && self.v.mate(i) == crate::cut::NIL {
                 // The pair was broken up (a forced split took the sibling): blend back.
-                self.start_blend(i, false);
+                self.start_blend(h, i, false);
             }
             if d.error > t && node >= h.leaves() {
-                if self.flags[i] & COLLAPSING != 0 {
+                if self.v.flags[i] & COLLAPSING != 0 {
                     // Wanted again: reverse the collapse's blend; no split this frame.
-                    self.start_blend(i, false);
-                } else if self.candidates.push((d.error.to_bits(), node)).is_err() {
-                    stats.queue_overflow = true;
+                    self.start_blend(h, i, false);
+                } else if self
+                    .candidates
+                    .heap_push((d.error.to_bits(), node))
+                    .is_err()
+                {
+                    frame.stats.queue_overflow = true;
                 }
                 continue;
             }
-            let Some(p) = self.pair_parent(i) else {
+            let Some(p) = self.pair_parent(h, i) else {
                 continue;
             };
-            let e = pair_error(policy.demand(&self.parent_bounds[i], view));
-            let j = self.family[i][2] as usize;
-            if e <= t && self.flags[i] & self.flags[j] & BLOCKED != 0 {
-                continue;
-            }
+            let j = self.v.mate(i) as usize;
+            let e = pair_error(policy.demand(&h.bounds(p), view));
             if e > t {
                 // The parent is wanted: a collapse under way blends back.
-                if (self.flags[i] | self.flags[j]) & COLLAPSING != 0 {
-                    self.start_blend(i, false);
-                    self.start_blend(j, false);
+                if (self.v.flags[i] | self.v.flags[j]) & COLLAPSING != 0 {
+                    self.start_blend(h, i, false);
+                    self.start_blend(h, j, false);
                 }
-            }
-            if self.pairs.push((e, p, i as u32)).is_err() {
-                stats.queue_overflow = true;
-            }
-        }
-
-        // Coarsen where the parent is no longer needed.
-        for k in 0..self.pairs.len() {
-            let (e, p, first) = self.pairs[k];
-            if e > t {
                 continue;
             }
+            if self.v.flags[i] & self.v.flags[j] & BLOCKED != 0 {
+                continue;
+            }
+            let pair = Pair {
+                error: e,
+                parent: p,
+                first: i as u32,
+            };
+            if self.pairs.push(pair).is_err() {
+                frame.stats.queue_overflow = true;
+            }
+        }
+    }
+
+    /// Collapses the listed pairs where the parent is no longer needed and Hoppe's condition
+    /// allows; with geomorphs, visible pairs first blend to the parent and collapse on arrival.
+    fn coarsen(&mut self, h: &HierarchyView<'_>, budget: &Budget, frame: &mut Frame) {
+        let frames = self.geomorph_frames;
+        for k in 0..self.pairs.len() {
+            let Pair {
+                error: e,
+                parent: p,
+                first,
+            } = self.pairs.as_slice()[k];
             // The first child's slot from the pass, unless a collapse since moved it.
-            let a = if self.family.get(first as usize).map(|f| f[0]) == Some(p)
-                && self.pair_parent(first as usize) == Some(p)
+            let a = if (first as usize) < self.v.len()
+                && self.pair_parent(h, first as usize) == Some(p)
             {
                 first
             } else {
-                match self.slot_of.get(h.split(p).children[0]) {
-                    Some(a) if self.pair_parent(a as usize) == Some(p) => a,
+                match self.slot(h.split(p).children[0]) {
+                    Some(a) if self.pair_parent(h, a as usize) == Some(p) => a,
                     _ => continue,
                 }
             };
-            let b = self.family[a as usize][2];
+            let b = self.v.mate(a as usize);
             let (a, b) = (a as usize, b as usize);
-            let (ma, mb) = (self.morph[a], self.morph[b]);
-            let blending = self.flags[a] & self.flags[b] & COLLAPSING != 0;
-            if ops >= budget.max_ops {
-                stats.ops_limited = true;
+            if frame.ops >= budget.max_ops {
+                frame.stats.ops_limited = true;
                 break;
             }
-            let seen = e >= 0.0 && (self.flags[a] | self.flags[b]) & WAS_VISIBLE != 0;
-            if blending && (ma.left > 0 || mb.left > 0) {
+            let (fa, fb) = (self.v.flags[a], self.v.flags[b]);
+            let blending = fa & fb & COLLAPSING != 0;
+            if blending && (fa | fb) & BLENDING != 0 {
                 continue;
             }
+            let seen = e >= 0.0 && (fa | fb) & WAS_VISIBLE != 0;
             let split = h.split(p);
             let mut fans = PairFans::default();
+            let legal = self.collapse_legal_at(h, p, &split, a as u32, b as u32, &mut fans);
             if !blending && frames > 0 && seen {
-                if self
-                    .collapse_legal_at(h, p, &split, a as u32, b as u32, &mut fans)
-                    .is_ok()
-                {
-                    self.start_blend(a, true);
-                    self.start_blend(b, true);
-                } else {
+                if legal.is_err() {
                     self.block(a, b);
+                    continue;
                 }
-                continue;
+                if self.blends.len() + 2 <= Q {
+                    self.start_blend(h, a, true);
+                    self.start_blend(h, b, true);
+                    continue;
+                }
+                frame.stats.blend_limited = true;
             }
-            if let Ok(slots) = self.collapse_legal_at(h, p, &split, a as u32, b as u32, &mut fans) {
-                self.collapse_unchecked(h, p, slots, &fans);
-                stats.ecols += 1;
-                ops += 1;
-            } else if !blending {
-                self.block(a, b);
-            } else {
-                // Arrived, but the neighbourhood changed meanwhile: blend back.
-                self.start_blend(a, false);
-                self.start_blend(b, false);
+            match legal {
+                Ok(plan) => {
+                    self.apply_collapse(h, p, plan, &fans);
+                    frame.stats.ecols += 1;
+                    frame.ops += 1;
+                }
+                Err(_) if !blending => self.block(a, b),
+                Err(_) => {
+                    // Arrived, but the neighbourhood changed meanwhile: blend back.
+                    self.start_blend(h, a, false);
+                    self.start_blend(h, b, false);
+                }
             }
         }
+    }
 
-        // Refine, largest error first, within the budget.
+    /// Lists every active pair with its parent's error, least needed first (for trades and
+    /// for [`Cut::enforce_max`]).
+    fn list_all_pairs<P: Policy>(
+        &mut self,
+        h: &HierarchyView<'_>,
+        view: &View,
+        policy: &P,
+        stats: &mut FrameStats,
+    ) {
+        self.pairs.clear();
+        for i in 0..self.v.len() {
+            if let Some(p) = self.pair_parent(h, i) {
+                let e = pair_error(policy.demand(&h.bounds(p), view));
+                let pair = Pair {
+                    error: e,
+                    parent: p,
+                    first: i as u32,
+                };
+                if self.pairs.push(pair).is_err() {
+                    stats.queue_overflow = true;
+                    break;
+                }
+            }
+        }
+        sort_pairs(self.pairs.as_mut_slice());
+    }
+
+    /// Splits the candidates largest error first, each forcing what it needs, within the
+    /// budget; when the budget binds, pairs whose parent is needed less than the next split are
+    /// collapsed to pay for it.
+    fn refine<P: Policy>(
+        &mut self,
+        h: &HierarchyView<'_>,
+        view: &View,
+        policy: &P,
+        budget: &Budget,
+        frame: &mut Frame,
+    ) {
+        let t = frame.threshold;
+        let frames = self.geomorph_frames;
         let mut traded = 0usize;
-        let mut sorted = false;
-        while let Some((bits, v)) = self.candidates.pop() {
-            let Some(s) = self.slot_of.get(v) else {
+        let mut listed = false;
+        while let Some((bits, v)) = self.candidates.heap_pop() {
+            let Some(s) = self.slot(v) else {
                 continue;
             };
-            if ops >= budget.max_ops {
-                stats.ops_limited = true;
+            if frame.ops >= budget.max_ops {
+                frame.stats.ops_limited = true;
                 break;
             }
-            let blend = if self.flags[s as usize] & WAS_VISIBLE != 0 {
+            let blend = if self.v.flags[s as usize] & WAS_VISIBLE != 0 {
                 frames
             } else {
                 0
             };
-            let before = self.node.len();
-            let mut tris = self.tri.len() as u32;
-            let mut spent = ops;
+            let before = self.v.len();
+            let mut tris = self.t.len() as u32;
+            let mut spent = frame.ops;
             // The nodes split (forced ones first): their children are evaluated next (past 64
             // forced splits, the rest wait for the next frame's pass).
             let mut split = [0u32; 64];
             let mut logged = 0usize;
             let result = self.force_split(h, v, blend, &mut |node, added| {
-                if tris.saturating_add(added) > budget.max_triangles {
+                if !budget.admits(tris, added) {
                     Err(Refused::Budget)
                 } else if spent >= budget.max_ops {
                     Err(Refused::Ops)
@@ -403,26 +443,26 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
                     Ok(())
                 }
             });
-            let done = (self.node.len() - before) as u32;
-            stats.vsplits += done;
-            stats.forced += done.saturating_sub(result.is_ok() as u32);
-            ops += done;
+            let done = (self.v.len() - before) as u32;
+            frame.stats.vsplits += done;
+            frame.stats.forced += done.saturating_sub(result.is_ok() as u32);
+            frame.ops += done;
             for &node in &split[..logged] {
-                if self.slot_of.get(node).is_some() {
+                if self.is_active(node) {
                     continue; // refused after all
                 }
                 for c in h.split(node).children {
-                    let Some(cs) = self.slot_of.get(c) else {
+                    let Some(cs) = self.slot(c) else {
                         continue;
                     };
-                    let d = policy.demand(&self.bounds[cs as usize], view);
-                    self.flags[cs as usize] =
-                        (self.flags[cs as usize] & !VISIBLE) | d.visible as u8;
+                    let d = policy.demand(&h.bounds(c), view);
+                    let flags = &mut self.v.flags[cs as usize];
+                    *flags = (*flags & !VISIBLE) | d.visible as u8;
                     if d.error > t
                         && c >= h.leaves()
-                        && self.candidates.push((d.error.to_bits(), c)).is_err()
+                        && self.candidates.heap_push((d.error.to_bits(), c)).is_err()
                     {
-                        stats.queue_overflow = true;
+                        frame.stats.queue_overflow = true;
                     }
                 }
             }
@@ -430,62 +470,44 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
                 Ok(_) => {}
                 Err(Refused::Budget) => {
                     // Make room from the pairs whose parent matters least, if less than this.
-                    if !sorted {
-                        sort_pairs(&mut self.pairs);
-                        sorted = true;
+                    if !listed {
+                        self.list_all_pairs(h, view, policy, &mut frame.stats);
+                        listed = true;
                     }
                     let e = f32::from_bits(bits);
                     let mut freed = false;
-                    while traded < self.pairs.len() && ops < budget.max_ops {
-                        let (pe, p, _) = self.pairs[traded];
-                        if pe >= e {
+                    while traded < self.pairs.len() && frame.ops < budget.max_ops {
+                        let pair = self.pairs.as_slice()[traded];
+                        if pair.error >= e {
                             break;
                         }
                         traded += 1;
-                        if self.collapse_now(h, p) {
-                            stats.ecols += 1;
-                            ops += 1;
+                        if self.collapse_now(h, pair.parent) {
+                            frame.stats.ecols += 1;
+                            frame.ops += 1;
                             freed = true;
-                            if self.tri.len() as u32 + 2 <= budget.max_triangles {
+                            if budget.admits(self.t.len() as u32, 2) {
                                 break;
                             }
                         }
                     }
-                    if freed && self.candidates.push((bits, v)).is_ok() {
+                    if freed && self.candidates.heap_push((bits, v)).is_ok() {
                         continue;
                     }
-                    stats.budget_limited = true;
+                    frame.stats.budget_limited = true;
                     break;
                 }
                 Err(Refused::Capacity) => {
-                    stats.capacity_limited = true;
+                    frame.stats.capacity_limited = true;
                     break;
                 }
                 Err(Refused::Ops) => {
-                    stats.ops_limited = true;
+                    frame.stats.ops_limited = true;
                     break;
                 }
                 Err(_) => {}
             }
         }
-
-        self.enforce_max(h, view, policy, budget, &mut stats);
-        // A cut that shrank gets a smaller node map (faster lookups).
-        self.respan_map(self.node.len());
-
-        // Regulation towards the target triangle count.
-        let tris = self.tri.len() as u32;
-        if budget.target_triangles > 0 {
-            let ratio = tris.max(1) as f32 / budget.target_triangles as f32;
-            if (ratio - 1.0).abs() > budget.target_band {
-                self.threshold = (self.threshold * ratio.clamp(0.5, 2.0)).clamp(1e-6, 1e6);
-            }
-        }
-        stats.triangles = tris;
-        stats.vertices = self.node.len() as u32;
-        stats.threshold = t;
-        stats.blending = self.flags.iter().filter(|&&f| f & BLENDING != 0).count() as u32;
-        stats
     }
 
     /// Collapses the least needed pairs until the cut fits [`Budget::max_triangles`] (after the
@@ -499,26 +521,16 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         stats: &mut FrameStats,
     ) {
         for _ in 0..64 {
-            if self.tri.len() as u32 <= budget.max_triangles {
+            if self.t.len() as u32 <= budget.max_triangles {
                 return;
             }
-            self.pairs.clear();
-            for i in 0..self.node.len() {
-                if let Some(p) = self.pair_parent(i) {
-                    let e = pair_error(policy.demand(&self.parent_bounds[i], view));
-                    if self.pairs.push((e, p, i as u32)).is_err() {
-                        stats.queue_overflow = true;
-                        break;
-                    }
-                }
-            }
-            sort_pairs(&mut self.pairs);
+            self.list_all_pairs(h, view, policy, stats);
             let mut progress = false;
             for k in 0..self.pairs.len() {
-                if self.tri.len() as u32 <= budget.max_triangles {
+                if self.t.len() as u32 <= budget.max_triangles {
                     return;
                 }
-                if self.collapse_now(h, self.pairs[k].1) {
+                if self.collapse_now(h, self.pairs.as_slice()[k].parent) {
                     stats.ecols += 1;
                     stats.budget_ecols += 1;
                     progress = true;
@@ -528,6 +540,6 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
                 break;
             }
         }
-        stats.over_budget = self.tri.len() as u32 > budget.max_triangles;
+        stats.over_budget = self.t.len() as u32 > budget.max_triangles;
     }
 }

@@ -6,7 +6,7 @@
 //! with geomorphs. Behind the `build` feature sits the offline `build`er that turns a triangle
 //! mesh into a vertex hierarchy (it needs `alloc`).
 #![no_std]
-#![forbid(unsafe_code)]
+#![deny(unsafe_code)]
 #![warn(missing_docs)]
 
 #[cfg(feature = "build")]

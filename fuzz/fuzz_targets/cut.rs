@@ -21,7 +21,7 @@ fuzz_target!(|data: &[u8]| {
     let Ok(view) = HierarchyView::parse(&sealed) else {
         return;
     };
-    let mut cut: Box<Cut<256, 512, 64>> = Box::default();
+    let mut cut = Cut::<256, 512, 64>::boxed();
     if cut.reset(&view).is_err() {
         return;
     }

@@ -5,7 +5,9 @@
 
 use std::path::Path;
 
-use vdlod_raster::{draw_indexed, DrawParams, DrawStats, Mesh, Rgba8, ShadedVertex, Target};
+use vdlod_raster::{
+    draw_indexed, DrawParams, DrawStats, Mesh, Rgba8, ShadedVertex, Target, VertexIndex,
+};
 
 /// Background colour of demo frames.
 pub const BACKGROUND: Rgba8 = Rgba8([24, 26, 32, 255]);
@@ -92,7 +94,11 @@ impl Frame {
     }
 
     /// Clears to [`BACKGROUND`] and draws `mesh`.
-    pub fn draw(&mut self, mesh: &Mesh<'_>, params: &DrawParams) -> Result<DrawStats, FrameError> {
+    pub fn draw<I: VertexIndex>(
+        &mut self,
+        mesh: &Mesh<'_, I>,
+        params: &DrawParams,
+    ) -> Result<DrawStats, FrameError> {
         if self.scratch.len() < mesh.positions.len() {
             self.scratch
                 .resize(mesh.positions.len(), ShadedVertex::default());

@@ -7,10 +7,10 @@ use std::path::Path;
 use std::time::Instant;
 
 use vdlod_core::adapt::{Budget, FrameStats};
-use vdlod_core::cut::{Coloring, Cut};
+use vdlod_core::cut::{Coloring, Cut, SlotIndex};
 use vdlod_core::format::HierarchyView;
 use vdlod_core::policy::{Frustum, Importance, MergeTree, Policy, QRefine, ScreenError, View};
-use vdlod_raster::{Mesh, Rgba8, Shading};
+use vdlod_raster::{Mesh, Rgba8, Shading, VertexIndex};
 
 use crate::camera::{Camera, Orbit};
 use crate::frame::{encode_png, Frame, FrameError};
@@ -19,24 +19,12 @@ use crate::mesh::{vertex_normals, Bounds, IndexedMesh};
 use crate::render::camera_params;
 
 /// The cut the demo uses: up to 262,144 active vertices and 524,288 triangles (a fully refined
-/// Loop-subdivided bunny fits), 32,768 queue entries; about 48 MB.
-pub type DemoCut = Cut<{ 1 << 18 }, { 1 << 19 }, { 1 << 15 }>;
+/// Loop-subdivided bunny fits), 32,768 queue entries, 32-bit indices; about 28 MB.
+pub type DemoCut = Cut<{ 1 << 18 }, { 1 << 19 }, { 1 << 15 }, u32>;
 
-/// A cut on the heap. The demo's cut is too large for a thread's default stack, so call this
-/// (and run the demo) on a thread with a large stack, as `main` does.
+/// A cut on the heap, made there directly (never on the stack).
 pub fn new_cut() -> Box<DemoCut> {
-    Box::default()
-}
-
-/// Runs `f` on a thread with a 1 GiB stack (reserved, not used: pages are touched only as
-/// needed), so that cuts of any capacity can be built by value.
-pub fn with_large_stack<T: Send + 'static>(f: impl FnOnce() -> T + Send + 'static) -> T {
-    std::thread::Builder::new()
-        .stack_size(1 << 30)
-        .spawn(f)
-        .expect("spawning a thread")
-        .join()
-        .unwrap_or_else(|e| std::panic::resume_unwind(e))
+    DemoCut::boxed()
 }
 
 /// Which policy decides where detail goes.
@@ -152,7 +140,7 @@ pub fn full_detail(h: &HierarchyView<'_>, cut: &mut DemoCut) -> Result<IndexedMe
     let triangles: Vec<[u32; 3]> = cut
         .triangles()
         .iter()
-        .map(|t| t.map(|s| nodes[s as usize]))
+        .map(|t| t.map(|s| nodes[s.index()]))
         .collect();
     if triangles.iter().flatten().any(|&v| v >= h.leaves()) {
         return Err("the cut holds too little for full detail".into());
@@ -214,17 +202,49 @@ pub fn make_policy(choice: PolicyChoice) -> Box<dyn Policy + Send> {
     }
 }
 
-/// The cut as a rasterizer mesh (no copy).
-pub fn cut_mesh<const V: usize, const F: usize, const Q: usize>(
-    cut: &Cut<V, F, Q>,
-    colors: bool,
-) -> Mesh<'_> {
-    Mesh {
-        positions: cut.positions(),
-        normals: Some(cut.normals()),
-        colors: colors.then(|| cut.colors()),
-        triangles: cut.triangles(),
-        face_colors: None,
+/// The cut's vertices as drawn this frame, gathered from the hierarchy into host arrays for the
+/// rasterizer's slices.
+#[derive(Clone, Debug, Default)]
+pub struct CutVertices {
+    /// Positions by slot.
+    pub positions: Vec<[f32; 3]>,
+    /// Normals by slot.
+    pub normals: Vec<[f32; 3]>,
+    /// Colours by slot.
+    pub colors: Vec<[u8; 3]>,
+}
+
+impl CutVertices {
+    /// Reads every active vertex of `cut` (see [`Cut::vertex`]).
+    pub fn gather<const V: usize, const F: usize, const Q: usize, I: SlotIndex>(
+        &mut self,
+        cut: &Cut<V, F, Q, I>,
+        h: &HierarchyView<'_>,
+    ) {
+        self.positions.clear();
+        self.normals.clear();
+        self.colors.clear();
+        for s in 0..cut.vertex_count() {
+            let v = cut.vertex(h, s);
+            self.positions.push(v.position);
+            self.normals.push(v.normal);
+            self.colors.push(v.color);
+        }
+    }
+
+    /// The cut as a rasterizer mesh over these vertices.
+    pub fn mesh<'a, const V: usize, const F: usize, const Q: usize, I: SlotIndex + VertexIndex>(
+        &'a self,
+        cut: &'a Cut<V, F, Q, I>,
+        colors: bool,
+    ) -> Mesh<'a, I> {
+        Mesh {
+            positions: &self.positions,
+            normals: Some(&self.normals),
+            colors: colors.then_some(&self.colors[..]),
+            triangles: cut.triangles(),
+            face_colors: None,
+        }
     }
 }
 
@@ -410,9 +430,9 @@ fn captioned(
 }
 
 /// Writes the cut's mesh as an OBJ file (positions as blended, 1-based faces).
-pub fn write_obj(path: &Path, cut: &DemoCut) -> std::io::Result<()> {
-    let mut s = String::with_capacity(cut.vertices() * 40 + cut.triangles().len() * 24);
-    for p in cut.positions() {
+pub fn write_obj(path: &Path, cut: &DemoCut, h: &HierarchyView<'_>) -> std::io::Result<()> {
+    let mut s = String::with_capacity(cut.vertex_count() * 40 + cut.triangles().len() * 24);
+    for p in (0..cut.vertex_count()).map(|i| cut.vertex(h, i).position) {
         let _ = writeln!(s, "v {} {} {}", p[0], p[1], p[2]);
     }
     for t in cut.triangles() {
@@ -492,6 +512,7 @@ pub fn run_orbit(
         "frame,triangles,vsplits,ecols,adapt_us,render_us,full_render_us,psnr_db,vertices,forced,blending,threshold,budget_limited\n",
     );
     let mut frames = Vec::with_capacity(opts.frames as usize);
+    let mut vertices = CutVertices::default();
     let compared = opts.frames / 2;
     for i in 0..opts.frames {
         let camera = orbit.camera(i);
@@ -501,8 +522,9 @@ pub fn run_orbit(
         let adapt_us = start.elapsed().as_secs_f64() * 1e6;
         let params = camera_params(&camera, frame.aspect(), Shading::Gouraud, false);
         let start = Instant::now();
+        vertices.gather(&cut, &h);
         frame
-            .draw(&cut_mesh(&cut, true_colors), &params)
+            .draw(&vertices.mesh(&cut, true_colors), &params)
             .map_err(|e| e.to_string())?;
         let render_us = start.elapsed().as_secs_f64() * 1e6;
         let start = Instant::now();
@@ -536,7 +558,7 @@ pub fn run_orbit(
             };
             let drawn = camera_params(&seen_from, frame.aspect(), Shading::Gouraud, opts.wireframe);
             frame
-                .draw(&cut_mesh(&cut, colors), &drawn)
+                .draw(&vertices.mesh(&cut, colors), &drawn)
                 .map_err(|e| e.to_string())?;
         }
         if opts.write_frames {
@@ -545,7 +567,7 @@ pub fn run_orbit(
                 .map_err(|e| e.to_string())?;
         }
         if opts.dump_mesh {
-            write_obj(&out_dir.join(format!("mesh_{i:04}.obj")), &cut).map_err(io)?;
+            write_obj(&out_dir.join(format!("mesh_{i:04}.obj")), &cut, &h).map_err(io)?;
         }
         let _ = writeln!(
             csv,

@@ -395,11 +395,6 @@ fn info(file: PathBuf) -> Result<(), String> {
 }
 
 fn main() -> ExitCode {
-    // The cut's arenas are built by value: give them a large stack.
-    lod::with_large_stack(run)
-}
-
-fn run() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Some(Command::Orbit(args)) => orbit_command(args),

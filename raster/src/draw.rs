@@ -20,9 +20,31 @@ use crate::vertex::{
 };
 use crate::wire::draw_line;
 
-/// Borrowed mesh data: per-vertex arrays of equal length and triangles indexing them.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct Mesh<'a> {
+/// A vertex index type of [`Mesh::triangles`]: `u32`, or `u16` for meshes of up to 65,535
+/// vertices (as a 16-bit cut hands them out).
+pub trait VertexIndex: Copy + core::fmt::Debug {
+    /// The index as a `u32`.
+    fn to_u32(self) -> u32;
+}
+
+impl VertexIndex for u16 {
+    #[inline(always)]
+    fn to_u32(self) -> u32 {
+        self as u32
+    }
+}
+
+impl VertexIndex for u32 {
+    #[inline(always)]
+    fn to_u32(self) -> u32 {
+        self
+    }
+}
+
+/// Borrowed mesh data: per-vertex arrays of equal length and triangles indexing them (with
+/// `u32` or `u16` indices).
+#[derive(Clone, Copy, Debug)]
+pub struct Mesh<'a, I: VertexIndex = u32> {
     /// Object-space positions.
     pub positions: &'a [[f32; 3]],
     /// Object-space vertex normals (needed by [`Shading::Gouraud`]).
@@ -30,10 +52,22 @@ pub struct Mesh<'a> {
     /// Per-vertex colours; [`DrawParams::base_color`] is used without them.
     pub colors: Option<&'a [[u8; 3]]>,
     /// Triangles, counter-clockwise when seen from the front.
-    pub triangles: &'a [[u32; 3]],
+    pub triangles: &'a [[I; 3]],
     /// Per-triangle colours that replace the vertex or base colour (for example a false colour by
     /// hierarchy depth); lighting still applies.
     pub face_colors: Option<&'a [[u8; 3]]>,
+}
+
+impl<I: VertexIndex> Default for Mesh<'_, I> {
+    fn default() -> Self {
+        Mesh {
+            positions: &[],
+            normals: None,
+            colors: None,
+            triangles: &[],
+            face_colors: None,
+        }
+    }
 }
 
 /// How colour is spread over a triangle.
@@ -175,7 +209,11 @@ fn check_len(attribute: &'static str, expected: usize, actual: usize) -> Result<
     }
 }
 
-fn validate(mesh: &Mesh<'_>, params: &DrawParams, scratch: usize) -> Result<(), DrawError> {
+fn validate<I: VertexIndex>(
+    mesh: &Mesh<'_, I>,
+    params: &DrawParams,
+    scratch: usize,
+) -> Result<(), DrawError> {
     let n = mesh.positions.len();
     if scratch < n {
         return Err(DrawError::ScratchTooSmall {
@@ -195,7 +233,7 @@ fn validate(mesh: &Mesh<'_>, params: &DrawParams, scratch: usize) -> Result<(), 
         check_len("face_colors", mesh.triangles.len(), faces.len())?;
     }
     for (triangle, tri) in mesh.triangles.iter().enumerate() {
-        if let Some(&index) = tri.iter().find(|&&i| i as usize >= n) {
+        if let Some(index) = tri.map(I::to_u32).into_iter().find(|&i| i as usize >= n) {
             return Err(DrawError::IndexOutOfRange {
                 triangle,
                 index,
@@ -220,7 +258,7 @@ fn rgb_f32(c: [u8; 3]) -> [f32; 3] {
 /// use glam::{Mat4, Vec3};
 /// use vdlod_raster::{draw_indexed, DrawParams, Mesh, Rgba8, ShadedVertex, Shading, Target};
 /// let positions = [[-1.0, -1.0, 0.0], [1.0, -1.0, 0.0], [0.0, 1.0, 0.0]];
-/// let mesh = Mesh { positions: &positions, triangles: &[[0, 1, 2]], ..Mesh::default() };
+/// let mesh = Mesh { positions: &positions, triangles: &[[0u32, 1, 2]], ..Mesh::default() };
 /// let proj = Mat4::perspective_rh(1.0, 1.0, 0.1, 10.0);
 /// let view = Mat4::look_at_rh(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, Vec3::Y);
 /// let params = DrawParams { mvp: proj * view, shading: Shading::Flat, ..DrawParams::default() };
@@ -233,9 +271,9 @@ fn rgb_f32(c: [u8; 3]) -> [f32; 3] {
 /// assert_eq!(stats.rasterized, 1);
 /// assert!(target.color().iter().any(|p| p.0[0] > 0));
 /// ```
-pub fn draw_indexed<P: Pixel>(
+pub fn draw_indexed<P: Pixel, I: VertexIndex>(
     target: &mut Target<'_, P>,
-    mesh: &Mesh<'_>,
+    mesh: &Mesh<'_, I>,
     params: &DrawParams,
     scratch: &mut [ShadedVertex],
 ) -> Result<DrawStats, DrawError> {
@@ -282,6 +320,7 @@ pub fn draw_indexed<P: Pixel>(
         }
     };
     for (t, tri) in mesh.triangles.iter().enumerate() {
+        let tri = &tri.map(I::to_u32);
         // References, not copies: a culled triangle reads only positions and outcodes.
         let v = tri.map(|i| &scratch[i as usize]);
         let union = v[0].outcode | v[1].outcode | v[2].outcode;
@@ -324,6 +363,7 @@ pub fn draw_indexed<P: Pixel>(
     if let Some(wire) = params.wireframe {
         let color = P::from_rgb(wire[0], wire[1], wire[2]);
         for tri in mesh.triangles {
+            let tri = &tri.map(I::to_u32);
             let v = tri.map(|i| scratch[i as usize]);
             let union = v[0].outcode | v[1].outcode | v[2].outcode;
             if union & clip::INVALID != 0 || v[0].outcode & v[1].outcode & v[2].outcode != 0 {
@@ -361,8 +401,8 @@ fn depth_test<P: Pixel>(c: &mut P, d: &mut u32, f: Fragment<'_>) {
 
 /// The colours the three corners of triangle `t` are drawn with.
 #[inline(always)]
-fn triangle_colors(
-    mesh: &Mesh<'_>,
+fn triangle_colors<I: VertexIndex>(
+    mesh: &Mesh<'_, I>,
     params: &DrawParams,
     lighting: Option<&PreparedLighting>,
     t: usize,
@@ -401,10 +441,10 @@ fn triangle_colors(
 }
 
 /// Clips a triangle with its corner colours and calls `f` with each projected piece.
-fn for_each_clipped(
+fn for_each_clipped<I: VertexIndex>(
     viewport: &Viewport,
     params: &DrawParams,
-    mesh: &Mesh<'_>,
+    mesh: &Mesh<'_, I>,
     tri: &[u32; 3],
     colors: [[f32; 3]; 3],
     planes: u8,

@@ -22,7 +22,7 @@
 //!
 //! // A square of two triangles, drawn into a 16-bit panel buffer.
 //! let positions = [[-1.0, -1.0, 0.0], [1.0, -1.0, 0.0], [1.0, 1.0, 0.0], [-1.0, 1.0, 0.0]];
-//! let triangles = [[0, 1, 2], [0, 2, 3]];
+//! let triangles: [[u32; 3]; 2] = [[0, 1, 2], [0, 2, 3]];
 //! let mesh = Mesh { positions: &positions, triangles: &triangles, ..Mesh::default() };
 //! let view = Mat4::look_at_rh(Vec3::new(0.0, 0.0, 4.0), Vec3::ZERO, Vec3::Y);
 //! let proj = Mat4::perspective_rh(0.8, 1.0, 0.5, 10.0);
@@ -47,6 +47,6 @@ pub mod target;
 pub mod vertex;
 pub mod wire;
 
-pub use draw::{draw_indexed, DrawError, DrawParams, DrawStats, Mesh, Shading};
+pub use draw::{draw_indexed, DrawError, DrawParams, DrawStats, Mesh, Shading, VertexIndex};
 pub use target::{Pixel, Rgb565, Rgba8, Target, TargetError, DEPTH_CLEAR, MAX_DIMENSION};
 pub use vertex::{Light, ShadedVertex};

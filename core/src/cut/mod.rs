@@ -2,26 +2,51 @@
 //!
 //! A [`Cut`] holds one triangle mesh whose vertices are hierarchy nodes, starting from the base
 //! mesh. A vertex split replaces an active node by its two children and adds the one or two
-//! triangles its collapse removed; an edge collapse undoes that. Both use Hoppe's rule, which the
-//! file stores per split as the four neighbour triangles `fn0..fn3` ([`crate::format`]): a split
-//! is legal when those triangles exist, a collapse when they are still next to the two triangles
-//! it removes. [`Cut::force_split`] makes a split legal by first splitting, recursively, whatever
-//! must exist (the merge-tree paper's forced refinement, §3.6), so detail that is asked for is
-//! never lost. The mesh stays a manifold with the input's topology and orientation after every
-//! operation; [`Cut::check`] proves it in tests.
+//! triangles its collapse removed; an edge collapse undoes that. Both use the legality rule of
+//! Hoppe ("View-dependent refinement of progressive meshes", SIGGRAPH 1997), which the file stores
+//! per split as the four neighbour triangles `fn0..fn3` ([`crate::format`]): a split is legal
+//! when those triangles exist ([`Cut::split`]), a collapse when they are still next to the two
+//! triangles it removes ([`Cut::collapse`]). [`Cut::force_split`] makes a split legal by first
+//! splitting whatever must exist (the forced refinement of Berkey and Song's merge-tree paper,
+//! §3.6, done with a stack rather than recursion), so detail that is asked for is never lost. The
+//! mesh stays a manifold with the input's topology and orientation after every operation;
+//! [`Cut::check`] proves it (Hoppe's `ok()`).
 //!
-//! Storage is plain arrays of `u32` slots (structure of arrays), with capacities in the type:
-//! `V` active vertices, `F` active triangles, `Q` entries of each work queue. The triangle slice is
-//! what the rasterizer draws ([`Cut::triangles`]), and the position, normal and colour slices are
-//! indexed by the same vertex slots, so drawing a cut copies nothing. Nothing allocates, nothing
-//! panics on any hierarchy [`HierarchyView::parse`] accepted: an operation that would overflow a
-//! capacity is refused and counted instead.
+//! The rooms: [`slot`] (index widths and the queue arena), [`store`] (vertex and triangle
+//! records), `fan` (walks around a vertex), `split`, `collapse`, `blend` (geomorph state and the
+//! vertex output), `check` (the invariants).
 //!
-//! Memory: [`Cut::BYTES`] = 165 bytes per vertex slot (node, a triangle of its fan and their number, cached
-//! bounds, parent, sibling and the parent's bounds, position, normal, colours, flags, blend state), 36 per triangle slot (corners,
-//! neighbours, id, and a node-map entry) and 24 per queue entry, plus a few words; asserted in
-//! the tests. A closed mesh has about two triangles per vertex, so `F = 2 V` and
-//! `Q = V / 4` cost about 240 bytes per active vertex.
+//! # Memory
+//!
+//! Capacities are in the type: `V` vertex slots, `F` triangle slots, `Q` entries of each work
+//! queue (and of the blend arena), and `I` the stored index ([`SlotIndex`]: `u16`, the default,
+//! for `V` and `F` below 65,535; `u32` above). Nothing else is kept: positions, normals, colours
+//! and bounds are read from the hierarchy in place, a vertex's family from its sibling link.
+//! [`Cut::BYTES`] is, with `i` the index size (2 or 4 bytes), the same on 32- and 64-bit
+//! targets (all lengths are `u32`):
+//!
+//! | per | bytes | what |
+//! |---|---|---|
+//! | vertex slot | `4 + 3i + 3` (13 with `u16`) | node, fan triangle, mate, blend entry; triangle count (`u16`) and flags (`u8`) |
+//! | triangle slot | `6i + 4 + i` (18 with `u16`) | corners, neighbours, id; one node-map entry |
+//! | queue entry | `4 + 8 + 12 + 28 = 52` | forcing stack, split heap, collapse pairs, blend arena |
+//!
+//! plus 40 bytes of lengths and settings. With the recommended `F = 2 V` and `Q = V / 8` that is
+//! 13 + 36 + 6.5 = 55.5 bytes per vertex slot, **27.75 bytes per triangle of capacity** with `u16`
+//! (49.5 with `u32`). A cut for a 10,000-triangle budget, `Cut<5120, 10240, 640>`, is 284,200
+//! bytes. The queues only bound how much one frame can do: when one overflows, the rest waits for
+//! the next frame and [`crate::adapt::FrameStats`] says so.
+//!
+//! [`Cut::new`] is `const` and all zeros, so `static CUT: Mutex<RefCell<Cut<..>>>` lands in
+//! `.bss` and never passes through the stack; [`Cut::boxed`] (feature `build`) puts one on the heap
+//! the same way.
+//!
+//! # Determinism
+//!
+//! The cut is a function of the hierarchy, the sequence of calls and the capacities: the same
+//! inputs give the same cut, bit for bit, on every target. When no capacity, queue, budget or
+//! operation limit binds, the capacities do not matter; when one binds, the cut stays coarser
+//! where the limit was met, so frames are identical across machines for the same capacities.
 //!
 //! ```
 //! # #[cfg(feature = "build")] {
@@ -46,12 +71,32 @@
 
 use core::fmt;
 
-use heapless::binary_heap::{BinaryHeap, Max};
-use heapless::Vec;
-
-use crate::format::{HierarchyView, NodeView, NONE};
+use crate::format::{HierarchyView, NONE};
 use crate::nodemap::NodeMap;
-use crate::policy::Bounds;
+
+mod blend;
+mod check;
+mod collapse;
+mod fan;
+pub mod slot;
+mod split;
+mod store;
+
+pub(crate) use blend::Blend;
+pub use blend::VertexOut;
+pub use check::Defect;
+pub(crate) use fan::PairFans;
+pub use fan::MAX_FAN;
+pub use slot::SlotIndex;
+
+use slot::Arena;
+use store::{Triangles, Vertices};
+
+// The documented figure, checked when the crate is compiled for any target (CI builds it for
+// x86_64 and a 32-bit Cortex-M): a cut for a 10,000-triangle budget with the recommended
+// capacities is 284,200 bytes, at most 32 bytes per triangle of capacity.
+const _: () = assert!(Cut::<5120, 10240, 640>::BYTES == 284_200);
+const _: () = assert!(Cut::<5120, 10240, 640>::BYTES <= 32 * 10240);
 
 /// A slot that holds nothing (no neighbour across a border edge, no incident triangle).
 pub const NIL: u32 = u32::MAX;
@@ -63,18 +108,12 @@ pub(crate) const WAS_VISIBLE: u8 = 2;
 /// Vertex flag, set on both children: their collapse was found illegal, and nothing around
 /// them has collapsed since (a collapse clears it on its fan), so it is not retried.
 pub(crate) const BLOCKED: u8 = 4;
-/// Vertex flag: a geomorph runs (its blend state has frames left).
+/// Vertex flag: a geomorph runs (its blend entry has frames left).
 pub(crate) const BLENDING: u8 = 8;
 /// Vertex flag: the geomorph runs towards the parent, for a collapse.
 pub(crate) const COLLAPSING: u8 = 16;
-
-/// Longest fan walked around one vertex; a hierarchy with larger vertex degrees is refused
-/// rather than walked forever.
-pub const MAX_FAN: usize = 1024;
-
-/// The triangles around the two vertices of a collapse, found while proving it legal and used
-/// again to do it.
-pub(crate) type PairFans = [Vec<u32, MAX_FAN>; 2];
+/// Vertex flag: the node is its parent's first child (the one a pair is looked at from).
+pub(crate) const FIRST_CHILD: u8 = 32;
 
 /// Why the cut could not be set up.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -134,91 +173,68 @@ pub enum Refused {
     Inconsistent,
 }
 
-/// What went wrong in [`Cut::check`].
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Defect {
-    /// What is wrong.
-    pub what: &'static str,
-    /// Where: a vertex or triangle slot.
-    pub slot: u32,
-}
-
-/// Blend state of one vertex (see [`crate::adapt`]).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub(crate) struct Morph {
-    pub from_pos: [f32; 3],
-    pub from_normal: [f32; 3],
-    pub from_color: [u8; 3],
-    /// Frames left; 0: not blending.
-    pub left: u16,
-    /// Blending towards the parent, to be collapsed when done.
-    pub collapsing: bool,
-}
-
 /// Colours of the vertices.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[repr(u8)]
 pub enum Coloring {
     /// The nodes' colours from the file.
     #[default]
-    Node,
+    Node = 0,
     /// A false colour by depth in the forest ([`depth_color`]).
-    Depth,
+    Depth = 1,
+}
+
+/// A pair of active siblings, as the adaptation's collapse list keeps it.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct Pair {
+    /// The parent's error (negative when culled, so culled pairs sort first).
+    pub error: f32,
+    /// The parent.
+    pub parent: u32,
+    /// The first child's slot when the pair was listed.
+    pub first: u32,
 }
 
 /// The active mesh; see the module documentation. `V` vertex slots, `F` triangle slots, `Q`
-/// queue entries.
-pub struct Cut<const V: usize, const F: usize, const Q: usize> {
-    // Vertices, by slot.
-    pub(crate) node: Vec<u32, V>,
-    /// One triangle around the vertex (`NIL` for none).
-    pub(crate) fan: Vec<u32, V>,
-    /// Triangles using the vertex, kept by every operation: a fan walk that finds this many
-    /// distinct triangles found them all, which is what makes renaming a vertex complete (and
-    /// the cut safe from hierarchies crafted to contradict the mesh).
-    pub(crate) degree: Vec<u16, V>,
-    pub(crate) bounds: Vec<Bounds, V>,
-    /// The parent, and when this is the parent's first child its sibling and the sibling's
-    /// slot when active (else `NIL`s), so that each pair is looked at once per frame without
-    /// reading the file or the node map.
-    pub(crate) family: Vec<[u32; 3], V>,
-    /// The parent's bounds, for first children (the collapse test reads them every frame).
-    pub(crate) parent_bounds: Vec<Bounds, V>,
-    pub(crate) positions: Vec<[f32; 3], V>,
-    pub(crate) normals: Vec<[f32; 3], V>,
-    pub(crate) colors: Vec<[u8; 3], V>,
-    /// The colour the vertex blends towards (its node's, or the depth colour).
-    pub(crate) tint: Vec<[u8; 3], V>,
-    /// [`VISIBLE`], [`WAS_VISIBLE`], [`BLOCKED`], [`BLENDING`], [`COLLAPSING`]: one byte per
-    /// vertex, so the per-frame pass reads the blend state only of vertices that blend.
-    pub(crate) flags: Vec<u8, V>,
-    pub(crate) morph: Vec<Morph, V>,
-    pub(crate) slot_of: NodeMap<F>,
-    // Triangles, by slot.
-    pub(crate) tri: Vec<[u32; 3], F>,
-    /// `adj[f][k]`: the triangle across edge `tri[f][k] -> tri[f][k + 1]`, or `NIL`.
-    pub(crate) adj: Vec<[u32; 3], F>,
-    /// Triangle ids in the hierarchy's numbering.
-    pub(crate) fid: Vec<u32, F>,
-    // Work queues.
-    pub(crate) stack: Vec<u32, Q>,
-    /// Split candidates: (error bits, node), largest error first.
-    pub(crate) candidates: BinaryHeap<(u32, u32), Max, Q>,
-    /// Collapse candidates: (parent's error, parent, first child's slot when found); the error
-    /// is negative when culled.
-    pub(crate) pairs: Vec<(f32, u32, u32), Q>,
+/// queue entries, indices stored as `I`.
+pub struct Cut<const V: usize, const F: usize, const Q: usize, I: SlotIndex = u16> {
+    pub(crate) v: Vertices<V, I>,
+    pub(crate) t: Triangles<F, I>,
+    pub(crate) map: NodeMap<F, I>,
+    /// Nodes waiting for a forced split, the one on top first.
+    pub(crate) stack: Arena<u32, Q>,
+    /// Split candidates, a max-heap of (error bits, node).
+    pub(crate) candidates: Arena<(u32, u32), Q>,
+    /// Collapse candidates.
+    pub(crate) pairs: Arena<Pair, Q>,
+    /// Running geomorphs.
+    pub(crate) blends: Arena<Blend, Q>,
     pub(crate) coloring: Coloring,
-    pub(crate) threshold: f32,
     pub(crate) geomorph_frames: u16,
+    /// The regulated error threshold; 0 before [`Cut::reset`] (which makes it 1).
+    pub(crate) threshold: f32,
 }
 
-impl<const V: usize, const F: usize, const Q: usize> Default for Cut<V, F, Q> {
+impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> fmt::Debug for Cut<V, F, Q, I> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("Cut")
+            .field("vertices", &self.v.len())
+            .field("triangles", &self.t.len())
+            .field("capacity", &(V, F, Q))
+            .field("bytes", &Self::BYTES)
+            .finish()
+    }
+}
+
+impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Default for Cut<V, F, Q, I> {
     fn default() -> Self {
         Self::new()
     }
 }
 
+/// The corner of `t` holding `v`.
 #[inline]
-fn corner(t: [u32; 3], v: u32) -> Option<usize> {
+pub(crate) fn corner(t: [u32; 3], v: u32) -> Option<usize> {
     if t[0] == v {
         Some(0)
     } else if t[1] == v {
@@ -231,7 +247,7 @@ fn corner(t: [u32; 3], v: u32) -> Option<usize> {
 }
 
 #[inline]
-fn next3(k: usize) -> usize {
+pub(crate) fn next3(k: usize) -> usize {
     if k == 2 {
         0
     } else {
@@ -240,7 +256,7 @@ fn next3(k: usize) -> usize {
 }
 
 #[inline]
-fn prev3(k: usize) -> usize {
+pub(crate) fn prev3(k: usize) -> usize {
     if k == 0 {
         2
     } else {
@@ -250,6 +266,7 @@ fn prev3(k: usize) -> usize {
 
 /// The false colour of a forest depth: eight distinct hues, repeating, so that neighbouring
 /// levels always differ.
+#[must_use]
 pub fn depth_color(depth: u16) -> [u8; 3] {
     const PALETTE: [[u8; 3]; 8] = [
         [230, 25, 75],
@@ -264,47 +281,36 @@ pub fn depth_color(depth: u16) -> [u8; 3] {
     PALETTE[depth as usize % PALETTE.len()]
 }
 
-pub(crate) fn bounds_of(n: &NodeView) -> Bounds {
-    Bounds {
-        center: n.position,
-        radius: n.radius,
-        axis: n.normal,
-        cone_sin: n.cone_sin,
-        a2: n.spheroid[0] * n.spheroid[0],
-        b2: n.spheroid[1] * n.spheroid[1],
-    }
-}
-
-impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
+impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, I> {
     /// Bytes of memory the cut occupies: the arenas and queues, nothing else (it allocates
-    /// nothing).
+    /// nothing). See the module documentation for the formula.
     pub const BYTES: usize = core::mem::size_of::<Self>();
 
-    /// An empty cut; [`Cut::reset`] loads a hierarchy's base mesh.
+    /// Fails to compile when a capacity does not fit the index type.
+    const CAPACITY_FITS: () = assert!(
+        V < I::LIMIT && F < I::LIMIT && Q < u32::MAX as usize,
+        "a cut's vertex and triangle capacities must be below 65,535 with u16 indices"
+    );
+
+    /// An empty cut, all zeros; [`Cut::reset`] loads a hierarchy's base mesh.
+    #[must_use]
     pub const fn new() -> Self {
+        let () = Self::CAPACITY_FITS;
         Cut {
-            node: Vec::new(),
-            fan: Vec::new(),
-            degree: Vec::new(),
-            bounds: Vec::new(),
-            family: Vec::new(),
-            parent_bounds: Vec::new(),
-            positions: Vec::new(),
-            normals: Vec::new(),
-            colors: Vec::new(),
-            tint: Vec::new(),
-            flags: Vec::new(),
-            morph: Vec::new(),
-            slot_of: NodeMap::new(),
-            tri: Vec::new(),
-            adj: Vec::new(),
-            fid: Vec::new(),
-            stack: Vec::new(),
-            candidates: BinaryHeap::new(),
-            pairs: Vec::new(),
+            v: Vertices::new(),
+            t: Triangles::new(),
+            map: NodeMap::new(),
+            stack: Arena::new(0),
+            candidates: Arena::new((0, 0)),
+            pairs: Arena::new(Pair {
+                error: 0.0,
+                parent: 0,
+                first: 0,
+            }),
+            blends: Arena::new(Blend::ZERO),
             coloring: Coloring::Node,
-            threshold: 1.0,
             geomorph_frames: 0,
+            threshold: 0.0,
         }
     }
 
@@ -329,49 +335,51 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
             let nodes = h.base_triangle(t);
             let mut slots = [NIL; 3];
             for (k, &n) in nodes.iter().enumerate() {
-                slots[k] = match self.slot_of.get(n) {
+                slots[k] = match self.slot(n) {
                     Some(s) => s,
-                    None => {
-                        let s = self.node.len() as u32;
-                        if !self.push_vertex(h, n, None) {
+                    None => match self.push_vertex(n) {
+                        Some(s) => s,
+                        None => {
                             self.clear();
                             return Err(too_big());
                         }
-                        s
-                    }
+                    },
                 };
             }
-            let f = self.tri.len() as u32;
             // Capacity was checked above.
-            let _ = self.tri.push(slots);
-            let _ = self.adj.push([NIL; 3]);
-            let _ = self.fid.push(t);
+            let Some(f) = self.t.push(slots, [NIL; 3], t) else {
+                self.clear();
+                return Err(too_big());
+            };
             for &s in &slots {
-                if self.fan[s as usize] == NIL {
-                    self.fan[s as usize] = f;
+                if self.v.fan(s as usize) == NIL {
+                    self.v.set_fan(s as usize, f);
                 }
-                self.degree[s as usize] = self.degree[s as usize].saturating_add(1);
+                self.v.degree[s as usize] = self.v.degree[s as usize].saturating_add(1);
             }
         }
-        for v in 0..self.node.len() as u32 {
-            self.link_family(h, v);
+        for s in 0..self.v.len() as u32 {
+            self.link_family(h, s);
         }
         // Adjacency by matching each directed edge with its reverse (the base mesh is small).
-        let n = self.tri.len();
+        let n = self.t.len() as u32;
         for f in 0..n {
+            let tf = self.t.at(f);
             for k in 0..3 {
-                let (a, b) = (self.tri[f][k], self.tri[f][next3(k)]);
+                let (a, b) = (tf[k], tf[next3(k)]);
                 for g in 0..n {
+                    let tg = self.t.at(g);
                     for j in 0..3 {
-                        let (c, d) = (self.tri[g][j], self.tri[g][next3(j)]);
+                        let (c, d) = (tg[j], tg[next3(j)]);
                         let same = g != f && c == a && d == b;
                         let paired = c == b && d == a;
-                        if same || (paired && self.adj[f][k] != NIL && self.adj[f][k] != g as u32) {
+                        let taken = self.t.adj(f)[k];
+                        if same || (paired && taken != NIL && taken != g) {
                             self.clear();
-                            return Err(CutError::BaseNotManifold { triangle: f as u32 });
+                            return Err(CutError::BaseNotManifold { triangle: f });
                         }
                         if paired {
-                            self.adj[f][k] = g as u32;
+                            self.t.set_adj(f, k, g);
                         }
                     }
                 }
@@ -379,788 +387,203 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         }
         // Every vertex's fan must be one edge-connected fan.
         if let Err(d) = self.check_fans() {
-            let triangle = self.fan.get(d.slot as usize).copied().unwrap_or(0);
+            let triangle = self.v.fan(d.slot as usize);
             self.clear();
-            return Err(CutError::BaseNotManifold { triangle });
+            return Err(CutError::BaseNotManifold {
+                triangle: if triangle == NIL { 0 } else { triangle },
+            });
         }
         Ok(())
     }
 
     fn clear(&mut self) {
-        self.node.clear();
-        self.fan.clear();
-        self.degree.clear();
-        self.bounds.clear();
-        self.family.clear();
-        self.parent_bounds.clear();
-        self.positions.clear();
-        self.normals.clear();
-        self.colors.clear();
-        self.tint.clear();
-        self.flags.clear();
-        self.morph.clear();
-        self.slot_of.clear();
-        self.tri.clear();
-        self.adj.clear();
-        self.fid.clear();
+        self.v.clear();
+        self.t.clear();
+        self.map.reset(NodeMap::<F, I>::span_for(0));
         self.stack.clear();
         self.candidates.clear();
         self.pairs.clear();
+        self.blends.clear();
         self.threshold = 1.0;
     }
 
-    pub(crate) fn tint_of(&self, n: &NodeView) -> [u8; 3] {
-        match self.coloring {
-            Coloring::Node => n.color,
-            Coloring::Depth => depth_color(n.depth),
-        }
+    /// Active vertices.
+    #[must_use]
+    pub fn vertex_count(&self) -> usize {
+        self.v.len()
     }
 
-    /// Fills slot `s`'s family entry, and its first sibling's if `s` holds a second child.
-    fn link_family(&mut self, h: &HierarchyView<'_>, s: u32) {
-        let node = self.node[s as usize];
-        let p = h.parent(node);
-        let mut entry = [NONE, NIL, NIL];
-        let mut pb = Bounds::default();
-        if p != NONE {
-            let [c0, c1] = h.split(p).children;
-            entry[0] = p;
-            if c0 == node {
-                entry[1] = c1;
-                entry[2] = self.slot_of.get(c1).unwrap_or(NIL);
-                pb = h.bounds(p);
-            } else if let Some(x) = self.slot_of.get(c0) {
-                self.family[x as usize][2] = s;
-            }
-        }
-        self.family[s as usize] = entry;
-        self.parent_bounds[s as usize] = pb;
+    /// The node at each vertex slot.
+    #[must_use]
+    pub fn nodes(&self) -> &[u32] {
+        self.v.nodes()
+    }
+
+    /// Triangles over vertex slots, counter-clockwise seen from the front: what the rasterizer
+    /// draws, with [`Cut::vertex`] giving each slot's position, normal and colour.
+    #[must_use]
+    pub fn triangles(&self) -> &[[I; 3]] {
+        self.t.corners()
+    }
+
+    /// The slot of `node` if it is active.
+    #[must_use]
+    pub fn slot(&self, node: u32) -> Option<u32> {
+        self.map.get(node, self.v.nodes())
+    }
+
+    /// Whether `node` is active.
+    #[must_use]
+    pub fn is_active(&self, node: u32) -> bool {
+        self.slot(node).is_some()
     }
 
     /// Whether the vertex at slot `i` is a first child whose sibling is active; then returns
     /// the parent.
     #[inline]
-    pub(crate) fn pair_parent(&self, i: usize) -> Option<u32> {
-        let [p, sibling, slot] = self.family[i];
-        (sibling != NIL && self.node.get(slot as usize) == Some(&sibling)).then_some(p)
+    pub(crate) fn pair_parent(&self, h: &HierarchyView<'_>, i: usize) -> Option<u32> {
+        (self.v.flags[i] & FIRST_CHILD != 0 && self.v.mate(i) != NIL)
+            .then(|| h.parent(self.v.node[i]))
     }
 
-    /// Inserts into the node map, first re-spanning it when the count calls for it.
-    fn map_insert(&mut self, node: u32, slot: u32) -> bool {
-        self.respan_map(self.node.len() + 1);
-        self.slot_of.insert(node, slot)
+    /// Sets slot `s`'s first-child flag and its mate links from the file and the node map.
+    fn link_family(&mut self, h: &HierarchyView<'_>, s: u32) {
+        let i = s as usize;
+        let node = self.v.node[i];
+        let p = h.parent(node);
+        self.v.flags[i] &= !FIRST_CHILD;
+        self.v.set_mate(i, NIL);
+        if p == NONE {
+            return;
+        }
+        let [c0, c1] = h.split(p).children;
+        let sibling = if c0 == node {
+            self.v.flags[i] |= FIRST_CHILD;
+            c1
+        } else {
+            c0
+        };
+        if let Some(m) = self.slot(sibling) {
+            self.v.set_mate(i, m);
+            self.v.set_mate(m as usize, s);
+        }
+    }
+
+    /// Breaks slot `s`'s mate link on both sides.
+    fn unlink_mate(&mut self, s: usize) {
+        let m = self.v.mate(s);
+        if m != NIL {
+            self.v.set_mate(m as usize, NIL);
+        }
+        self.v.set_mate(s, NIL);
+    }
+
+    /// Inserts slot `s` into the node map, first re-spanning the map when the count calls for
+    /// it.
+    fn map_insert(&mut self, s: u32) -> bool {
+        self.respan_map(self.v.len());
+        self.map.insert(s, self.v.nodes())
     }
 
     /// Rebuilds the node map over a span fit for `entries` active vertices, if it needs another.
     pub(crate) fn respan_map(&mut self, entries: usize) {
-        if !self.slot_of.should_resize(entries) {
+        if !self.map.should_resize(entries) {
             return;
         }
-        self.slot_of.reset(NodeMap::<F>::span_for(entries));
-        for (s, &n) in self.node.iter().enumerate() {
-            let _ = self.slot_of.insert(n, s as u32);
+        self.map.reset(NodeMap::<F, I>::span_for(entries));
+        for s in 0..self.v.len() as u32 {
+            self.map.insert(s, self.v.nodes());
         }
     }
 
-    /// Appends a vertex for `node`; `false` when full. `start` = the blend it starts with.
-    fn push_vertex(&mut self, h: &HierarchyView<'_>, node: u32, start: Option<Morph>) -> bool {
-        if self.node.is_full() || !self.map_insert(node, self.node.len() as u32) {
-            return false;
+    /// Appends a vertex for `node` (visible, no blend, not linked); its slot, or `None` when
+    /// the arena or the node map is full.
+    fn push_vertex(&mut self, node: u32) -> Option<u32> {
+        let s = self.v.push(node, VISIBLE)?;
+        if !self.map_insert(s) {
+            self.v.pop();
+            return None;
         }
-        let n = h.node(node);
-        let tint = self.tint_of(&n);
-        let _ = self.node.push(node);
-        let _ = self.fan.push(NIL);
-        let _ = self.degree.push(0);
-        let _ = self.bounds.push(bounds_of(&n));
-        let _ = self.family.push([NONE, NIL, NIL]);
-        let _ = self.parent_bounds.push(Bounds::default());
-        let (pos, normal, color, morph) = match start {
-            Some(m) => (m.from_pos, m.from_normal, m.from_color, m),
-            None => (n.position, n.normal, tint, Morph::default()),
-        };
-        let _ = self.positions.push(pos);
-        let _ = self.normals.push(normal);
-        let _ = self.colors.push(color);
-        let _ = self.tint.push(tint);
-        let _ = self.flags.push(VISIBLE | Self::blend_flags(&morph));
-        let _ = self.morph.push(morph);
-        true
+        Some(s)
     }
 
-    fn blend_flags(m: &Morph) -> u8 {
-        (if m.left > 0 { BLENDING } else { 0 }) | (if m.collapsing { COLLAPSING } else { 0 })
-    }
-
-    /// Makes slot `s` hold `node` (in place of the node it held).
-    fn set_vertex(&mut self, h: &HierarchyView<'_>, s: usize, node: u32, start: Option<Morph>) {
-        let n = h.node(node);
-        let tint = self.tint_of(&n);
-        self.slot_of.remove(self.node[s]);
+    /// Makes slot `s` hold `node` in place of the node it held (no blend; links redone).
+    fn rename_vertex(&mut self, h: &HierarchyView<'_>, s: usize, node: u32) {
+        self.map.remove(self.v.node[s], self.v.nodes());
+        self.unlink_mate(s);
+        self.free_blend(s);
+        self.v.node[s] = node;
         // The old entry was removed, so there is room.
-        let _ = self.slot_of.insert(node, s as u32);
-        self.node[s] = node;
-        self.bounds[s] = bounds_of(&n);
-        self.tint[s] = tint;
-        let m = match start {
-            Some(m) => {
-                self.positions[s] = m.from_pos;
-                self.normals[s] = m.from_normal;
-                self.colors[s] = m.from_color;
-                m
-            }
-            None => {
-                self.positions[s] = n.position;
-                self.normals[s] = n.normal;
-                self.colors[s] = tint;
-                Morph::default()
-            }
-        };
-        self.morph[s] = m;
-        self.flags[s] = (self.flags[s] & (VISIBLE | WAS_VISIBLE)) | Self::blend_flags(&m);
+        self.map.insert(s as u32, self.v.nodes());
+        self.v.flags[s] &= VISIBLE | WAS_VISIBLE;
+        self.link_family(h, s as u32);
     }
 
-    /// Active vertices.
-    pub fn vertices(&self) -> usize {
-        self.node.len()
-    }
-
-    /// The node at each vertex slot.
-    pub fn nodes(&self) -> &[u32] {
-        &self.node
-    }
-
-    /// Vertex positions (blended while a geomorph runs), by slot.
-    pub fn positions(&self) -> &[[f32; 3]] {
-        &self.positions
-    }
-
-    /// Unit vertex normals (blended), by slot.
-    pub fn normals(&self) -> &[[f32; 3]] {
-        &self.normals
-    }
-
-    /// Vertex colours (blended; see [`Coloring`]), by slot.
-    pub fn colors(&self) -> &[[u8; 3]] {
-        &self.colors
-    }
-
-    /// Triangles over vertex slots, counter-clockwise seen from the front.
-    pub fn triangles(&self) -> &[[u32; 3]] {
-        &self.tri
-    }
-
-    /// The slot of `node` if it is active.
-    pub fn slot(&self, node: u32) -> Option<u32> {
-        self.slot_of.get(node)
-    }
-
-    /// Whether `node` is active.
-    pub fn is_active(&self, node: u32) -> bool {
-        self.slot_of.get(node).is_some()
-    }
-
-    /// The triangle after `f` going counter-clockwise around vertex `v` (`NIL` at a border).
-    #[inline]
-    fn ccw(&self, f: u32, v: u32) -> Option<u32> {
-        let t = *self.tri.get(f as usize)?;
-        let k = corner(t, v)?;
-        Some(self.adj[f as usize][prev3(k)])
-    }
-
-    /// The triangle before `f` going counter-clockwise around `v` (`NIL` at a border).
-    #[inline]
-    fn cw(&self, f: u32, v: u32) -> Option<u32> {
-        let t = *self.tri.get(f as usize)?;
-        let k = corner(t, v)?;
-        Some(self.adj[f as usize][k])
-    }
-
-    /// Collects `v`'s triangles into `out` and says whether the walk found every triangle that
-    /// uses `v`, each once. Each step of a walk is a function of the triangle it stands on, so a
-    /// walk that comes back to its start (or reaches a border) without exceeding [`MAX_FAN`]
-    /// steps repeats nothing; only the two halves of a border fan can overlap, which is checked,
-    /// and the count must match the vertex's triangle count.
-    fn complete_fan(&self, v: u32, out: &mut Vec<u32, MAX_FAN>) -> bool {
-        out.clear();
-        let Some(&start) = self.fan.get(v as usize) else {
-            return false;
-        };
-        let degree = self
-            .degree
-            .get(v as usize)
-            .map_or(usize::MAX, |&d| d as usize);
-        if start == NIL {
-            return degree == 0;
-        }
-        let mut f = start;
-        loop {
-            if out.push(f).is_err() {
-                return false;
-            }
-            match self.ccw(f, v) {
-                Some(g) if g == start => return out.len() == degree,
-                Some(NIL) => break,
-                Some(g) => f = g,
-                None => return false,
-            }
-        }
-        // A border: the rest lies clockwise of the start, and must not meet the first half.
-        let ccw_part = out.len();
-        let mut g = match self.cw(start, v) {
-            Some(g) => g,
-            None => return false,
-        };
-        while g != NIL {
-            if out[..ccw_part].contains(&g) || out.push(g).is_err() {
-                return false;
-            }
-            g = match self.cw(g, v) {
-                Some(g) => g,
-                None => return false,
-            };
-        }
-        out.len() == degree
-    }
-
-    /// Whether walking `v`'s fan finds every triangle that uses `v`, each once.
-    fn fan_complete(&self, v: u32) -> bool {
-        self.complete_fan(v, &mut Vec::new())
-    }
-
-    /// Points the edge `a -> b` of triangle `f` at `to`.
-    fn set_adj(&mut self, f: u32, a: u32, b: u32, to: u32) -> Option<()> {
-        let t = *self.tri.get(f as usize)?;
-        let k = corner(t, a)?;
-        (t[next3(k)] == b).then_some(())?;
-        self.adj[f as usize][k] = to;
-        Some(())
-    }
-
-    /// Splits active `node` if legal now. On success returns the children's slots.
-    pub fn split(&mut self, h: &HierarchyView<'_>, node: u32) -> Result<[u32; 2], Refused> {
-        self.split_with(h, node, 0)
-    }
-
-    /// Splits `node`; with `frames > 0` its children start at its current (blended) position,
-    /// normal and colour and blend to their own over that many frames.
-    pub(crate) fn split_with(
-        &mut self,
-        h: &HierarchyView<'_>,
-        node: u32,
-        frames: u16,
-    ) -> Result<[u32; 2], Refused> {
-        let ps = self.slot_of.get(node).ok_or(Refused::NotActive)?;
-        if node < h.leaves() {
-            return Err(Refused::NoSuchOperation);
-        }
-        let s = h.split(node);
-        let [c0, c1] = s.children;
-        let n = s.neighbours;
-        let second = s.wings[1] != NONE;
-        // The neighbour triangles must all be around the vertex (whose fan must be whole).
-        let mut fan: Vec<u32, MAX_FAN> = Vec::new();
-        if !self.complete_fan(ps, &mut fan) {
-            return Err(Refused::Inconsistent);
-        }
-        let mut ns = [NIL; 4];
-        for &f in &fan {
-            let id = self.fid[f as usize];
-            for k in 0..4 {
-                if n[k] == id {
-                    ns[k] = f;
+    /// Swap-removes vertex slot `v` (its node already out of the map, its triangles gone or
+    /// renamed). Returns the slot the last vertex moved from, if it moved.
+    fn remove_vertex(&mut self, v: u32) -> Option<u32> {
+        self.unlink_mate(v as usize);
+        self.free_blend(v as usize);
+        let last = self.v.len() as u32 - 1;
+        let moved = (v != last).then(|| {
+            let mut fan = fan::Fan::new_fan();
+            // Proven whole before the collapse that removes `v`.
+            let _ = self.complete_fan(last, &mut fan);
+            for &f in fan.as_slice() {
+                if let Some(k) = corner(self.t.at(f), last) {
+                    self.t.set_corner(f, k, v);
                 }
             }
-        }
-        for k in 0..4 {
-            if n[k] != NONE && ns[k] == NIL {
-                return Err(Refused::Missing(n[k]));
+            let key = self.v.node[last as usize];
+            self.map.repoint(key, v, self.v.nodes());
+            self.v.copy(last as usize, v as usize);
+            let m = self.v.mate(v as usize);
+            if m != NIL {
+                self.v.set_mate(m as usize, v);
             }
-        }
-        let added = 1 + second as usize;
-        if self.node.is_full() || self.tri.len() + added > F {
-            return Err(Refused::Capacity);
-        }
-
-        // Wings, read off the neighbours (the nodes there now may be finer than at formation).
-        let third = |f: u32, v: u32, offset: usize| -> Option<u32> {
-            let t = *self.tri.get(f as usize)?;
-            let k = corner(t, v)?;
-            Some(t[(k + offset) % 3])
-        };
-        // n1 holds c0 -> wl, n2 holds wr -> c0: both still have the parent's slot as c0.
-        let wl = if ns[1] != NIL {
-            third(ns[1], ps, 1)
-        } else {
-            third(ns[0], ps, 2)
-        }
-        .ok_or(Refused::Inconsistent)?;
-        let wr = if !second {
-            NIL
-        } else if ns[2] != NIL {
-            third(ns[2], ps, 2).ok_or(Refused::Inconsistent)?
-        } else {
-            third(ns[3], ps, 1).ok_or(Refused::Inconsistent)?
-        };
-        // Each neighbour pair must meet along the edge the new triangle will take over
-        // (n0: wl -> p, n1: p -> wl, n2: wr -> p, n3: p -> wr), so the new links are mutual.
-        let across = |f: u32, a: u32, b: u32| -> Option<u32> {
-            let t = *self.tri.get(f as usize)?;
-            let k = corner(t, a)?;
-            (t[next3(k)] == b).then(|| self.adj[f as usize][k])
-        };
-        let pairs_meet = |x: u32, y: u32, w: u32| -> bool {
-            // x holds w -> p, y holds p -> w; across each lies the other (or a border).
-            let xy = if x == NIL {
-                true
-            } else {
-                across(x, w, ps) == Some(y)
-            };
-            let yx = if y == NIL {
-                true
-            } else {
-                across(y, ps, w) == Some(x)
-            };
-            xy && yx
-        };
-        if !pairs_meet(ns[0], ns[1], wl) || (second && !pairs_meet(ns[2], ns[3], wr)) {
-            return Err(Refused::Inconsistent);
-        }
-        // The triangles that go to c1: counter-clockwise from n3 to n0, or up to a border and
-        // then clockwise from n0 to the other border (as `Hierarchy::refine_all` does).
-        let mut moved: Vec<u32, MAX_FAN> = Vec::new();
-        let mut reached = false;
-        if ns[3] != NIL {
-            let mut f = ns[3];
-            while f != NIL {
-                moved.push(f).map_err(|_| Refused::Inconsistent)?;
-                if f == ns[0] {
-                    reached = true;
-                    break;
-                }
-                f = self.ccw(f, ps).ok_or(Refused::Inconsistent)?;
-                if f == ns[3] {
-                    return Err(Refused::Inconsistent);
-                }
+            let b = self.v.blend(v as usize);
+            if let Some(entry) = self.blends.as_mut_slice().get_mut(b as usize) {
+                entry.slot = v;
             }
-        }
-        if !reached && ns[0] != NIL {
-            let mut f = ns[0];
-            while f != NIL {
-                if moved.contains(&f) {
-                    return Err(Refused::Inconsistent);
-                }
-                moved.push(f).map_err(|_| Refused::Inconsistent)?;
-                f = self.cw(f, ps).ok_or(Refused::Inconsistent)?;
-            }
-        }
-        if (ns[1] != NIL && moved.contains(&ns[1])) || (ns[2] != NIL && moved.contains(&ns[2])) {
-            return Err(Refused::Inconsistent);
-        }
-
-        // Checks done; from here on nothing fails.
-        let start = (frames > 0).then(|| Morph {
-            from_pos: self.positions[ps as usize],
-            from_normal: self.normals[ps as usize],
-            from_color: self.colors[ps as usize],
-            left: frames,
-            collapsing: false,
+            last
         });
-        let c1s = self.node.len() as u32;
-        let own = self.bounds[ps as usize];
-        let (family, parent_bounds) = (self.family[ps as usize], self.parent_bounds[ps as usize]);
-        self.set_vertex(h, ps as usize, c0, start);
-        if !self.push_vertex(h, c1, start) {
-            // Only the node map can refuse here (the arena was checked): undo.
-            self.set_vertex(h, ps as usize, node, None);
-            self.family[ps as usize] = family;
-            self.parent_bounds[ps as usize] = parent_bounds;
-            return Err(Refused::Capacity);
-        }
-        // The children's family is known: no need to read it from the file.
-        self.family[ps as usize] = [node, c1, c1s];
-        self.parent_bounds[ps as usize] = own;
-        self.family[c1s as usize] = [node, NIL, NIL];
-        for &f in &moved {
-            let t = &mut self.tri[f as usize];
-            if let Some(k) = corner(*t, ps) {
-                t[k] = c1s;
-            }
-        }
-        let m = moved.len() as u16;
-        let d = self.degree[ps as usize];
-        self.degree[ps as usize] = d.saturating_sub(m).saturating_add(added as u16);
-        self.degree[c1s as usize] = m.saturating_add(added as u16);
-        for w in [wl, wr] {
-            if let Some(d) = self.degree.get_mut(w as usize) {
-                *d = d.saturating_add(1);
-            }
-        }
-        let fl = self.tri.len() as u32;
-        let fr = if second { fl + 1 } else { NIL };
-        let _ = self.tri.push([ps, c1s, wl]);
-        let _ = self.adj.push([fr, ns[0], ns[1]]);
-        let _ = self.fid.push(h.split_face(node, false));
-        if second {
-            let _ = self.tri.push([c1s, ps, wr]);
-            let _ = self.adj.push([fl, ns[2], ns[3]]);
-            let _ = self.fid.push(h.split_face(node, true));
-        }
-        if ns[0] != NIL {
-            let _ = self.set_adj(ns[0], wl, c1s, fl);
-        }
-        if ns[1] != NIL {
-            let _ = self.set_adj(ns[1], ps, wl, fl);
-        }
-        if ns[2] != NIL {
-            let _ = self.set_adj(ns[2], wr, ps, fr);
-        }
-        if ns[3] != NIL {
-            let _ = self.set_adj(ns[3], c1s, wr, fr);
-        }
-        self.fan[ps as usize] = fl;
-        self.fan[c1s as usize] = fl;
-        Ok([ps, c1s])
-    }
-
-    /// Splits active `node`, first splitting whatever its split needs (Hoppe's forced split; the
-    /// merge-tree paper's forced refinement, §3.6), each with a blend of `frames` frames.
-    /// `allow` is asked before each split with the node and the number of triangles it adds, and
-    /// answers why not or `Ok` to go on. Returns the splits done; on a refusal the splits done so far stay.
-    pub fn force_split(
-        &mut self,
-        h: &HierarchyView<'_>,
-        node: u32,
-        frames: u16,
-        allow: &mut dyn FnMut(u32, u32) -> Result<(), Refused>,
-    ) -> Result<u32, Refused> {
-        if !self.is_active(node) {
-            return Err(Refused::NotActive);
-        }
-        self.stack.clear();
-        self.stack.push(node).map_err(|_| Refused::Capacity)?;
-        let mut done = 0;
-        // Each round splits once or pushes a coarser node; bounded for crafted files.
-        let mut rounds = 0u32;
-        let limit = h.nodes().saturating_mul(4).saturating_add(64);
-        while let Some(&v) = self.stack.last() {
-            rounds += 1;
-            if rounds > limit {
-                return Err(Refused::Inconsistent);
-            }
-            if !self.is_active(v) {
-                // Either split already (by an earlier forced split), or coarser than the cut
-                // here: then its first active ancestor goes first.
-                let mut a = h.parent(v);
-                let mut steps = 0;
-                while a != NONE && !self.is_active(a) {
-                    a = h.parent(a);
-                    steps += 1;
-                    if steps > h.nodes() {
-                        return Err(Refused::Inconsistent);
-                    }
-                }
-                if a == NONE {
-                    self.stack.pop();
-                } else {
-                    self.stack.push(a).map_err(|_| Refused::Capacity)?;
-                }
-                continue;
-            }
-            let added = if h.split(v).wings[1] != NONE { 2 } else { 1 };
-            allow(v, added)?;
-            match self.split_with(h, v, frames) {
-                Ok(_) => {
-                    done += 1;
-                    self.stack.pop();
-                    if v == node {
-                        return Ok(done);
-                    }
-                }
-                Err(Refused::Missing(face)) => {
-                    let Some(creator) = h.face_creator(face) else {
-                        return Err(Refused::Inconsistent);
-                    };
-                    if self.stack.contains(&creator) {
-                        return Err(Refused::Inconsistent);
-                    }
-                    self.stack.push(creator).map_err(|_| Refused::Capacity)?;
-                }
-                Err(e) => return Err(e),
-            }
-        }
-        Ok(done)
-    }
-
-    /// Collapses active siblings into their parent `node` if Hoppe's condition holds. Returns the
-    /// parent's slot.
-    pub fn collapse(&mut self, h: &HierarchyView<'_>, node: u32) -> Result<u32, Refused> {
-        let mut fans = PairFans::default();
-        let ok = self.collapse_legal(h, node, &mut fans)?;
-        Ok(self.collapse_unchecked(h, node, ok, &fans))
-    }
-
-    /// The slots `[a, b, fl, fr]` of a legal collapse of `node`.
-    pub(crate) fn collapse_legal(
-        &self,
-        h: &HierarchyView<'_>,
-        node: u32,
-        fans: &mut PairFans,
-    ) -> Result<[u32; 4], Refused> {
-        if node < h.leaves() || node >= h.nodes() {
-            return Err(Refused::NoSuchOperation);
-        }
-        let s = h.split(node);
-        let [c0, c1] = s.children;
-        let a = self.slot_of.get(c0).ok_or(Refused::NotActive)?;
-        let b = self.slot_of.get(c1).ok_or(Refused::NotActive)?;
-        self.collapse_legal_at(h, node, &s, a, b, fans)
-    }
-
-    /// [`Cut::collapse_legal`] with the children's slots `a` and `b` known.
-    pub(crate) fn collapse_legal_at(
-        &self,
-        h: &HierarchyView<'_>,
-        node: u32,
-        s: &crate::format::SplitView,
-        a: u32,
-        b: u32,
-        fans: &mut PairFans,
-    ) -> Result<[u32; 4], Refused> {
-        let [fan_a, fan_b] = fans;
-        if !self.complete_fan(a, fan_a) {
-            return Err(Refused::Inconsistent);
-        }
-        let id = h.split_face(node, false);
-        let fl = fan_a
-            .iter()
-            .copied()
-            .find(|&f| self.fid[f as usize] == id)
-            .ok_or(Refused::Illegal)?;
-        let t = self.tri[fl as usize];
-        let k = corner(t, a).ok_or(Refused::Inconsistent)?;
-        if t[next3(k)] != b {
-            return Err(Refused::Inconsistent);
-        }
-        let adj = self.adj[fl as usize];
-        let id = |f: u32| {
-            if f == NIL {
-                NONE
-            } else {
-                self.fid[f as usize]
-            }
-        };
-        // fl = (a, b, wl): edge b -> wl has n0, edge wl -> a has n1.
-        if id(adj[next3(k)]) != s.neighbours[0] || id(adj[prev3(k)]) != s.neighbours[1] {
-            return Err(Refused::Illegal);
-        }
-        let fr = adj[k];
-        if s.wings[1] != NONE {
-            let Some(&t) = self.tri.get(fr as usize) else {
-                return Err(Refused::Illegal);
-            };
-            if self.fid[fr as usize] != h.split_face(node, true) {
-                return Err(Refused::Illegal);
-            }
-            let j = corner(t, b).ok_or(Refused::Inconsistent)?;
-            if t[next3(j)] != a {
-                return Err(Refused::Inconsistent);
-            }
-            // fr = (b, a, wr): edge a -> wr has n2, edge wr -> b has n3.
-            let adj = self.adj[fr as usize];
-            if id(adj[next3(j)]) != s.neighbours[2] || id(adj[prev3(j)]) != s.neighbours[3] {
-                return Err(Refused::Illegal);
-            }
-        } else if fr != NIL {
-            return Err(Refused::Inconsistent);
-        }
-        // Renaming b and moving the last vertex into b's slot must reach every triangle.
-        let last = self.node.len() as u32 - 1;
-        if !self.complete_fan(b, fan_b) || !self.fan_complete(last) {
-            return Err(Refused::Inconsistent);
-        }
-        Ok([a, b, fl, fr])
-    }
-
-    /// Performs a collapse [`Cut::collapse_legal`] approved, with the fans it found; returns the
-    /// parent's slot.
-    pub(crate) fn collapse_unchecked(
-        &mut self,
-        h: &HierarchyView<'_>,
-        node: u32,
-        [a, b, fl, fr]: [u32; 4],
-        [fan_a, fan_b]: &PairFans,
-    ) -> u32 {
-        // Collapses around here may become legal: clear the marks on every corner of the
-        // triangles around both vertices (the parent's fan and its neighbours).
-        for &f in fan_a.iter().chain(fan_b.iter()) {
-            for v in self.tri[f as usize] {
-                self.flags[v as usize] &= !BLOCKED;
-            }
-        }
-        // The removed triangles' corners lose one triangle each; then b's become a's.
-        for f in [fl, fr] {
-            if let Some(t) = self.tri.get(f as usize).copied() {
-                for v in t {
-                    if let Some(d) = self.degree.get_mut(v as usize) {
-                        *d = d.saturating_sub(1);
-                    }
-                }
-            }
-        }
-        let db = self.degree[b as usize];
-        self.degree[a as usize] = self.degree[a as usize].saturating_add(db);
-        self.degree[b as usize] = 0;
-        for &f in fan_b.iter() {
-            if f == fl || f == fr {
-                continue;
-            }
-            if let Some(k) = corner(self.tri[f as usize], b) {
-                self.tri[f as usize][k] = a;
-            }
-        }
-        // The neighbours of each removed triangle become each other's.
-        let mut new_fan = NIL;
-        for f in [fl, fr] {
-            if f == NIL {
-                continue;
-            }
-            let t = self.tri[f as usize];
-            let adj = self.adj[f as usize];
-            // The third corner w and the neighbours across its two edges.
-            let j = (0..3).find(|&j| t[j] != a && t[j] != b).unwrap_or(0);
-            let w = t[j];
-            let (x, y) = (adj[j], adj[prev3(j)]);
-            for (p, q) in [(x, y), (y, x)] {
-                if p != NIL {
-                    for e in self.adj[p as usize].iter_mut() {
-                        if *e == f {
-                            *e = q;
-                        }
-                    }
-                }
-            }
-            let keep = if x != NIL { x } else { y };
-            if let Some(fw) = self.fan.get_mut(w as usize) {
-                if *fw == fl || *fw == fr {
-                    *fw = keep;
-                }
-            }
-            if new_fan == NIL {
-                new_fan = keep;
-            }
-        }
-        self.fan[a as usize] = new_fan;
-        // Remove the triangles, the higher slot first so the lower stays where it is.
-        let (hi, lo) = if fr != NIL && fr > fl {
-            (fr, fl)
-        } else {
-            (fl, fr)
-        };
-        self.remove_triangle(hi);
-        if lo != NIL {
-            self.remove_triangle(lo);
-        }
-        self.set_vertex(h, a as usize, node, None);
-        self.link_family(h, a);
-        self.slot_of.remove(self.node[b as usize]);
-        self.remove_vertex(h, b)
-            .map(|moved_to| if moved_to == a { b } else { a })
-            .unwrap_or(a)
+        self.v.pop();
+        moved
     }
 
     /// Swap-removes triangle slot `f`, re-pointing whatever pointed at the moved one.
     fn remove_triangle(&mut self, f: u32) {
-        let last = self.tri.len() as u32 - 1;
+        let last = self.t.len() as u32 - 1;
         if f != last {
-            let t = self.tri[last as usize];
-            let adj = self.adj[last as usize];
-            for g in adj {
-                if let Some(ga) = self.adj.get_mut(g as usize) {
-                    for e in ga.iter_mut() {
-                        if *e == last {
-                            *e = f;
-                        }
+            let t = self.t.at(last);
+            for g in self.t.adj(last) {
+                if g == NIL || g >= self.t.len() as u32 {
+                    continue;
+                }
+                for k in 0..3 {
+                    if self.t.adj(g)[k] == last {
+                        self.t.set_adj(g, k, f);
                     }
                 }
             }
             for v in t {
-                if let Some(fv) = self.fan.get_mut(v as usize) {
-                    if *fv == last {
-                        *fv = f;
-                    }
+                if self.v.fan(v as usize) == last {
+                    self.v.set_fan(v as usize, f);
                 }
             }
-            self.tri[f as usize] = t;
-            self.adj[f as usize] = adj;
-            self.fid[f as usize] = self.fid[last as usize];
+            self.t.copy(last, f);
         }
-        self.tri.pop();
-        self.adj.pop();
-        self.fid.pop();
-    }
-
-    /// Swap-removes vertex slot `v` (its node is already out of the map). Returns the slot the
-    /// last vertex moved from, if it moved.
-    fn remove_vertex(&mut self, h: &HierarchyView<'_>, v: u32) -> Option<u32> {
-        let last = self.node.len() as u32 - 1;
-        let moved = (v != last).then(|| {
-            let mut fan: Vec<u32, MAX_FAN> = Vec::new();
-            // Proven whole before the collapse that removes `v`.
-            let _ = self.complete_fan(last, &mut fan);
-            for &f in &fan {
-                if let Some(k) = corner(self.tri[f as usize], last) {
-                    self.tri[f as usize][k] = v;
-                }
-            }
-            let i = v as usize;
-            let j = last as usize;
-            self.node[i] = self.node[j];
-            self.fan[i] = self.fan[j];
-            self.degree[i] = self.degree[j];
-            self.bounds[i] = self.bounds[j];
-            self.family[i] = self.family[j];
-            self.parent_bounds[i] = self.parent_bounds[j];
-            self.positions[i] = self.positions[j];
-            self.normals[i] = self.normals[j];
-            self.colors[i] = self.colors[j];
-            self.tint[i] = self.tint[j];
-            self.flags[i] = self.flags[j];
-            self.morph[i] = self.morph[j];
-            let _ = self.slot_of.insert(self.node[i], v);
-            // A second child tells its first sibling where it went.
-            let [p, sibling, _] = self.family[i];
-            if p != NONE && sibling == NIL {
-                let c0 = h.split(p).children[0];
-                if let Some(x) = self.slot_of.get(c0) {
-                    self.family[x as usize][2] = v;
-                }
-            }
-            last
-        });
-        self.node.pop();
-        self.fan.pop();
-        self.degree.pop();
-        self.bounds.pop();
-        self.family.pop();
-        self.parent_bounds.pop();
-        self.positions.pop();
-        self.normals.pop();
-        self.colors.pop();
-        self.tint.pop();
-        self.flags.pop();
-        self.morph.pop();
-        moved
+        self.t.pop();
     }
 
     /// Splits every active vertex that has children, once (children are not split again in the
     /// same call); returns the splits done. Repeat until it returns 0 for full detail.
     pub fn refine_everything(&mut self, h: &HierarchyView<'_>) -> u32 {
         let mut done = 0;
+        let n = self.v.len();
         let mut i = 0;
-        let n = self.node.len();
-        while i < n.min(self.node.len()) {
-            let v = self.node[i];
+        while i < n.min(self.v.len()) {
+            let v = self.v.node[i];
             if v >= h.leaves() {
                 if let Ok(k) = self.force_split(h, v, 0, &mut |_, _| Ok(())) {
                     done += k;
@@ -1170,80 +593,31 @@ impl<const V: usize, const F: usize, const Q: usize> Cut<V, F, Q> {
         }
         done
     }
+}
 
-    /// Every vertex's fan walk finds all its triangles, each once, and the counts add up to
-    /// three corners per triangle: each vertex's triangles form one fan (a manifold).
-    fn check_fans(&self) -> Result<(), Defect> {
-        let mut corners = 0usize;
-        for v in 0..self.node.len() as u32 {
-            if !self.fan_complete(v) {
-                return Err(Defect {
-                    what: "a vertex's triangles are not one fan, or its count is wrong",
-                    slot: v,
-                });
+#[cfg(feature = "build")]
+impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, I> {
+    /// An empty cut on the heap, made there directly (a large cut never passes through the
+    /// stack, as `Box::new(Cut::new())` may).
+    #[must_use]
+    #[allow(unsafe_code)]
+    pub fn boxed() -> alloc::boxed::Box<Self> {
+        let () = Self::CAPACITY_FITS;
+        let layout = core::alloc::Layout::new::<Self>();
+        // SAFETY: a cut is never zero-sized (it holds its lengths), so `alloc_zeroed` may be
+        // called with its layout; a null result is handed to `handle_alloc_error`. Every field of
+        // a cut, recursively, is an integer, a float, a `bool`, an array of those or `Coloring`
+        // (`repr(u8)`, 0 = `Node`), for all of which the all-zero bytes are a valid value, and
+        // all zeros is exactly the state `Cut::new` builds (lengths 0, threshold 0, colouring
+        // `Node`; the test `boxed_is_new` compares them); so the pointer is a valid, owned
+        // `Self` allocated with the global allocator and `Self`'s layout, as `Box` requires.
+        unsafe {
+            let p = alloc::alloc::alloc_zeroed(layout).cast::<Self>();
+            if p.is_null() {
+                alloc::alloc::handle_alloc_error(layout);
             }
-            corners += self.degree[v as usize] as usize;
+            alloc::boxed::Box::from_raw(p)
         }
-        if corners != 3 * self.tri.len() {
-            return Err(Defect {
-                what: "triangle counts do not add up",
-                slot: 0,
-            });
-        }
-        Ok(())
-    }
-
-    /// Verifies the cut: slots in range, adjacency symmetric along reversed edges (consistent
-    /// orientation, no crack: every edge has one triangle on each side or is a border), every
-    /// vertex's triangles one fan (a manifold), no degenerate triangle, the node map and the
-    /// triangle ids right for `h`.
-    pub fn check(&self, h: &HierarchyView<'_>) -> Result<(), Defect> {
-        let bad = |what, slot| Err(Defect { what, slot });
-        let nv = self.node.len() as u32;
-        let nf = self.tri.len() as u32;
-        for f in 0..nf {
-            let t = self.tri[f as usize];
-            if t.iter().any(|&v| v >= nv) {
-                return bad("corner out of range", f);
-            }
-            if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
-                return bad("degenerate triangle", f);
-            }
-            let id = self.fid[f as usize];
-            if id >= h.faces() {
-                return bad("triangle id out of range", f);
-            }
-            for k in 0..3 {
-                let g = self.adj[f as usize][k];
-                if g == NIL {
-                    continue;
-                }
-                if g >= nf {
-                    return bad("neighbour out of range", f);
-                }
-                let (a, b) = (t[k], t[next3(k)]);
-                let u = self.tri[g as usize];
-                let Some(j) = corner(u, b) else {
-                    return bad("neighbour does not share the edge", f);
-                };
-                if u[next3(j)] != a || self.adj[g as usize][j] != f {
-                    return bad("adjacency not symmetric or orientation flipped", f);
-                }
-            }
-        }
-        for v in 0..nv {
-            let node = self.node[v as usize];
-            if self.slot_of.get(node) != Some(v) {
-                return bad("node map wrong", v);
-            }
-            if node >= h.nodes() {
-                return bad("node out of range", v);
-            }
-        }
-        if self.slot_of.len() != nv as usize {
-            return bad("node map has extra entries", 0);
-        }
-        self.check_fans()
     }
 }
 

@@ -1,0 +1,204 @@
+//! Geomorph state, and what each vertex looks like this frame.
+//!
+//! A vertex that is not blending is exactly its node: [`Cut::vertex`] reads its position,
+//! normal and colour from the hierarchy in place, so the cut stores none of them. A blending
+//! vertex has an entry in the blend arena (`Q` entries of 28 bytes, shared by all running
+//! geomorphs): where it started, how many frames are left, and whether it blends towards its
+//! parent (a collapse) or its own node (a split). Its output is a function of that entry and
+//! the file, so starting a blend from "where it is now" is exact however blends overlap (the
+//! wavelet paper's overlapping geomorphs, Azuma et al., "View-dependent refinement of
+//! multiresolution meshes with subdivision connectivity", 2003, equation 6). When the arena is
+//! full a change happens without a blend and the frame says so.
+
+use super::slot::SlotIndex;
+use super::{depth_color, Coloring, Cut, BLENDING, COLLAPSING, NIL};
+use crate::format::{HierarchyView, NodeView};
+
+/// A vertex as drawn this frame.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct VertexOut {
+    /// Position.
+    pub position: [f32; 3],
+    /// Unit normal.
+    pub normal: [f32; 3],
+    /// Colour (see [`Coloring`]).
+    pub color: [u8; 3],
+}
+
+/// One running geomorph.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Blend {
+    /// The vertex slot.
+    pub slot: u32,
+    pub from_position: [f32; 3],
+    /// The start normal in units of 1/32767.
+    pub from_normal: [i16; 3],
+    pub from_color: [u8; 3],
+    /// Towards the parent, for a collapse that happens when it arrives.
+    pub collapsing: bool,
+    /// Frames left; 0 once arrived (only a collapse waits there).
+    pub left: u16,
+}
+
+impl Blend {
+    pub const ZERO: Blend = Blend {
+        slot: 0,
+        from_position: [0.0; 3],
+        from_normal: [0; 3],
+        from_color: [0; 3],
+        collapsing: false,
+        left: 0,
+    };
+}
+
+#[inline]
+fn lerp3(a: [f32; 3], b: [f32; 3], s: f32) -> [f32; 3] {
+    [
+        a[0] + (b[0] - a[0]) * s,
+        a[1] + (b[1] - a[1]) * s,
+        a[2] + (b[2] - a[2]) * s,
+    ]
+}
+
+impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, I> {
+    /// The colour a node is drawn with.
+    pub(crate) fn tint_of(&self, n: &NodeView) -> [u8; 3] {
+        match self.coloring {
+            Coloring::Node => n.color,
+            Coloring::Depth => depth_color(n.depth),
+        }
+    }
+
+    fn node_out(&self, h: &HierarchyView<'_>, node: u32) -> VertexOut {
+        let n = h.node(node);
+        VertexOut {
+            position: n.position,
+            normal: n.normal,
+            color: self.tint_of(&n),
+        }
+    }
+
+    /// Slot `s` as drawn this frame: its node's position, normal and colour, or the blend
+    /// between where it started and where it goes while a geomorph runs. (Slots out of range
+    /// read as the default.)
+    #[must_use]
+    pub fn vertex(&self, h: &HierarchyView<'_>, s: usize) -> VertexOut {
+        let Some(&node) = self.v.nodes().get(s) else {
+            return VertexOut::default();
+        };
+        let Some(b) = self.blends.as_slice().get(self.v.blend(s) as usize) else {
+            return self.node_out(h, node);
+        };
+        let to = self.node_out(h, if b.collapsing { h.parent(node) } else { node });
+        let total = self.geomorph_frames.max(1);
+        if b.left == 0 {
+            // Arrived: exactly the target (a + (b - a) need not round to b).
+            return to;
+        }
+        let done = 1.0 - b.left.min(total) as f32 / total as f32;
+        let from_normal = b.from_normal.map(|c| c as f32 / 32767.0);
+        let n = lerp3(from_normal, to.normal, done);
+        let l = libm::sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        let c = |k: usize| {
+            let (x, y) = (b.from_color[k] as f32, to.color[k] as f32);
+            (x + (y - x) * done + 0.5) as u8
+        };
+        VertexOut {
+            position: lerp3(b.from_position, to.position, done),
+            normal: if l > 1e-12 {
+                [n[0] / l, n[1] / l, n[2] / l]
+            } else {
+                to.normal
+            },
+            color: [c(0), c(1), c(2)],
+        }
+    }
+
+    /// Starts (or restarts) a blend of slot `s` from `from` over `frames` frames, towards the
+    /// parent when `collapsing`, else towards its own node. `false` (and no blend) when the
+    /// arena is full or `frames` is 0.
+    pub(crate) fn start_blend_from(
+        &mut self,
+        s: usize,
+        from: &VertexOut,
+        frames: u16,
+        collapsing: bool,
+    ) -> bool {
+        let entry = Blend {
+            slot: s as u32,
+            from_position: from.position,
+            from_normal: from.normal.map(|c| (c.clamp(-1.0, 1.0) * 32767.0) as i16),
+            from_color: from.color,
+            collapsing,
+            left: frames,
+        };
+        self.v.flags[s] &= !(BLENDING | COLLAPSING);
+        if frames == 0 {
+            self.free_blend(s);
+            return false;
+        }
+        let k = self.v.blend(s) as usize;
+        if let Some(b) = self.blends.as_mut_slice().get_mut(k) {
+            *b = entry;
+        } else {
+            match self.blends.push(entry) {
+                Ok(k) => self.v.set_blend(s, k),
+                Err(_) => return false,
+            }
+        }
+        self.v.flags[s] |= BLENDING | if collapsing { COLLAPSING } else { 0 };
+        true
+    }
+
+    /// Starts (or reverses) a blend of slot `s` from where it is now; see
+    /// [`Cut::start_blend_from`].
+    pub(crate) fn start_blend(
+        &mut self,
+        h: &HierarchyView<'_>,
+        s: usize,
+        collapsing: bool,
+    ) -> bool {
+        let from = self.vertex(h, s);
+        self.start_blend_from(s, &from, self.geomorph_frames, collapsing)
+    }
+
+    /// Ends slot `s`'s blend, if any: it is its node again.
+    pub(crate) fn free_blend(&mut self, s: usize) {
+        let k = self.v.blend(s);
+        if k == NIL {
+            return;
+        }
+        self.v.set_blend(s, NIL);
+        self.v.flags[s] &= !(BLENDING | COLLAPSING);
+        if let Some((_, Some(_))) = self.blends.swap_remove(k as usize) {
+            // The last entry moved into k: tell its vertex.
+            let moved = self.blends.as_slice()[k as usize].slot;
+            self.v.set_blend(moved as usize, k);
+        }
+    }
+
+    /// Advances slot `s`'s blend by one frame; a split's blend ends when it arrives, a
+    /// collapse's waits there for the collapse.
+    pub(crate) fn advance(&mut self, s: usize) {
+        let total = self.geomorph_frames.max(1);
+        let k = self.v.blend(s) as usize;
+        let Some(b) = self.blends.as_mut_slice().get_mut(k) else {
+            self.v.flags[s] &= !(BLENDING | COLLAPSING);
+            return;
+        };
+        b.left = b.left.saturating_sub(1).min(total);
+        if b.left > 0 {
+            return;
+        }
+        self.v.flags[s] &= !BLENDING;
+        if !b.collapsing {
+            self.free_blend(s);
+        }
+    }
+
+    /// Vertices with a geomorph running.
+    #[must_use]
+    pub fn blending(&self) -> u32 {
+        self.blends.as_slice().iter().filter(|b| b.left > 0).count() as u32
+    }
+}

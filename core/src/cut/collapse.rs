@@ -1,0 +1,210 @@
+//! Edge collapses: Hoppe's legality test (`ecol_legal`) and the collapse itself (`apply_ecol`).
+
+use super::fan::PairFans;
+use super::slot::SlotIndex;
+use super::{corner, next3, prev3, Cut, Refused, BLOCKED, NIL};
+use crate::format::{HierarchyView, SplitView, NONE};
+
+/// The slots of a legal collapse: the two children `a` and `b`, and the triangles it removes
+/// (`right` is `NIL` on a border).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct CollapsePlan {
+    pub a: u32,
+    pub b: u32,
+    pub left: u32,
+    pub right: u32,
+}
+
+impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, I> {
+    /// Collapses active siblings into their parent `node` if Hoppe's condition holds. Returns the
+    /// parent's slot.
+    pub fn collapse(&mut self, h: &HierarchyView<'_>, node: u32) -> Result<u32, Refused> {
+        let mut fans = PairFans::default();
+        let plan = self.collapse_legal(h, node, &mut fans)?;
+        Ok(self.apply_collapse(h, node, plan, &fans))
+    }
+
+    /// Proves the collapse of `node`'s children legal.
+    pub(crate) fn collapse_legal(
+        &self,
+        h: &HierarchyView<'_>,
+        node: u32,
+        fans: &mut PairFans,
+    ) -> Result<CollapsePlan, Refused> {
+        if node < h.leaves() || node >= h.nodes() {
+            return Err(Refused::NoSuchOperation);
+        }
+        let s = h.split(node);
+        let [c0, c1] = s.children;
+        let a = self.slot(c0).ok_or(Refused::NotActive)?;
+        let b = self.slot(c1).ok_or(Refused::NotActive)?;
+        self.collapse_legal_at(h, node, &s, a, b, fans)
+    }
+
+    /// [`Cut::collapse_legal`] with the children's slots `a` and `b` known.
+    pub(crate) fn collapse_legal_at(
+        &self,
+        h: &HierarchyView<'_>,
+        node: u32,
+        s: &SplitView,
+        a: u32,
+        b: u32,
+        fans: &mut PairFans,
+    ) -> Result<CollapsePlan, Refused> {
+        let [fan_a, fan_b] = &mut fans.0;
+        if !self.complete_fan(a, fan_a) {
+            return Err(Refused::Inconsistent);
+        }
+        let id = h.split_face(node, false);
+        let fl = fan_a
+            .as_slice()
+            .iter()
+            .copied()
+            .find(|&f| self.t.id[f as usize] == id)
+            .ok_or(Refused::Illegal)?;
+        let t = self.t.at(fl);
+        let k = corner(t, a).ok_or(Refused::Inconsistent)?;
+        if t[next3(k)] != b {
+            return Err(Refused::Inconsistent);
+        }
+        let adj = self.t.adj(fl);
+        let id = |f: u32| {
+            if f == NIL {
+                NONE
+            } else {
+                self.t.id[f as usize]
+            }
+        };
+        // fl = (a, b, wl): edge b -> wl has n0, edge wl -> a has n1.
+        if id(adj[next3(k)]) != s.neighbours[0] || id(adj[prev3(k)]) != s.neighbours[1] {
+            return Err(Refused::Illegal);
+        }
+        let fr = adj[k];
+        if s.wings[1] != NONE {
+            let Some(t) = self.t.get(fr) else {
+                return Err(Refused::Illegal);
+            };
+            if self.t.id[fr as usize] != h.split_face(node, true) {
+                return Err(Refused::Illegal);
+            }
+            let j = corner(t, b).ok_or(Refused::Inconsistent)?;
+            if t[next3(j)] != a {
+                return Err(Refused::Inconsistent);
+            }
+            // fr = (b, a, wr): edge a -> wr has n2, edge wr -> b has n3.
+            let adj = self.t.adj(fr);
+            if id(adj[next3(j)]) != s.neighbours[2] || id(adj[prev3(j)]) != s.neighbours[3] {
+                return Err(Refused::Illegal);
+            }
+        } else if fr != NIL {
+            return Err(Refused::Inconsistent);
+        }
+        // Renaming b and moving the last vertex into b's slot must reach every triangle.
+        let last = self.v.len() as u32 - 1;
+        if !self.complete_fan(b, fan_b) || !self.fan_complete(last) {
+            return Err(Refused::Inconsistent);
+        }
+        Ok(CollapsePlan {
+            a,
+            b,
+            left: fl,
+            right: fr,
+        })
+    }
+
+    /// Performs a collapse [`Cut::collapse_legal`] approved, with the fans it found; returns the
+    /// parent's slot.
+    pub(crate) fn apply_collapse(
+        &mut self,
+        h: &HierarchyView<'_>,
+        node: u32,
+        plan: CollapsePlan,
+        fans: &PairFans,
+    ) -> u32 {
+        let CollapsePlan {
+            a,
+            b,
+            left: fl,
+            right: fr,
+        } = plan;
+        let [fan_a, fan_b] = &fans.0;
+        // Collapses around here may become legal: clear the marks on every corner of the
+        // triangles around both vertices (the parent's fan and its neighbours).
+        for &f in fan_a.as_slice().iter().chain(fan_b.as_slice()) {
+            for v in self.t.at(f) {
+                if let Some(flags) = self.v.flags.get_mut(v as usize) {
+                    *flags &= !BLOCKED;
+                }
+            }
+        }
+        // The removed triangles' corners lose one triangle each; then b's become a's.
+        for f in [fl, fr] {
+            if let Some(t) = self.t.get(f) {
+                for v in t {
+                    if let Some(d) = self.v.degree.get_mut(v as usize) {
+                        *d = d.saturating_sub(1);
+                    }
+                }
+            }
+        }
+        let db = self.v.degree[b as usize];
+        self.v.degree[a as usize] = self.v.degree[a as usize].saturating_add(db);
+        self.v.degree[b as usize] = 0;
+        for &f in fan_b.as_slice() {
+            if f == fl || f == fr {
+                continue;
+            }
+            if let Some(k) = corner(self.t.at(f), b) {
+                self.t.set_corner(f, k, a);
+            }
+        }
+        // The neighbours of each removed triangle become each other's.
+        let mut new_fan = NIL;
+        for f in [fl, fr] {
+            let Some(t) = self.t.get(f) else {
+                continue;
+            };
+            let adj = self.t.adj(f);
+            // The third corner w and the neighbours across its two edges.
+            let j = (0..3).find(|&j| t[j] != a && t[j] != b).unwrap_or(0);
+            let w = t[j];
+            let (x, y) = (adj[j], adj[prev3(j)]);
+            for (p, q) in [(x, y), (y, x)] {
+                if p == NIL {
+                    continue;
+                }
+                for k in 0..3 {
+                    if self.t.adj(p)[k] == f {
+                        self.t.set_adj(p, k, q);
+                    }
+                }
+            }
+            let keep = if x != NIL { x } else { y };
+            let fw = self.v.fan(w as usize);
+            if fw == fl || fw == fr {
+                self.v.set_fan(w as usize, keep);
+            }
+            if new_fan == NIL {
+                new_fan = keep;
+            }
+        }
+        self.v.set_fan(a as usize, new_fan);
+        // Remove the triangles, the higher slot first so the lower stays where it is.
+        let (hi, lo) = if fr != NIL && fr > fl {
+            (fr, fl)
+        } else {
+            (fl, fr)
+        };
+        self.remove_triangle(hi);
+        if lo != NIL {
+            self.remove_triangle(lo);
+        }
+        self.map.remove(self.v.node[b as usize], self.v.nodes());
+        self.unlink_mate(b as usize);
+        self.rename_vertex(h, a as usize, node);
+        match self.remove_vertex(b) {
+            Some(moved_from) if moved_from == a => b,
+            _ => a,
+        }
+    }
+}

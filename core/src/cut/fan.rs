@@ -1,0 +1,102 @@
+//! Walks around a vertex: the triangles of its fan, proven complete.
+//!
+//! Every operation renames corners around one or two vertices, so it must reach every triangle
+//! that uses them. A walk steps from triangle to neighbouring triangle around the vertex; it is
+//! complete when it found exactly as many distinct triangles as the vertex's triangle count,
+//! which every operation keeps. That count check is what keeps the cut whole on hierarchies
+//! crafted to contradict the mesh.
+
+use super::slot::{Arena, SlotIndex};
+use super::{corner, prev3, Cut, NIL};
+
+/// Longest fan walked around one vertex; a hierarchy with larger vertex degrees is refused
+/// rather than walked forever.
+pub const MAX_FAN: usize = 1024;
+
+/// The triangle slots of one fan.
+pub(crate) type Fan = Arena<u32, MAX_FAN>;
+
+impl Fan {
+    /// An empty fan (on the stack: 4 KiB).
+    pub fn new_fan() -> Fan {
+        Arena::new(0)
+    }
+}
+
+/// The triangles around the two vertices of a collapse, found while proving it legal and used
+/// again to do it.
+pub(crate) struct PairFans(pub [Fan; 2]);
+
+impl Default for PairFans {
+    fn default() -> Self {
+        PairFans([Fan::new_fan(), Fan::new_fan()])
+    }
+}
+
+impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, I> {
+    /// The triangle after `f` going counter-clockwise around vertex `v` (`NIL` at a border).
+    #[inline]
+    pub(crate) fn ccw(&self, f: u32, v: u32) -> Option<u32> {
+        let t = self.t.get(f)?;
+        let k = corner(t, v)?;
+        Some(self.t.adj(f)[prev3(k)])
+    }
+
+    /// The triangle before `f` going counter-clockwise around `v` (`NIL` at a border).
+    #[inline]
+    pub(crate) fn cw(&self, f: u32, v: u32) -> Option<u32> {
+        let t = self.t.get(f)?;
+        let k = corner(t, v)?;
+        Some(self.t.adj(f)[k])
+    }
+
+    /// Collects `v`'s triangles into `out` and says whether the walk found every triangle that
+    /// uses `v`, each once. Each step of a walk is a function of the triangle it stands on, so a
+    /// walk that comes back to its start (or reaches a border) without exceeding [`MAX_FAN`]
+    /// steps repeats nothing; only the two halves of a border fan can overlap, which is checked,
+    /// and the count must match the vertex's triangle count.
+    pub(crate) fn complete_fan(&self, v: u32, out: &mut Fan) -> bool {
+        out.clear();
+        if v as usize >= self.v.len() {
+            return false;
+        }
+        let start = self.v.fan(v as usize);
+        let degree = self.v.degree[v as usize] as usize;
+        if start == NIL {
+            return degree == 0;
+        }
+        let mut f = start;
+        loop {
+            if out.push(f).is_err() {
+                return false;
+            }
+            match self.ccw(f, v) {
+                Some(g) if g == start => return out.len() == degree,
+                Some(NIL) => break,
+                Some(g) => f = g,
+                None => return false,
+            }
+        }
+        // A border: the rest lies clockwise of the start, and must not meet the first half.
+        let ccw_part = out.len();
+        let mut g = match self.cw(start, v) {
+            Some(g) => g,
+            None => return false,
+        };
+        while g != NIL {
+            if out.as_slice()[..ccw_part].contains(&g) || out.push(g).is_err() {
+                return false;
+            }
+            g = match self.cw(g, v) {
+                Some(g) => g,
+                None => return false,
+            };
+        }
+        out.len() == degree
+    }
+
+    /// Whether walking `v`'s fan finds every triangle that uses `v`, each once.
+    pub(crate) fn fan_complete(&self, v: u32) -> bool {
+        self.complete_fan(v, &mut Fan::new_fan())
+    }
+}

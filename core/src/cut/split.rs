@@ -1,0 +1,291 @@
+//! Vertex splits: Hoppe's legality test (`vspl_legal`), the split itself (`apply_vspl`), and
+//! forced splits (`force_vsplit`; the merge-tree paper's forced refinement, §3.6).
+
+use super::fan::Fan;
+use super::slot::SlotIndex;
+use super::{corner, next3, Cut, Refused, NIL};
+use crate::format::{HierarchyView, NONE};
+
+/// Everything a legal split needs, found while proving it legal.
+pub(crate) struct SplitPlan {
+    /// The parent's slot (it becomes the first child's).
+    parent: u32,
+    /// The neighbour triangles' slots (`fn0..fn3`, `NIL` where the file has none).
+    neighbours: [u32; 4],
+    /// The wing vertices' slots (the second `NIL` on a border).
+    wings: [u32; 2],
+    /// The triangles that move to the second child.
+    moved: Fan,
+}
+
+impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, I> {
+    /// Splits active `node` if legal now. On success returns the children's slots.
+    pub fn split(&mut self, h: &HierarchyView<'_>, node: u32) -> Result<[u32; 2], Refused> {
+        let plan = self.split_legal(h, node)?;
+        Ok(self.apply_split(h, node, &plan, 0))
+    }
+
+    /// Proves the split of `node` legal: it is active, its neighbour triangles are all around
+    /// it and meet along the edges the new triangles take over, and there is room.
+    pub(crate) fn split_legal(
+        &self,
+        h: &HierarchyView<'_>,
+        node: u32,
+    ) -> Result<SplitPlan, Refused> {
+        let ps = self.slot(node).ok_or(Refused::NotActive)?;
+        if node < h.leaves() {
+            return Err(Refused::NoSuchOperation);
+        }
+        let s = h.split(node);
+        let n = s.neighbours;
+        let second = s.wings[1] != NONE;
+        // The neighbour triangles must all be around the vertex (whose fan must be whole).
+        let mut fan = Fan::new_fan();
+        if !self.complete_fan(ps, &mut fan) {
+            return Err(Refused::Inconsistent);
+        }
+        let mut ns = [NIL; 4];
+        for &f in fan.as_slice() {
+            let id = self.t.id[f as usize];
+            for k in 0..4 {
+                if n[k] == id {
+                    ns[k] = f;
+                }
+            }
+        }
+        for k in 0..4 {
+            if n[k] != NONE && ns[k] == NIL {
+                return Err(Refused::Missing(n[k]));
+            }
+        }
+        let added = 1 + second as usize;
+        if self.v.is_full() || self.v.len() >= self.map.capacity() || self.t.len() + added > F {
+            return Err(Refused::Capacity);
+        }
+
+        // Wings, read off the neighbours (the nodes there now may be finer than at formation).
+        let third = |f: u32, v: u32, offset: usize| -> Option<u32> {
+            let t = self.t.get(f)?;
+            let k = corner(t, v)?;
+            Some(t[(k + offset) % 3])
+        };
+        // n1 holds c0 -> wl, n2 holds wr -> c0: both still have the parent's slot as c0.
+        let wl = if ns[1] != NIL {
+            third(ns[1], ps, 1)
+        } else {
+            third(ns[0], ps, 2)
+        }
+        .ok_or(Refused::Inconsistent)?;
+        let wr = if !second {
+            NIL
+        } else if ns[2] != NIL {
+            third(ns[2], ps, 2).ok_or(Refused::Inconsistent)?
+        } else {
+            third(ns[3], ps, 1).ok_or(Refused::Inconsistent)?
+        };
+        // Each neighbour pair must meet along the edge the new triangle will take over
+        // (n0: wl -> p, n1: p -> wl, n2: wr -> p, n3: p -> wr), so the new links are mutual.
+        let across = |f: u32, a: u32, b: u32| -> Option<u32> {
+            let t = self.t.get(f)?;
+            let k = corner(t, a)?;
+            (t[next3(k)] == b).then(|| self.t.adj(f)[k])
+        };
+        let pairs_meet = |x: u32, y: u32, w: u32| -> bool {
+            // x holds w -> p, y holds p -> w; across each lies the other (or a border).
+            let xy = x == NIL || across(x, w, ps) == Some(y);
+            let yx = y == NIL || across(y, ps, w) == Some(x);
+            xy && yx
+        };
+        if !pairs_meet(ns[0], ns[1], wl) || (second && !pairs_meet(ns[2], ns[3], wr)) {
+            return Err(Refused::Inconsistent);
+        }
+        // The triangles that go to c1: counter-clockwise from n3 to n0, or up to a border and
+        // then clockwise from n0 to the other border.
+        let mut moved = Fan::new_fan();
+        let mut reached = false;
+        if ns[3] != NIL {
+            let mut f = ns[3];
+            while f != NIL {
+                moved.push(f).map_err(|_| Refused::Inconsistent)?;
+                if f == ns[0] {
+                    reached = true;
+                    break;
+                }
+                f = self.ccw(f, ps).ok_or(Refused::Inconsistent)?;
+                if f == ns[3] {
+                    return Err(Refused::Inconsistent);
+                }
+            }
+        }
+        if !reached && ns[0] != NIL {
+            let mut f = ns[0];
+            while f != NIL {
+                if moved.as_slice().contains(&f) {
+                    return Err(Refused::Inconsistent);
+                }
+                moved.push(f).map_err(|_| Refused::Inconsistent)?;
+                f = self.cw(f, ps).ok_or(Refused::Inconsistent)?;
+            }
+        }
+        let m = moved.as_slice();
+        if (ns[1] != NIL && m.contains(&ns[1])) || (ns[2] != NIL && m.contains(&ns[2])) {
+            return Err(Refused::Inconsistent);
+        }
+        Ok(SplitPlan {
+            parent: ps,
+            neighbours: ns,
+            wings: [wl, wr],
+            moved,
+        })
+    }
+
+    /// Performs a split [`Cut::split_legal`] approved; with `frames > 0` the children start at
+    /// the parent's current (blended) position, normal and colour and blend to their own over
+    /// that many frames. Returns the children's slots.
+    pub(crate) fn apply_split(
+        &mut self,
+        h: &HierarchyView<'_>,
+        node: u32,
+        plan: &SplitPlan,
+        frames: u16,
+    ) -> [u32; 2] {
+        let [c0, c1] = h.split(node).children;
+        let SplitPlan {
+            parent: ps,
+            neighbours: ns,
+            wings: [wl, wr],
+            ref moved,
+        } = *plan;
+        let second = wr != NIL;
+        let start = (frames > 0 && self.blends.len() + 2 <= Q).then(|| self.vertex(h, ps as usize));
+        // Room was proven: the vertex arena has a slot, and the node map takes the second child
+        // because the first replaces the parent's entry.
+        self.rename_vertex(h, ps as usize, c0);
+        let Some(c1s) = self.push_vertex(c1) else {
+            // Only a full node map can refuse (never at half load): undo.
+            self.rename_vertex(h, ps as usize, node);
+            return [ps, ps];
+        };
+        self.link_family(h, c1s);
+        if let Some(from) = start {
+            self.start_blend_from(ps as usize, &from, frames, false);
+            self.start_blend_from(c1s as usize, &from, frames, false);
+        }
+        for &f in moved.as_slice() {
+            if let Some(k) = corner(self.t.at(f), ps) {
+                self.t.set_corner(f, k, c1s);
+            }
+        }
+        let added = 1 + second as u16;
+        let m = moved.len() as u16;
+        let d = self.v.degree[ps as usize];
+        self.v.degree[ps as usize] = d.saturating_sub(m).saturating_add(added);
+        self.v.degree[c1s as usize] = m.saturating_add(added);
+        for w in [wl, wr] {
+            if let Some(d) = self.v.degree.get_mut(w as usize) {
+                *d = d.saturating_add(1);
+            }
+        }
+        let fl = self.t.len() as u32;
+        let fr = if second { fl + 1 } else { NIL };
+        // Room was proven.
+        let _ = self
+            .t
+            .push([ps, c1s, wl], [fr, ns[0], ns[1]], h.split_face(node, false));
+        if second {
+            let _ = self
+                .t
+                .push([c1s, ps, wr], [fl, ns[2], ns[3]], h.split_face(node, true));
+        }
+        self.point_edge(ns[0], wl, c1s, fl);
+        self.point_edge(ns[1], ps, wl, fl);
+        self.point_edge(ns[2], wr, ps, fr);
+        self.point_edge(ns[3], c1s, wr, fr);
+        self.v.set_fan(ps as usize, fl);
+        self.v.set_fan(c1s as usize, fl);
+        [ps, c1s]
+    }
+
+    /// Points the edge `a -> b` of triangle `f` (if `f` is a triangle with that edge) at `to`.
+    fn point_edge(&mut self, f: u32, a: u32, b: u32, to: u32) {
+        let Some(t) = self.t.get(f) else {
+            return;
+        };
+        if let Some(k) = corner(t, a) {
+            if t[next3(k)] == b {
+                self.t.set_adj(f, k, to);
+            }
+        }
+    }
+
+    /// Splits active `node`, first splitting whatever its split needs (Hoppe's forced split; the
+    /// merge-tree paper's forced refinement, §3.6), each with a blend of `frames` frames.
+    /// `allow` is asked before each split with the node and the number of triangles it adds, and
+    /// answers why not or `Ok` to go on. Returns the splits done; on a refusal the splits done
+    /// so far stay.
+    pub fn force_split(
+        &mut self,
+        h: &HierarchyView<'_>,
+        node: u32,
+        frames: u16,
+        allow: &mut dyn FnMut(u32, u32) -> Result<(), Refused>,
+    ) -> Result<u32, Refused> {
+        if !self.is_active(node) {
+            return Err(Refused::NotActive);
+        }
+        self.stack.clear();
+        self.stack.push(node).map_err(|_| Refused::Capacity)?;
+        let mut done = 0;
+        // Each round splits once or pushes a coarser node; bounded for crafted files.
+        let mut rounds = 0u32;
+        let limit = h.nodes().saturating_mul(4).saturating_add(64);
+        while let Some(&v) = self.stack.last() {
+            rounds += 1;
+            if rounds > limit {
+                return Err(Refused::Inconsistent);
+            }
+            if !self.is_active(v) {
+                // Either split already (by an earlier forced split), or coarser than the cut
+                // here: then its first active ancestor goes first.
+                let mut a = h.parent(v);
+                let mut steps = 0;
+                while a != NONE && !self.is_active(a) {
+                    a = h.parent(a);
+                    steps += 1;
+                    if steps > h.nodes() {
+                        return Err(Refused::Inconsistent);
+                    }
+                }
+                if a == NONE {
+                    self.stack.pop();
+                } else {
+                    self.stack.push(a).map_err(|_| Refused::Capacity)?;
+                }
+                continue;
+            }
+            match self.split_legal(h, v) {
+                Ok(plan) => {
+                    let added = if plan.wings[1] != NIL { 2 } else { 1 };
+                    allow(v, added)?;
+                    self.apply_split(h, v, &plan, frames);
+                    done += 1;
+                    self.stack.pop();
+                    if v == node {
+                        return Ok(done);
+                    }
+                }
+                Err(Refused::Missing(face)) => {
+                    let Some(creator) = h.face_creator(face) else {
+                        return Err(Refused::Inconsistent);
+                    };
+                    if self.stack.as_slice().contains(&creator) {
+                        return Err(Refused::Inconsistent);
+                    }
+                    self.stack.push(creator).map_err(|_| Refused::Capacity)?;
+                }
+                Err(e) => return Err(e),
+            }
+        }
+        Ok(done)
+    }
+}

@@ -1,0 +1,220 @@
+//! The cut's vertex and triangle tables: structure-of-arrays records with one length each, and
+//! the only code that appends, moves or drops a record.
+//!
+//! A vertex record is 13 bytes with 16-bit slots: its node (`u32`), one triangle of its fan, its
+//! triangle count, its sibling's slot when both are active ("mate"), its geomorph's entry in the
+//! blend arena, and a flag byte. Positions, normals and colours are not stored: they are read
+//! from the hierarchy in place ([`super::Cut::vertex`]), except for vertices in a geomorph. A
+//! triangle record is 16 bytes: three corner slots, the three neighbouring triangles' slots
+//! (across edges `t[k] -> t[k + 1]`) and its id in the hierarchy's numbering.
+
+use super::slot::{load3, store3, SlotIndex};
+use super::NIL;
+
+/// The vertex records.
+#[derive(Clone, Debug)]
+pub(crate) struct Vertices<const V: usize, I: SlotIndex> {
+    len: u32,
+    pub node: [u32; V],
+    fan: [I; V],
+    /// Triangles using the vertex, kept by every operation: a fan walk that finds this many
+    /// distinct triangles found them all, which is what makes renaming a vertex complete (and
+    /// the cut safe from hierarchies crafted to contradict the mesh).
+    pub degree: [u16; V],
+    mate: [I; V],
+    blend: [I; V],
+    pub flags: [u8; V],
+}
+
+impl<const V: usize, I: SlotIndex> Vertices<V, I> {
+    pub const fn new() -> Self {
+        Vertices {
+            len: 0,
+            node: [0; V],
+            fan: [I::ZERO; V],
+            degree: [0; V],
+            mate: [I::ZERO; V],
+            blend: [I::ZERO; V],
+            flags: [0; V],
+        }
+    }
+
+    #[inline(always)]
+    pub fn len(&self) -> usize {
+        self.len as usize
+    }
+
+    #[inline]
+    pub fn is_full(&self) -> bool {
+        self.len() >= V
+    }
+
+    pub fn clear(&mut self) {
+        self.len = 0;
+    }
+
+    /// The nodes of the active vertices, by slot.
+    #[inline(always)]
+    pub fn nodes(&self) -> &[u32] {
+        &self.node[..self.len as usize]
+    }
+
+    #[inline(always)]
+    pub fn fan(&self, s: usize) -> u32 {
+        self.fan.get(s).map_or(NIL, |f| f.load())
+    }
+
+    #[inline(always)]
+    pub fn set_fan(&mut self, s: usize, f: u32) {
+        if let Some(x) = self.fan.get_mut(s) {
+            *x = I::store(f);
+        }
+    }
+
+    /// The sibling's slot when this vertex and its sibling are both active, else `NIL`.
+    #[inline(always)]
+    pub fn mate(&self, s: usize) -> u32 {
+        self.mate.get(s).map_or(NIL, |m| m.load())
+    }
+
+    #[inline(always)]
+    pub fn set_mate(&mut self, s: usize, m: u32) {
+        if let Some(x) = self.mate.get_mut(s) {
+            *x = I::store(m);
+        }
+    }
+
+    /// The vertex's entry in the blend arena, or `NIL`.
+    #[inline(always)]
+    pub fn blend(&self, s: usize) -> u32 {
+        self.blend.get(s).map_or(NIL, |b| b.load())
+    }
+
+    #[inline(always)]
+    pub fn set_blend(&mut self, s: usize, b: u32) {
+        if let Some(x) = self.blend.get_mut(s) {
+            *x = I::store(b);
+        }
+    }
+
+    /// Appends a vertex for `node` with no triangles, no mate and no blend; its slot, or `None`
+    /// when full.
+    pub fn push(&mut self, node: u32, flags: u8) -> Option<u32> {
+        let s = self.len as usize;
+        if s >= V {
+            return None;
+        }
+        self.node[s] = node;
+        self.fan[s] = I::store(NIL);
+        self.degree[s] = 0;
+        self.mate[s] = I::store(NIL);
+        self.blend[s] = I::store(NIL);
+        self.flags[s] = flags;
+        self.len += 1;
+        Some(s as u32)
+    }
+
+    /// Copies record `from` over record `to`.
+    pub fn copy(&mut self, from: usize, to: usize) {
+        self.node[to] = self.node[from];
+        self.fan[to] = self.fan[from];
+        self.degree[to] = self.degree[from];
+        self.mate[to] = self.mate[from];
+        self.blend[to] = self.blend[from];
+        self.flags[to] = self.flags[from];
+    }
+
+    /// Drops the last record.
+    pub fn pop(&mut self) {
+        self.len = self.len.saturating_sub(1);
+    }
+}
+
+/// The triangle records.
+#[derive(Clone, Debug)]
+pub(crate) struct Triangles<const F: usize, I: SlotIndex> {
+    len: u32,
+    corners: [[I; 3]; F],
+    adj: [[I; 3]; F],
+    /// Triangle ids in the hierarchy's numbering.
+    pub id: [u32; F],
+}
+
+impl<const F: usize, I: SlotIndex> Triangles<F, I> {
+    pub const fn new() -> Self {
+        Triangles {
+            len: 0,
+            corners: [[I::ZERO; 3]; F],
+            adj: [[I::ZERO; 3]; F],
+            id: [0; F],
+        }
+    }
+
+    #[inline(always)]
+    pub fn len(&self) -> usize {
+        self.len as usize
+    }
+
+    pub fn clear(&mut self) {
+        self.len = 0;
+    }
+
+    /// The corner records, as the rasterizer reads them.
+    #[inline(always)]
+    pub fn corners(&self) -> &[[I; 3]] {
+        &self.corners[..self.len as usize]
+    }
+
+    /// Triangle `f`'s corners (`None` out of range).
+    #[inline(always)]
+    pub fn get(&self, f: u32) -> Option<[u32; 3]> {
+        (f < self.len).then(|| load3(self.corners[f as usize]))
+    }
+
+    /// Triangle `f`'s corners (`f` in range).
+    #[inline(always)]
+    pub fn at(&self, f: u32) -> [u32; 3] {
+        load3(self.corners[f as usize])
+    }
+
+    #[inline(always)]
+    pub fn set_corner(&mut self, f: u32, k: usize, v: u32) {
+        self.corners[f as usize][k] = I::store(v);
+    }
+
+    /// `adj(f)[k]`: the triangle across edge `t[k] -> t[k + 1]`, or `NIL`.
+    #[inline(always)]
+    pub fn adj(&self, f: u32) -> [u32; 3] {
+        load3(self.adj[f as usize])
+    }
+
+    #[inline(always)]
+    pub fn set_adj(&mut self, f: u32, k: usize, g: u32) {
+        self.adj[f as usize][k] = I::store(g);
+    }
+
+    /// Appends a triangle; its slot, or `None` when full.
+    pub fn push(&mut self, corners: [u32; 3], adj: [u32; 3], id: u32) -> Option<u32> {
+        let f = self.len as usize;
+        if f >= F {
+            return None;
+        }
+        self.corners[f] = store3(corners);
+        self.adj[f] = store3(adj);
+        self.id[f] = id;
+        self.len += 1;
+        Some(f as u32)
+    }
+
+    /// Copies record `from` over record `to`.
+    pub fn copy(&mut self, from: u32, to: u32) {
+        let (from, to) = (from as usize, to as usize);
+        self.corners[to] = self.corners[from];
+        self.adj[to] = self.adj[from];
+        self.id[to] = self.id[from];
+    }
+
+    pub fn pop(&mut self) {
+        self.len = self.len.saturating_sub(1);
+    }
+}
