@@ -33,7 +33,7 @@
 //!
 //! plus 40 bytes of lengths and settings. With the recommended `F = 2 V` and `Q = V / 8` that is
 //! 13 + 36 + 6.5 = 55.5 bytes per vertex slot, **27.75 bytes per triangle of capacity** with `u16`
-//! (49.5 with `u32`). A cut for a 10,000-triangle budget, `Cut<5120, 10240, 640>`, is 284,200
+//! (44.75 with `u32`). A cut for a 10,000-triangle budget, `Cut<5120, 10240, 640>`, is 284,200
 //! bytes. The queues only bound how much one frame can do: when one overflows, the rest waits for
 //! the next frame and [`crate::adapt::FrameStats`] says so.
 //!

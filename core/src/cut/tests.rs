@@ -364,3 +364,18 @@ mod adapt {
         assert!(settled(&cut));
     }
 }
+
+#[test]
+fn the_budget_table_of_the_readme() {
+    // A cut for a budget of B triangles: V = B / 2 + 32 vertex slots, F = B, Q = V / 8.
+    assert_eq!(Cut::<532, 1000, 66>::BYTES, 28_388);
+    assert_eq!(Cut::<1032, 2000, 129>::BYTES, 56_164);
+    assert_eq!(Cut::<2532, 5000, 316>::BYTES, 139_388);
+    assert_eq!(Cut::<5032, 10000, 629>::BYTES, 278_164);
+}
+
+#[test]
+fn the_readme_figures_of_the_benchmark_cuts() {
+    assert_eq!(Cut::<16384, 32768, 2048>::BYTES, 909_352);
+    assert_eq!(Cut::<262144, 524288, 32768, u32>::BYTES, 23_461_928);
+}
