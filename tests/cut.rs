@@ -225,3 +225,33 @@ fn a_small_cut_reports_capacity_instead_of_failing() {
     }
     assert!(limited);
 }
+
+/// Adapting the same view a second time does nothing when no budget, capacity or operation cap
+/// binds: one call reaches the cut the view asks for.
+#[test]
+fn one_call_converges_over_the_peer_orbit() {
+    use vdlod_core::policy::QRefine;
+    use vdlod_demo::camera::Orbit;
+    use vdlod_demo::lod::policy_view;
+    let mesh = fixture("bunny.obj");
+    let bytes = hierarchy_bytes(&mesh);
+    let h = HierarchyView::parse(&bytes).unwrap();
+    let orbit = Orbit::peer(&mesh.bounds(), 200);
+    for tau in [0.25f32, 0.5, 1.0, 2.0, 4.0] {
+        let mut cut = Cut::<16384, 32768, 2048>::boxed();
+        cut.reset(&h).unwrap();
+        let policy = QRefine::new(tau);
+        let mut again = 0;
+        for i in 0..40 {
+            let view = policy_view(&orbit.camera(i * 5), 640.0 / 480.0, 480, 1.0);
+            let first = cut.adapt(&h, &view, &policy, &Budget::default());
+            assert!(
+                !first.queue_overflow && !first.capacity_limited,
+                "{tau} px, frame {i}: {first:?}"
+            );
+            let second = cut.adapt(&h, &view, &policy, &Budget::default());
+            again += second.vsplits + second.ecols;
+        }
+        assert_eq!(again, 0, "{tau} px: a second call still split or collapsed");
+    }
+}

@@ -4,7 +4,11 @@
 //! `adapt_refinement`: one pass over the active vertices asks the [`Policy`] about each, then
 //!
 //! 1. **coarsen**: sibling pairs whose parent the policy no longer needs are collapsed where
-//!    Hoppe's condition allows (collapses it forbids wait for a later frame);
+//!    Hoppe's condition allows; a pair it forbids is retried in the same frame after other
+//!    collapses (one of them may be what it waited for), and a collapse that makes a new pair
+//!    lists it, so when no budget, queue or operation cap binds, one call reaches the cut the
+//!    view asks for and a second call with the same view does nothing (a test over the peer
+//!    orbit at 0.25-4 px);
 //! 2. **refine**: vertices over tolerance are split largest error first (a priority queue), each
 //!    forcing the splits it depends on, and their children join the queue;
 //! 3. **budget**: splits stop at [`Budget::max_triangles`]; when the budget binds, pairs whose
@@ -58,7 +62,8 @@
 //! ```
 
 use crate::cut::{
-    Cut, Pair, PairFans, Refused, SlotIndex, BLENDING, BLOCKED, COLLAPSING, VISIBLE, WAS_VISIBLE,
+    Cut, Pair, PairFans, Refused, SlotIndex, BLENDING, BLOCKED, COLLAPSING, FIRST_CHILD, VISIBLE,
+    WAS_VISIBLE,
 };
 use crate::format::HierarchyView;
 use crate::policy::{Demand, Policy, View};
@@ -220,7 +225,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             ops: 0,
         };
         self.evaluate(h, view, policy, &mut frame);
-        self.coarsen(h, budget, &mut frame);
+        self.coarsen(h, view, policy, budget, &mut frame);
         self.refine(h, view, policy, budget, &mut frame);
         self.enforce_max(h, view, policy, budget, &mut frame.stats);
         // A cut that shrank gets a smaller node map (faster lookups).
@@ -288,9 +293,6 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 }
                 continue;
             }
-            if self.v.flags[i] & self.v.flags[j] & BLOCKED != 0 {
-                continue;
-            }
             let pair = Pair {
                 error: e,
                 parent: p,
@@ -304,65 +306,131 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
 
     /// Collapses the listed pairs where the parent is no longer needed and Hoppe's condition
     /// allows; with geomorphs, visible pairs first blend to the parent and collapse on arrival.
-    fn coarsen(&mut self, h: &HierarchyView<'_>, budget: &Budget, frame: &mut Frame) {
+    /// A collapse that makes a new pair lists it too, so coarsening goes as far as the view asks
+    /// in one call.
+    fn coarsen<P: Policy>(
+        &mut self,
+        h: &HierarchyView<'_>,
+        view: &View,
+        policy: &P,
+        budget: &Budget,
+        frame: &mut Frame,
+    ) {
         let frames = self.geomorph_frames;
-        for k in 0..self.pairs.len() {
-            let Pair {
-                error: e,
-                parent: p,
-                first,
-            } = self.pairs.as_slice()[k];
-            // The first child's slot from the pass, unless a collapse since moved it.
-            let a = if (first as usize) < self.v.len()
-                && self.pair_parent(h, first as usize) == Some(p)
-            {
-                first
-            } else {
-                match self.slot(h.split(p).children[0]) {
-                    Some(a) if self.pair_parent(h, a as usize) == Some(p) => a,
-                    _ => continue,
+        // Rounds: a pair found illegal is kept for another round while collapses happen, since
+        // one of them may be what it waited for.
+        loop {
+            let mut kept = 0usize;
+            let mut progress = false;
+            let mut k = 0;
+            while k < self.pairs.len() {
+                let pair = self.pairs.as_slice()[k];
+                k += 1;
+                let Pair {
+                    error: e,
+                    parent: p,
+                    first,
+                } = pair;
+                // The first child's slot from the pass, unless a collapse since moved it.
+                let a = if (first as usize) < self.v.len()
+                    && self.pair_parent(h, first as usize) == Some(p)
+                {
+                    first
+                } else {
+                    match self.slot(h.split(p).children[0]) {
+                        Some(a) if self.pair_parent(h, a as usize) == Some(p) => a,
+                        _ => continue,
+                    }
+                };
+                let b = self.v.mate(a as usize);
+                let (a, b) = (a as usize, b as usize);
+                if frame.ops >= budget.max_ops {
+                    frame.stats.ops_limited = true;
+                    return;
                 }
-            };
-            let b = self.v.mate(a as usize);
-            let (a, b) = (a as usize, b as usize);
-            if frame.ops >= budget.max_ops {
-                frame.stats.ops_limited = true;
-                break;
-            }
-            let (fa, fb) = (self.v.flags[a], self.v.flags[b]);
-            let blending = fa & fb & COLLAPSING != 0;
-            if blending && (fa | fb) & BLENDING != 0 {
-                continue;
-            }
-            let seen = e >= 0.0 && (fa | fb) & WAS_VISIBLE != 0;
-            let split = h.split(p);
-            let mut fans = PairFans::default();
-            let legal = self.collapse_legal_at(h, p, &split, a as u32, b as u32, &mut fans);
-            if !blending && frames > 0 && seen {
-                if legal.is_err() {
+                let (fa, fb) = (self.v.flags[a], self.v.flags[b]);
+                if fa & fb & BLOCKED != 0 {
+                    // Found illegal before, and nothing around collapsed since: wait for a
+                    // collapse of this frame to clear the mark.
+                    self.pairs.as_mut_slice()[kept] = pair;
+                    kept += 1;
+                    continue;
+                }
+                let blending = fa & fb & COLLAPSING != 0;
+                if blending && (fa | fb) & BLENDING != 0 {
+                    continue;
+                }
+                let seen = e >= 0.0 && (fa | fb) & WAS_VISIBLE != 0;
+                let split = h.split(p);
+                let mut fans = PairFans::default();
+                let legal = self.collapse_legal_at(h, p, &split, a as u32, b as u32, &mut fans);
+                if legal.is_err() && !blending {
                     self.block(a, b);
+                    self.pairs.as_mut_slice()[kept] = pair;
+                    kept += 1;
                     continue;
                 }
-                if self.blends.len() + 2 <= Q {
-                    self.start_blend(h, a, true);
-                    self.start_blend(h, b, true);
-                    continue;
+                if !blending && frames > 0 && seen {
+                    if self.blends.len() + 2 <= Q {
+                        self.start_blend(h, a, true);
+                        self.start_blend(h, b, true);
+                        continue;
+                    }
+                    frame.stats.blend_limited = true;
                 }
-                frame.stats.blend_limited = true;
+                match legal {
+                    Ok(plan) => {
+                        let s = self.apply_collapse(h, p, plan, &fans);
+                        frame.stats.ecols += 1;
+                        frame.ops += 1;
+                        progress = true;
+                        self.list_new_pair(h, view, policy, s as usize, frame);
+                    }
+                    Err(_) => {
+                        // Arrived, but the neighbourhood changed meanwhile: blend back.
+                        self.start_blend(h, a, false);
+                        self.start_blend(h, b, false);
+                    }
+                }
             }
-            match legal {
-                Ok(plan) => {
-                    self.apply_collapse(h, p, plan, &fans);
-                    frame.stats.ecols += 1;
-                    frame.ops += 1;
-                }
-                Err(_) if !blending => self.block(a, b),
-                Err(_) => {
-                    // Arrived, but the neighbourhood changed meanwhile: blend back.
-                    self.start_blend(h, a, false);
-                    self.start_blend(h, b, false);
-                }
+            if !progress || kept == 0 {
+                return;
             }
+            self.pairs.truncate(kept);
+        }
+    }
+
+    /// Lists the pair slot `s` now belongs to, if its sibling is active and their parent is no
+    /// longer needed.
+    fn list_new_pair<P: Policy>(
+        &mut self,
+        h: &HierarchyView<'_>,
+        view: &View,
+        policy: &P,
+        s: usize,
+        frame: &mut Frame,
+    ) {
+        let m = self.v.mate(s);
+        if m == crate::cut::NIL {
+            return;
+        }
+        let first = if self.v.flags[s] & FIRST_CHILD != 0 {
+            s
+        } else {
+            m as usize
+        };
+        let p = h.parent(self.v.node[first]);
+        let error = pair_error(policy.demand(&h.bounds(p), view));
+        if error > frame.threshold {
+            return;
+        }
+        let pair = Pair {
+            error,
+            parent: p,
+            first: first as u32,
+        };
+        if self.pairs.push(pair).is_err() {
+            frame.stats.queue_overflow = true;
         }
     }
 
