@@ -8,7 +8,7 @@ use proptest::prelude::*;
 use vdlod_core::adapt::Budget;
 use vdlod_core::build::{build, BuildOptions, InputMesh};
 use vdlod_core::cut::Cut;
-use vdlod_core::format::{crc32, HierarchyView, HEADER_SIZE, NONE};
+use vdlod_core::format::{crc32, HierarchyView, COUNT_OFFSETS, CRC_OFFSET, HEADER_SIZE, NONE};
 use vdlod_core::policy::{QRefine, View};
 use vdlod_demo::mesh::{load_obj_bytes, COW_NAME, COW_OBJ};
 
@@ -82,7 +82,7 @@ fn fly(view: &HierarchyView<'_>) {
 fn reseal(bytes: &mut [u8]) {
     if bytes.len() >= HEADER_SIZE {
         let crc = crc32(&bytes[HEADER_SIZE..]);
-        bytes[24..28].copy_from_slice(&crc.to_le_bytes());
+        bytes[CRC_OFFSET..CRC_OFFSET + 4].copy_from_slice(&crc.to_le_bytes());
     }
 }
 
@@ -127,8 +127,8 @@ proptest! {
         counts in [0u32..64, 0u32..64, 0u32..64],
     ) {
         let mut bytes = cow_bytes()[..HEADER_SIZE].to_vec();
-        for (k, c) in counts.iter().enumerate() {
-            bytes[8 + 4 * k..12 + 4 * k].copy_from_slice(&c.to_le_bytes());
+        for (&o, c) in COUNT_OFFSETS.iter().zip(counts) {
+            bytes[o..o + 4].copy_from_slice(&c.to_le_bytes());
         }
         bytes.extend_from_slice(&body);
         reseal(&mut bytes);

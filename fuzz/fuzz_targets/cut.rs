@@ -8,7 +8,7 @@
 use libfuzzer_sys::fuzz_target;
 use vdlod_core::adapt::Budget;
 use vdlod_core::cut::Cut;
-use vdlod_core::format::{crc32, HierarchyView, HEADER_SIZE};
+use vdlod_core::format::{crc32, HierarchyView, CRC_OFFSET, HEADER_SIZE};
 use vdlod_core::policy::{QRefine, View};
 
 fuzz_target!(|data: &[u8]| {
@@ -17,7 +17,7 @@ fuzz_target!(|data: &[u8]| {
     }
     let mut sealed = data.to_vec();
     let crc = crc32(&sealed[HEADER_SIZE..]);
-    sealed[24..28].copy_from_slice(&crc.to_le_bytes());
+    sealed[CRC_OFFSET..CRC_OFFSET + 4].copy_from_slice(&crc.to_le_bytes());
     let Ok(view) = HierarchyView::parse(&sealed) else {
         return;
     };

@@ -5,7 +5,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use vdlod_core::format::{crc32, HierarchyView, HEADER_SIZE, NONE};
+use vdlod_core::format::{crc32, HierarchyView, CRC_OFFSET, HEADER_SIZE, NONE};
 
 fn check(data: &[u8]) {
     if let Ok(view) = HierarchyView::parse(data) {
@@ -32,7 +32,7 @@ fuzz_target!(|data: &[u8]| {
     if data.len() >= HEADER_SIZE {
         let mut sealed = data.to_vec();
         let crc = crc32(&sealed[HEADER_SIZE..]);
-        sealed[24..28].copy_from_slice(&crc.to_le_bytes());
+        sealed[CRC_OFFSET..CRC_OFFSET + 4].copy_from_slice(&crc.to_le_bytes());
         check(&sealed);
     }
 });

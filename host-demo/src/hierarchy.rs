@@ -51,15 +51,15 @@ pub fn summarize(view: &HierarchyView<'_>) -> Summary {
     let mut max_depth = 0u32;
     let mut sum = 0u64;
     for i in 0..view.leaves() {
-        let d = view.node(i).depth as u32;
+        let d = view.depth(i) as u32;
         max_depth = max_depth.max(d);
         sum += d as u64;
     }
     let base_vertices = (0..view.nodes())
-        .filter(|&i| view.node(i).parent == NONE)
+        .filter(|&i| view.parent(i) == NONE)
         .count() as u32;
     let border_splits = (view.leaves()..view.nodes())
-        .filter(|&p| view.split(p).wings[1] == NONE)
+        .filter(|&p| !view.split(p).second())
         .count() as u32;
     let splits = view.nodes() - view.leaves();
     Summary {

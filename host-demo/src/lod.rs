@@ -142,8 +142,25 @@ pub fn full_detail(h: &HierarchyView<'_>, cut: &mut DemoCut) -> Result<IndexedMe
         .iter()
         .map(|t| t.map(|s| nodes[s.index()]))
         .collect();
+    cut.check(h).map_err(|d| {
+        format!(
+            "the file contradicts its own mesh: {} (slot {})",
+            d.what, d.slot
+        )
+    })?;
     if triangles.iter().flatten().any(|&v| v >= h.leaves()) {
-        return Err("the cut holds too little for full detail".into());
+        let full = cut.vertex_count() >= (1 << 18) || triangles.len() >= (1 << 19);
+        return Err(if full {
+            format!(
+                "full detail needs more than the demo cut's {} vertices and {} triangles",
+                1 << 18,
+                1 << 19
+            )
+        } else {
+            "full refinement does not reach every input vertex: the file's split records \
+             contradict its mesh (forged or corrupted)"
+                .into()
+        });
     }
     let colors = h
         .has_colors()

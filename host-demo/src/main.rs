@@ -379,9 +379,19 @@ fn build_command(args: BuildArgs) -> Result<(), String> {
     let show = std::io::IsTerminal::is_terminal(&std::io::stderr());
     let (_, bytes, seconds) = hierarchy::build_with_progress(&mesh, &opts, show)
         .map_err(|e| format!("{}: {e}", args.mesh.display()))?;
-    std::fs::write(&args.out, &bytes)
-        .map_err(|e| format!("{}: cannot write: {e}", args.out.display()))?;
+    // Validate, write beside the target, then rename: never an invalid or partial file.
     let view = HierarchyView::parse(&bytes).map_err(|e| format!("{}: {e}", args.out.display()))?;
+    lod::full_detail(&view, &mut lod::new_cut())
+        .map_err(|e| format!("{}: {e}", args.out.display()))?;
+    let mut partial = args.out.clone().into_os_string();
+    partial.push(".partial");
+    let partial = PathBuf::from(partial);
+    std::fs::write(&partial, &bytes)
+        .and_then(|()| std::fs::rename(&partial, &args.out))
+        .map_err(|e| {
+            let _ = std::fs::remove_file(&partial);
+            format!("{}: cannot write: {e}", args.out.display())
+        })?;
     println!("{}: {}", args.out.display(), hierarchy::summarize(&view));
     println!("built in {seconds:.3} s");
     Ok(())
@@ -390,6 +400,8 @@ fn build_command(args: BuildArgs) -> Result<(), String> {
 fn info(file: PathBuf) -> Result<(), String> {
     let bytes = hierarchy::read(&file)?;
     let view = HierarchyView::parse(&bytes).map_err(|e| format!("{}: {e}", file.display()))?;
+    // What `orbit` would reject, `info` rejects: refine it fully and check the mesh.
+    lod::full_detail(&view, &mut lod::new_cut()).map_err(|e| format!("{}: {e}", file.display()))?;
     println!("{}: {}", file.display(), hierarchy::summarize(&view));
     Ok(())
 }

@@ -292,3 +292,52 @@ fn orbit_rejects_a_corrupted_hierarchy_in_one_line() {
     assert_eq!(stderr.lines().count(), 1, "{stderr}");
     assert!(stderr.contains("bad.vdh: truncated"), "{stderr}");
 }
+
+/// A forged split record with a valid checksum passes the format checks but not a full
+/// refinement: `info` rejects it as `orbit` does, with the same reason.
+#[test]
+fn info_rejects_what_orbit_rejects() {
+    use vdlod_core::build::{build, InputMesh};
+    use vdlod_core::format::{HierarchyView, NONE};
+    use vdlod_demo::mesh::{load_obj_bytes, COW_NAME, COW_OBJ};
+    let dir = scratch_dir("cli_info_forged");
+    let cow = load_obj_bytes(COW_NAME, COW_OBJ).unwrap();
+    let input = InputMesh {
+        positions: &cow.positions,
+        colors: None,
+        triangles: &cow.triangles,
+    };
+    let mut h = build(&input, &Default::default(), &mut |_| {}).unwrap();
+    // Swap the neighbours of the first added triangle of the finest split that has both.
+    let p = (h.leaves as usize..h.nodes.len())
+        .find(|&p| h.nodes[p].neighbours[0] != NONE && h.nodes[p].neighbours[1] != NONE)
+        .unwrap();
+    h.nodes[p].neighbours.swap(0, 1);
+    let bytes = h.to_bytes(false);
+    assert!(
+        HierarchyView::parse(&bytes).is_ok(),
+        "the forgery passes the format checks"
+    );
+    std::fs::write(dir.join("forged.vdh"), &bytes).unwrap();
+    for args in [
+        &["info", "forged.vdh"][..],
+        &["orbit", "forged.vdh", "--frames", "1"],
+    ] {
+        let out = demo(args, &dir);
+        assert!(!out.status.success(), "{args:?}");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(stderr.lines().count(), 1, "{stderr}");
+        assert!(stderr.contains("forged.vdh: "), "{stderr}");
+        assert!(stderr.contains("contradict"), "{args:?}: {stderr}");
+    }
+    // An old file says to rebuild it.
+    let mut old = bytes.clone();
+    old[4] = 2;
+    std::fs::write(dir.join("old.vdh"), &old).unwrap();
+    let out = demo(&["info", "old.vdh"], &dir);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && stderr.contains("rebuild"),
+        "{stderr}"
+    );
+}

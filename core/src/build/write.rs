@@ -1,56 +1,163 @@
-//! Writing a [`Hierarchy`] in the format [`crate::format`] reads.
+//! Writing a [`Hierarchy`] in the format [`crate::format`] reads (version 3).
 
 use alloc::vec::Vec;
 
 use super::Hierarchy;
 use crate::format::{
-    crc32, f32_to_f16_up, oct_encode, FLAG_COLORS, HEADER_SIZE, MAGIC, NODE_SIZE, SPLIT_SIZE,
-    VERSION,
+    crc32, encode_length, id_width, oct_encode, BOX_OFFSET, COUNT_OFFSETS, CRC_OFFSET, FLAG_COLORS,
+    HEADER_SIZE, MAGIC, NONE, POSITION_STEPS, VERSION,
 };
+
+/// Appends values of a few bits each, least significant first.
+struct BitWriter<'a> {
+    out: &'a mut Vec<u8>,
+    acc: u64,
+    bits: u32,
+}
+
+impl<'a> BitWriter<'a> {
+    fn new(out: &'a mut Vec<u8>) -> Self {
+        BitWriter {
+            out,
+            acc: 0,
+            bits: 0,
+        }
+    }
+
+    /// Appends the low `width` (at most 32) bits of `v`.
+    fn push(&mut self, v: u32, width: u32) {
+        let v = if width >= 32 {
+            v as u64
+        } else {
+            (v & ((1u32 << width) - 1)) as u64
+        };
+        self.acc |= v << self.bits;
+        self.bits += width;
+        while self.bits >= 8 {
+            self.out.push(self.acc as u8);
+            self.acc >>= 8;
+            self.bits -= 8;
+        }
+    }
+
+    /// An id at `width` bits; [`NONE`] as all ones.
+    fn push_id(&mut self, id: u32, width: u32) {
+        self.push(if id == NONE { u32::MAX } else { id }, width);
+    }
+
+    /// Pads the last byte with zeros.
+    fn finish(self) {
+        if self.bits > 0 {
+            self.out.push(self.acc as u8);
+        }
+    }
+}
 
 impl Hierarchy {
     /// The hierarchy as bytes for [`crate::format::HierarchyView::parse`]. `colors` sets the
-    /// header flag saying the nodes' colours mean something.
+    /// header flag saying the nodes' colours mean something (and stores them).
+    ///
+    /// Positions are quantized to 16 bits over the nodes' bounding box, and every bound grows by
+    /// twice the largest quantization error (a node and a leaf each move by at most that much),
+    /// then rounds up to its 8-bit code: bounds stay bounds of what a device reads.
     pub fn to_bytes(&self, colors: bool) -> Vec<u8> {
         // A hierarchy that is not `is_consistent` gives bytes that `parse` rejects, not a panic.
-        let parent_nodes = self.nodes.get(self.leaves as usize..).unwrap_or(&[]);
-        let parents = parent_nodes.len();
-        let size = HEADER_SIZE
-            + self.nodes.len() * NODE_SIZE
-            + parents * SPLIT_SIZE
-            + self.base_triangles.len() * 12;
-        let mut out = Vec::with_capacity(size);
+        let n = self.nodes.len() as u32;
+        let leaves = self.leaves.min(n);
+        let base = self.base_triangles.len() as u32;
+        let faces = base.saturating_add((n - leaves).saturating_mul(2));
+        let (wn, wf) = (id_width(n), id_width(faces));
+
+        let mut lo = [f32::INFINITY; 3];
+        let mut hi = [f32::NEG_INFINITY; 3];
+        for node in &self.nodes {
+            for k in 0..3 {
+                lo[k] = lo[k].min(node.position[k]);
+                hi[k] = hi[k].max(node.position[k]);
+            }
+        }
+        if self.nodes.is_empty() {
+            (lo, hi) = ([0.0; 3], [0.0; 3]);
+        }
+        let extent = [0, 1, 2].map(|k| (hi[k] - lo[k]).max(0.0));
+        let step = extent.map(|e| e / POSITION_STEPS);
+        let diagonal = libm::sqrtf(extent.iter().map(|e| e * e).sum::<f32>());
+        let unit = if diagonal.is_finite() && diagonal > 0.0 {
+            diagonal
+        } else {
+            1.0
+        };
+        let quantize = |p: [f32; 3]| -> [u16; 3] {
+            [0, 1, 2].map(|k| {
+                if step[k] > 0.0 {
+                    libm::roundf((p[k] - lo[k]) / step[k]).clamp(0.0, POSITION_STEPS) as u16
+                } else {
+                    0
+                }
+            })
+        };
+        let decoded = |q: [u16; 3]| [0, 1, 2].map(|k| lo[k] + q[k] as f32 * step[k]);
+        let mut moved = 0.0f64;
+        for node in &self.nodes {
+            let d = decoded(quantize(node.position));
+            let e: f64 = (0..3)
+                .map(|k| {
+                    let x = d[k] as f64 - node.position[k] as f64;
+                    x * x
+                })
+                .sum();
+            moved = moved.max(libm::sqrt(e));
+        }
+        let grow = (2.0 * moved) as f32 * 1.001;
+        let code = |v: f32| encode_length((v + grow) / unit);
+
+        let mut out = Vec::new();
         out.extend_from_slice(&MAGIC);
         out.extend_from_slice(&VERSION.to_le_bytes());
         out.extend_from_slice(&(if colors { FLAG_COLORS } else { 0 }).to_le_bytes());
-        for count in [
-            self.leaves,
-            self.nodes.len() as u32,
-            self.base_triangles.len() as u32,
-            0,
-        ] {
-            out.extend_from_slice(&count.to_le_bytes());
+        out.resize(HEADER_SIZE, 0);
+        for (o, c) in COUNT_OFFSETS.into_iter().zip([leaves, n, base]) {
+            out[o..o + 4].copy_from_slice(&c.to_le_bytes());
         }
-        out.extend_from_slice(&[0u8; 16]); // checksum, then reserved
-        for n in &self.nodes {
-            for c in n.position {
-                out.extend_from_slice(&c.to_le_bytes());
+        for (k, v) in lo.iter().chain(&extent).chain([&unit]).enumerate() {
+            let o = BOX_OFFSET + 4 * k;
+            out[o..o + 4].copy_from_slice(&v.to_le_bytes());
+        }
+        for node in &self.nodes {
+            for q in quantize(node.position) {
+                out.extend_from_slice(&q.to_le_bytes());
             }
-            for b in [n.radius, n.mu, n.delta, n.spheroid[0], n.spheroid[1]] {
-                out.extend_from_slice(&f32_to_f16_up(b).to_le_bytes());
-            }
-            let (x, y) = oct_encode(n.normal);
+            let (x, y) = oct_encode(node.normal);
             out.extend_from_slice(&[x as u8, y as u8]);
-            out.push(libm::ceilf(n.cone_sin.clamp(0.0, 1.0) * 255.0) as u8);
-            out.extend_from_slice(&n.color);
-            out.extend_from_slice(&n.depth.to_le_bytes());
-            out.extend_from_slice(&n.parent.to_le_bytes());
         }
-        for n in parent_nodes {
-            for v in n.children.iter().chain(&n.wings).chain(&n.neighbours) {
-                out.extend_from_slice(&v.to_le_bytes());
+        if colors {
+            for node in &self.nodes {
+                out.extend_from_slice(&node.color);
             }
         }
+        let mut bits = BitWriter::new(&mut out);
+        for node in &self.nodes {
+            bits.push_id(node.parent, wn);
+        }
+        bits.finish();
+        let mut bits = BitWriter::new(&mut out);
+        for node in self.nodes.get(leaves as usize..).unwrap_or(&[]) {
+            for &c in &node.children {
+                bits.push_id(c, wn);
+            }
+            for &f in &node.neighbours {
+                bits.push_id(f, wf);
+            }
+            let cone = libm::ceilf(node.cone_sin.clamp(0.0, 1.0) * 255.0) as u8;
+            let codes = [
+                code(node.radius),
+                code(node.spheroid[0]),
+                code(node.spheroid[1]),
+                cone,
+            ];
+            bits.push(u32::from_le_bytes(codes), 32);
+        }
+        bits.finish();
         for t in &self.base_triangles {
             for v in t {
                 out.extend_from_slice(&v.to_le_bytes());
@@ -58,7 +165,7 @@ impl Hierarchy {
         }
 
         let crc = crc32(&out[HEADER_SIZE..]);
-        out[24..28].copy_from_slice(&crc.to_le_bytes());
+        out[CRC_OFFSET..CRC_OFFSET + 4].copy_from_slice(&crc.to_le_bytes());
         out
     }
 }

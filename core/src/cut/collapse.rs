@@ -80,7 +80,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             return Err(Refused::Illegal);
         }
         let fr = adj[k];
-        if s.wings[1] != NONE {
+        if s.second() {
             let Some(t) = self.t.get(fr) else {
                 return Err(Refused::Illegal);
             };

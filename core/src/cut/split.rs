@@ -38,7 +38,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         }
         let s = h.split(node);
         let n = s.neighbours;
-        let second = s.wings[1] != NONE;
+        let second = s.second();
         // The neighbour triangles must all be around the vertex (whose fan must be whole).
         let mut fan = Fan::new_fan();
         if !self.complete_fan(ps, &mut fan) {
