@@ -530,12 +530,22 @@ pub fn run_orbit(
     );
     let mut frames = Vec::with_capacity(opts.frames as usize);
     let mut vertices = CutVertices::default();
+    let mut warned = false;
     let compared = opts.frames / 2;
     for i in 0..opts.frames {
         let camera = orbit.camera(i);
         let view = policy_view(&camera, frame.aspect(), opts.height, opts.frustum);
         let start = Instant::now();
         let stats = cut.adapt(&h, &view, &&*policy, &opts.budget);
+        if stats.over_budget && !warned && h.base_triangles() > opts.budget.max_triangles {
+            eprintln!(
+                "vdlod-demo: warning: the base mesh has {} triangles, more than the budget of {}: \
+                 no cut of this hierarchy fits it",
+                h.base_triangles(),
+                opts.budget.max_triangles
+            );
+            warned = true;
+        }
         let adapt_us = start.elapsed().as_secs_f64() * 1e6;
         let params = camera_params(&camera, frame.aspect(), Shading::Gouraud, false);
         let start = Instant::now();

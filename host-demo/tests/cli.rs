@@ -341,3 +341,27 @@ fn info_rejects_what_orbit_rejects() {
         "{stderr}"
     );
 }
+
+/// A budget below the base mesh is honoured as far as it can be, and said once.
+#[test]
+fn orbit_warns_once_when_the_base_mesh_exceeds_the_budget() {
+    let dir = scratch_dir("cli_orbit_budget");
+    let head = fixture("head.obj");
+    let args = [
+        "orbit",
+        head.to_str().unwrap(),
+        "--budget",
+        "5",
+        "--frames",
+        "3",
+        "--width",
+        "32",
+        "--height",
+        "24",
+    ];
+    let out = demo(&args, &dir);
+    assert!(out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(stderr.matches("warning").count(), 1, "{stderr}");
+    assert!(stderr.contains("more than the budget of 5"), "{stderr}");
+}
