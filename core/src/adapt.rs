@@ -61,12 +61,13 @@
 //! # }
 //! ```
 
+use crate::cut::NIL;
 use crate::cut::{
     Cut, Pair, PairFans, Refused, SlotIndex, BLENDING, BLOCKED, COLLAPSING, FIRST_CHILD, VISIBLE,
     WAS_VISIBLE,
 };
-use crate::format::HierarchyView;
-use crate::policy::{Demand, Policy, View};
+use crate::format::{HierarchyView, NONE};
+use crate::policy::{Bounds, Demand, Policy, View};
 
 /// Limits on one frame's cut.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -250,57 +251,104 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         policy: &P,
         frame: &mut Frame,
     ) {
-        let t = frame.threshold;
         self.candidates.clear();
         self.pairs.clear();
-        for i in 0..self.v.len() {
-            if self.v.flags[i] & BLENDING != 0 {
-                self.advance(i);
+        // In batches: first every read of the hierarchy the batch needs (independent loads the
+        // processor overlaps, where one vertex at a time would wait for each), then the decisions.
+        const BATCH: usize = 32;
+        let mut bounds = [Bounds::default(); BATCH];
+        let mut parents = [NONE; BATCH];
+        let mut parent_bounds = [Bounds::default(); BATCH];
+        let mut base = 0;
+        while base < self.v.len() {
+            let n = (self.v.len() - base).min(BATCH);
+            let nodes = &self.v.node[base..base + n];
+            for (b, &node) in bounds.iter_mut().zip(nodes) {
+                *b = h.bounds(node);
             }
-            let node = self.v.node[i];
-            let d = policy.demand(&h.bounds(node), view);
-            let flags = self.v.flags[i];
-            let was = if flags & VISIBLE != 0 { WAS_VISIBLE } else { 0 };
-            self.v.flags[i] = (flags & !(VISIBLE | WAS_VISIBLE)) | was | d.visible as u8;
-            let collapsing = flags & COLLAPSING != 0;
-            if collapsing && self.v.mate(i) == crate::cut::NIL {
-                // The pair was broken up (a forced split took the sibling): blend back.
+            for (k, p) in parents[..n].iter_mut().enumerate() {
+                let i = base + k;
+                *p = if self.v.flags[i] & FIRST_CHILD != 0 && self.v.mate(i) != NIL {
+                    h.parent(self.v.node[i])
+                } else {
+                    NONE
+                };
+            }
+            for (b, &p) in parent_bounds.iter_mut().zip(&parents[..n]) {
+                if p != NONE {
+                    *b = h.bounds(p);
+                }
+            }
+            for k in 0..n {
+                let (b, p, pb) = (bounds[k], parents[k], parent_bounds[k]);
+                self.decide(h, view, policy, base + k, &b, p, &pb, frame);
+            }
+            base += n;
+        }
+    }
+
+    /// The decisions for slot `i` (see [`Cut::evaluate`]), with its bounds and, for a first child
+    /// whose sibling is active, its parent and the parent's bounds.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn decide<P: Policy>(
+        &mut self,
+        h: &HierarchyView<'_>,
+        view: &View,
+        policy: &P,
+        i: usize,
+        bounds: &Bounds,
+        p: u32,
+        parent_bounds: &Bounds,
+        frame: &mut Frame,
+    ) {
+        let t = frame.threshold;
+        if self.v.flags[i] & BLENDING != 0 {
+            self.advance(i);
+        }
+        let node = self.v.node[i];
+        let d = policy.demand(bounds, view);
+        let flags = self.v.flags[i];
+        let was = if flags & VISIBLE != 0 { WAS_VISIBLE } else { 0 };
+        self.v.flags[i] = (flags & !(VISIBLE | WAS_VISIBLE)) | was | d.visible as u8;
+        let collapsing = flags & COLLAPSING != 0;
+        if collapsing && self.v.mate(i) == NIL {
+            // The pair was broken up (a forced split took the sibling): blend back.
+            self.start_blend(h, i, false);
+        }
+        if d.error > t && node >= h.leaves() {
+            if self.v.flags[i] & COLLAPSING != 0 {
+                // Wanted again: reverse the collapse's blend; no split this frame.
                 self.start_blend(h, i, false);
-            }
-            if d.error > t && node >= h.leaves() {
-                if self.v.flags[i] & COLLAPSING != 0 {
-                    // Wanted again: reverse the collapse's blend; no split this frame.
-                    self.start_blend(h, i, false);
-                } else if self
-                    .candidates
-                    .heap_push((d.error.to_bits(), node))
-                    .is_err()
-                {
-                    frame.stats.queue_overflow = true;
-                }
-                continue;
-            }
-            let Some(p) = self.pair_parent(h, i) else {
-                continue;
-            };
-            let j = self.v.mate(i) as usize;
-            let e = pair_error(policy.demand(&h.bounds(p), view));
-            if e > t {
-                // The parent is wanted: a collapse under way blends back.
-                if (self.v.flags[i] | self.v.flags[j]) & COLLAPSING != 0 {
-                    self.start_blend(h, i, false);
-                    self.start_blend(h, j, false);
-                }
-                continue;
-            }
-            let pair = Pair {
-                error: e,
-                parent: p,
-                first: i as u32,
-            };
-            if self.pairs.push(pair).is_err() {
+            } else if self
+                .candidates
+                .heap_push((d.error.to_bits(), node))
+                .is_err()
+            {
                 frame.stats.queue_overflow = true;
             }
+            return;
+        }
+        if p == NONE {
+            return;
+        }
+        let j = self.v.mate(i) as usize;
+        let e = pair_error(policy.demand(parent_bounds, view));
+        if e > t {
+            // The parent is wanted: a collapse under way blends back.
+            if (self.v.flags[i] | self.v.flags[j]) & COLLAPSING != 0 {
+                self.start_blend(h, i, false);
+                self.start_blend(h, j, false);
+            }
+            return;
+        }
+        let pair = Pair {
+            error: e,
+            parent: p,
+            first: i as u32,
+        };
+        if self.pairs.push(pair).is_err() {
+            frame.stats.queue_overflow = true;
         }
     }
 
@@ -411,7 +459,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         frame: &mut Frame,
     ) {
         let m = self.v.mate(s);
-        if m == crate::cut::NIL {
+        if m == NIL {
             return;
         }
         let first = if self.v.flags[s] & FIRST_CHILD != 0 {

@@ -18,13 +18,47 @@ use crate::label;
 use crate::mesh::{vertex_normals, Bounds, IndexedMesh};
 use crate::render::camera_params;
 
-/// The cut the demo uses: up to 262,144 active vertices and 524,288 triangles (a fully refined
-/// Loop-subdivided bunny fits), 32,768 queue entries, 32-bit indices; about 28 MB.
-pub type DemoCut = Cut<{ 1 << 18 }, { 1 << 19 }, { 1 << 15 }, u32>;
+/// Calls `$body` with `$cut` bound to a new boxed cut of the smallest capacity class that holds
+/// `$vertices` vertices and `$triangles` triangles: 16-bit cuts up to 32,767 vertices and 65,534
+/// triangles, then 32-bit cuts of 2^18, 2^20 and 2^22 vertices (twice the triangles), each with a
+/// queue of an eighth of its vertices. A cut is made on the heap directly, never on the stack, and
+/// its untouched pages cost nothing.
+macro_rules! with_cut {
+    ($vertices:expr, $triangles:expr, |$cut:ident| $body:expr) => {{
+        let (v, f): (u64, u64) = ($vertices, $triangles);
+        if v <= 4096 && f <= 8192 {
+            let mut $cut = Cut::<4096, 8192, 512>::boxed();
+            $body
+        } else if v <= 16384 && f <= 32768 {
+            let mut $cut = Cut::<16384, 32768, 2048>::boxed();
+            $body
+        } else if v <= 32767 && f <= 65534 {
+            let mut $cut = Cut::<32767, 65534, 4096>::boxed();
+            $body
+        } else if v <= 1 << 18 && f <= 1 << 19 {
+            let mut $cut = Cut::<{ 1 << 18 }, { 1 << 19 }, { 1 << 15 }, u32>::boxed();
+            $body
+        } else if v <= 1 << 20 && f <= 1 << 21 {
+            let mut $cut = Cut::<{ 1 << 20 }, { 1 << 21 }, { 1 << 17 }, u32>::boxed();
+            $body
+        } else {
+            let mut $cut = Cut::<{ 1 << 22 }, { 1 << 23 }, { 1 << 19 }, u32>::boxed();
+            $body
+        }
+    }};
+}
 
-/// A cut on the heap, made there directly (never on the stack).
-pub fn new_cut() -> Box<DemoCut> {
-    DemoCut::boxed()
+/// Vertices and triangles a cut of `h` needs for full detail, or at most `max_triangles`: a
+/// connected surface has at most two more vertices than triangles, plus one per root that no
+/// triangle uses (every component adds two; roots bound components).
+pub fn cut_size(h: &HierarchyView<'_>, max_triangles: u32) -> (u64, u64) {
+    let full = h.base_triangles() as u64 + 2 * (h.nodes() - h.leaves()) as u64;
+    let triangles = full
+        .min(max_triangles as u64)
+        .max(h.base_triangles() as u64);
+    let roots = h.nodes() as u64 - 2 * (h.nodes() - h.leaves()) as u64;
+    let vertices = (h.leaves() as u64).min(triangles + 2 * roots + 2);
+    (vertices, triangles)
 }
 
 /// Which policy decides where detail goes.
@@ -131,8 +165,17 @@ pub fn observer(orbit: &Orbit, i: u32) -> Camera {
     }
 }
 
-/// The full-detail mesh of a hierarchy: every split done, in leaf numbering.
-pub fn full_detail(h: &HierarchyView<'_>, cut: &mut DemoCut) -> Result<IndexedMesh, String> {
+/// The full-detail mesh of a hierarchy: every split done, in leaf numbering. Also proves the file
+/// consistent with its mesh (the cut's invariants hold and every leaf is reached).
+pub fn full_detail(h: &HierarchyView<'_>) -> Result<IndexedMesh, String> {
+    let (v, f) = cut_size(h, u32::MAX);
+    with_cut!(v, f, |cut| full_detail_with(h, &mut cut))
+}
+
+fn full_detail_with<const V: usize, const F: usize, const Q: usize, I: SlotIndex>(
+    h: &HierarchyView<'_>,
+    cut: &mut Cut<V, F, Q, I>,
+) -> Result<IndexedMesh, String> {
     cut.reset(h).map_err(|e| e.to_string())?;
     while cut.refine_everything(h) > 0 {}
     let positions: Vec<[f32; 3]> = (0..h.leaves()).map(|i| h.node(i).position).collect();
@@ -149,13 +192,8 @@ pub fn full_detail(h: &HierarchyView<'_>, cut: &mut DemoCut) -> Result<IndexedMe
         )
     })?;
     if triangles.iter().flatten().any(|&v| v >= h.leaves()) {
-        let full = cut.vertex_count() >= (1 << 18) || triangles.len() >= (1 << 19);
-        return Err(if full {
-            format!(
-                "full detail needs more than the demo cut's {} vertices and {} triangles",
-                1 << 18,
-                1 << 19
-            )
+        return Err(if cut.vertex_count() >= V || triangles.len() + 2 > F {
+            format!("full detail needs more than the largest cut's {V} vertices and {F} triangles")
         } else {
             "full refinement does not reach every input vertex: the file's split records \
              contradict its mesh (forged or corrupted)"
@@ -447,13 +485,23 @@ fn captioned(
 }
 
 /// Writes the cut's mesh as an OBJ file (positions as blended, 1-based faces).
-pub fn write_obj(path: &Path, cut: &DemoCut, h: &HierarchyView<'_>) -> std::io::Result<()> {
+pub fn write_obj<const V: usize, const F: usize, const Q: usize, I: SlotIndex>(
+    path: &Path,
+    cut: &Cut<V, F, Q, I>,
+    h: &HierarchyView<'_>,
+) -> std::io::Result<()> {
     let mut s = String::with_capacity(cut.vertex_count() * 40 + cut.triangles().len() * 24);
     for p in (0..cut.vertex_count()).map(|i| cut.vertex(h, i).position) {
         let _ = writeln!(s, "v {} {} {}", p[0], p[1], p[2]);
     }
     for t in cut.triangles() {
-        let _ = writeln!(s, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1);
+        let _ = writeln!(
+            s,
+            "f {} {} {}",
+            t[0].index() + 1,
+            t[1].index() + 1,
+            t[2].index() + 1
+        );
     }
     std::fs::write(path, s)
 }
@@ -500,9 +548,29 @@ pub fn run_orbit(
     mut report: impl FnMut(&OrbitFrame),
 ) -> Result<OrbitSummary, String> {
     let h = HierarchyView::parse(bytes).map_err(|e| e.to_string())?;
+    let (v, f) = cut_size(&h, opts.budget.max_triangles);
+    with_cut!(v, f, |cut| fly_orbit(
+        &h,
+        &mut cut,
+        full,
+        opts,
+        out_dir,
+        &mut report
+    ))
+}
+
+/// [`run_orbit`] with its cut.
+fn fly_orbit<const V: usize, const F: usize, const Q: usize, I: SlotIndex + VertexIndex>(
+    h: &HierarchyView<'_>,
+    cut: &mut Cut<V, F, Q, I>,
+    full: &IndexedMesh,
+    opts: &OrbitOptions,
+    out_dir: &Path,
+    report: &mut impl FnMut(&OrbitFrame),
+) -> Result<OrbitSummary, String> {
+    let h = *h;
     let io = |e: std::io::Error| format!("{}: {e}", out_dir.display());
     std::fs::create_dir_all(out_dir).map_err(io)?;
-    let mut cut = new_cut();
     cut.set_coloring(if opts.depth_colors {
         Coloring::Depth
     } else {
@@ -549,9 +617,9 @@ pub fn run_orbit(
         let adapt_us = start.elapsed().as_secs_f64() * 1e6;
         let params = camera_params(&camera, frame.aspect(), Shading::Gouraud, false);
         let start = Instant::now();
-        vertices.gather(&cut, &h);
+        vertices.gather(cut, &h);
         frame
-            .draw(&vertices.mesh(&cut, true_colors), &params)
+            .draw(&vertices.mesh(cut, true_colors), &params)
             .map_err(|e| e.to_string())?;
         let render_us = start.elapsed().as_secs_f64() * 1e6;
         let start = Instant::now();
@@ -585,7 +653,7 @@ pub fn run_orbit(
             };
             let drawn = camera_params(&seen_from, frame.aspect(), Shading::Gouraud, opts.wireframe);
             frame
-                .draw(&vertices.mesh(&cut, colors), &drawn)
+                .draw(&vertices.mesh(cut, colors), &drawn)
                 .map_err(|e| e.to_string())?;
         }
         if opts.write_frames {
@@ -594,7 +662,7 @@ pub fn run_orbit(
                 .map_err(|e| e.to_string())?;
         }
         if opts.dump_mesh {
-            write_obj(&out_dir.join(format!("mesh_{i:04}.obj")), &cut, &h).map_err(io)?;
+            write_obj(&out_dir.join(format!("mesh_{i:04}.obj")), cut, &h).map_err(io)?;
         }
         let _ = writeln!(
             csv,

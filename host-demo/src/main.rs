@@ -270,9 +270,7 @@ fn load_lod(mesh: Option<&PathBuf>) -> Result<(String, Vec<u8>, IndexedMesh), St
     if let (true, Some(path)) = (is_vdh, mesh) {
         let bytes = hierarchy::read(path)?;
         let view = HierarchyView::parse(&bytes).map_err(|e| format!("{}: {e}", path.display()))?;
-        let mut cut = lod::new_cut();
-        let full =
-            lod::full_detail(&view, &mut cut).map_err(|e| format!("{}: {e}", path.display()))?;
+        let full = lod::full_detail(&view).map_err(|e| format!("{}: {e}", path.display()))?;
         return Ok((path.display().to_string(), bytes, full));
     }
     let (name, mut full) = load(mesh).map_err(|e| e.to_string())?;
@@ -381,8 +379,7 @@ fn build_command(args: BuildArgs) -> Result<(), String> {
         .map_err(|e| format!("{}: {e}", args.mesh.display()))?;
     // Validate, write beside the target, then rename: never an invalid or partial file.
     let view = HierarchyView::parse(&bytes).map_err(|e| format!("{}: {e}", args.out.display()))?;
-    lod::full_detail(&view, &mut lod::new_cut())
-        .map_err(|e| format!("{}: {e}", args.out.display()))?;
+    lod::full_detail(&view).map_err(|e| format!("{}: {e}", args.out.display()))?;
     let mut partial = args.out.clone().into_os_string();
     partial.push(".partial");
     let partial = PathBuf::from(partial);
@@ -401,7 +398,7 @@ fn info(file: PathBuf) -> Result<(), String> {
     let bytes = hierarchy::read(&file)?;
     let view = HierarchyView::parse(&bytes).map_err(|e| format!("{}: {e}", file.display()))?;
     // What `orbit` would reject, `info` rejects: refine it fully and check the mesh.
-    lod::full_detail(&view, &mut lod::new_cut()).map_err(|e| format!("{}: {e}", file.display()))?;
+    lod::full_detail(&view).map_err(|e| format!("{}: {e}", file.display()))?;
     println!("{}: {}", file.display(), hierarchy::summarize(&view));
     Ok(())
 }

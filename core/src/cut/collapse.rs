@@ -57,7 +57,6 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         }
         let id = h.split_face(node, false);
         let fl = fan_a
-            .as_slice()
             .iter()
             .copied()
             .find(|&f| self.t.id[f as usize] == id)
@@ -130,7 +129,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         let [fan_a, fan_b] = &fans.0;
         // Collapses around here may become legal: clear the marks on every corner of the
         // triangles around both vertices (the parent's fan and its neighbours).
-        for &f in fan_a.as_slice().iter().chain(fan_b.as_slice()) {
+        for &f in fan_a.iter().chain(fan_b.iter()) {
             for v in self.t.at(f) {
                 if let Some(flags) = self.v.flags.get_mut(v as usize) {
                     *flags &= !BLOCKED;
@@ -150,7 +149,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         let db = self.v.degree[b as usize];
         self.v.degree[a as usize] = self.v.degree[a as usize].saturating_add(db);
         self.v.degree[b as usize] = 0;
-        for &f in fan_b.as_slice() {
+        for &f in fan_b {
             if f == fl || f == fr {
                 continue;
             }

@@ -6,22 +6,16 @@
 //! which every operation keeps. That count check is what keeps the cut whole on hierarchies
 //! crafted to contradict the mesh.
 
-use super::slot::{Arena, SlotIndex};
+use super::slot::SlotIndex;
 use super::{corner, prev3, Cut, NIL};
 
 /// Longest fan walked around one vertex; a hierarchy with larger vertex degrees is refused
 /// rather than walked forever.
 pub const MAX_FAN: usize = 1024;
 
-/// The triangle slots of one fan.
-pub(crate) type Fan = Arena<u32, MAX_FAN>;
-
-impl Fan {
-    /// An empty fan (on the stack: 4 KiB).
-    pub fn new_fan() -> Fan {
-        Arena::new(0)
-    }
-}
+/// The triangle slots of one fan: scratch on the stack, never in the cut, so an uninitialised
+/// vector (making one writes no memory; an arena would zero its 4 KiB each time).
+pub(crate) type Fan = heapless::Vec<u32, MAX_FAN>;
 
 /// The triangles around the two vertices of a collapse, found while proving it legal and used
 /// again to do it.
@@ -29,7 +23,7 @@ pub(crate) struct PairFans(pub [Fan; 2]);
 
 impl Default for PairFans {
     fn default() -> Self {
-        PairFans([Fan::new_fan(), Fan::new_fan()])
+        PairFans([Fan::new(), Fan::new()])
     }
 }
 
@@ -84,7 +78,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             None => return false,
         };
         while g != NIL {
-            if out.as_slice()[..ccw_part].contains(&g) || out.push(g).is_err() {
+            if out[..ccw_part].contains(&g) || out.push(g).is_err() {
                 return false;
             }
             g = match self.cw(g, v) {
@@ -97,6 +91,6 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
 
     /// Whether walking `v`'s fan finds every triangle that uses `v`, each once.
     pub(crate) fn fan_complete(&self, v: u32) -> bool {
-        self.complete_fan(v, &mut Fan::new_fan())
+        self.complete_fan(v, &mut Fan::new())
     }
 }

@@ -526,10 +526,10 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         self.free_blend(v as usize);
         let last = self.v.len() as u32 - 1;
         let moved = (v != last).then(|| {
-            let mut fan = fan::Fan::new_fan();
+            let mut fan = fan::Fan::new();
             // Proven whole before the collapse that removes `v`.
             let _ = self.complete_fan(last, &mut fan);
-            for &f in fan.as_slice() {
+            for &f in &fan {
                 if let Some(k) = corner(self.t.at(f), last) {
                     self.t.set_corner(f, k, v);
                 }

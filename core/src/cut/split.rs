@@ -14,23 +14,24 @@ pub(crate) struct SplitPlan {
     neighbours: [u32; 4],
     /// The wing vertices' slots (the second `NIL` on a border).
     wings: [u32; 2],
-    /// The triangles that move to the second child.
-    moved: Fan,
 }
 
 impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, I> {
     /// Splits active `node` if legal now. On success returns the children's slots.
     pub fn split(&mut self, h: &HierarchyView<'_>, node: u32) -> Result<[u32; 2], Refused> {
-        let plan = self.split_legal(h, node)?;
-        Ok(self.apply_split(h, node, &plan, 0))
+        let mut moved = Fan::new();
+        let plan = self.split_legal(h, node, &mut moved)?;
+        Ok(self.apply_split(h, node, &plan, &moved, 0))
     }
 
     /// Proves the split of `node` legal: it is active, its neighbour triangles are all around
-    /// it and meet along the edges the new triangles take over, and there is room.
+    /// it and meet along the edges the new triangles take over, and there is room. Collects the
+    /// triangles that move to the second child into `moved`.
     pub(crate) fn split_legal(
         &self,
         h: &HierarchyView<'_>,
         node: u32,
+        moved: &mut Fan,
     ) -> Result<SplitPlan, Refused> {
         let ps = self.slot(node).ok_or(Refused::NotActive)?;
         if node < h.leaves() {
@@ -40,12 +41,12 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         let n = s.neighbours;
         let second = s.second();
         // The neighbour triangles must all be around the vertex (whose fan must be whole).
-        let mut fan = Fan::new_fan();
+        let mut fan = Fan::new();
         if !self.complete_fan(ps, &mut fan) {
             return Err(Refused::Inconsistent);
         }
         let mut ns = [NIL; 4];
-        for &f in fan.as_slice() {
+        for &f in &fan {
             let id = self.t.id[f as usize];
             for k in 0..4 {
                 if n[k] == id {
@@ -101,7 +102,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         }
         // The triangles that go to c1: counter-clockwise from n3 to n0, or up to a border and
         // then clockwise from n0 to the other border.
-        let mut moved = Fan::new_fan();
+        moved.clear();
         let mut reached = false;
         if ns[3] != NIL {
             let mut f = ns[3];
@@ -120,22 +121,20 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         if !reached && ns[0] != NIL {
             let mut f = ns[0];
             while f != NIL {
-                if moved.as_slice().contains(&f) {
+                if moved.contains(&f) {
                     return Err(Refused::Inconsistent);
                 }
                 moved.push(f).map_err(|_| Refused::Inconsistent)?;
                 f = self.cw(f, ps).ok_or(Refused::Inconsistent)?;
             }
         }
-        let m = moved.as_slice();
-        if (ns[1] != NIL && m.contains(&ns[1])) || (ns[2] != NIL && m.contains(&ns[2])) {
+        if (ns[1] != NIL && moved.contains(&ns[1])) || (ns[2] != NIL && moved.contains(&ns[2])) {
             return Err(Refused::Inconsistent);
         }
         Ok(SplitPlan {
             parent: ps,
             neighbours: ns,
             wings: [wl, wr],
-            moved,
         })
     }
 
@@ -147,6 +146,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         h: &HierarchyView<'_>,
         node: u32,
         plan: &SplitPlan,
+        moved: &Fan,
         frames: u16,
     ) -> [u32; 2] {
         let [c0, c1] = h.split(node).children;
@@ -154,7 +154,6 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             parent: ps,
             neighbours: ns,
             wings: [wl, wr],
-            ref moved,
         } = *plan;
         let second = wr != NIL;
         let start = (frames > 0 && self.blends.len() + 2 <= Q).then(|| self.vertex(h, ps as usize));
@@ -171,7 +170,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             self.start_blend_from(ps as usize, &from, frames, false);
             self.start_blend_from(c1s as usize, &from, frames, false);
         }
-        for &f in moved.as_slice() {
+        for &f in moved {
             if let Some(k) = corner(self.t.at(f), ps) {
                 self.t.set_corner(f, k, c1s);
             }
@@ -236,6 +235,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         self.stack.clear();
         self.stack.push(node).map_err(|_| Refused::Capacity)?;
         let mut done = 0;
+        let mut moved = Fan::new();
         // Each round splits once or pushes a coarser node; bounded for crafted files.
         let mut rounds = 0u32;
         let limit = h.nodes().saturating_mul(4).saturating_add(64);
@@ -263,11 +263,11 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 }
                 continue;
             }
-            match self.split_legal(h, v) {
+            match self.split_legal(h, v, &mut moved) {
                 Ok(plan) => {
                     let added = if plan.wings[1] != NIL { 2 } else { 1 };
                     allow(v, added)?;
-                    self.apply_split(h, v, &plan, frames);
+                    self.apply_split(h, v, &plan, &moved, frames);
                     done += 1;
                     self.stack.pop();
                     if v == node {
