@@ -200,12 +200,11 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         self.v.flags[b] |= BLOCKED;
     }
 
-    /// Collapses `parent` now if legal; `true` when done.
-    fn collapse_now(&mut self, h: &HierarchyView<'_>, parent: u32) -> bool {
-        let mut fans = PairFans::default();
-        match self.collapse_legal(h, parent, &mut fans) {
+    /// Collapses `parent` now if legal, with `fans` as scratch; `true` when done.
+    fn collapse_now(&mut self, h: &HierarchyView<'_>, parent: u32, fans: &mut PairFans) -> bool {
+        match self.collapse_legal(h, parent, fans) {
             Ok(plan) => {
-                self.apply_collapse(h, parent, plan, &fans);
+                self.apply_collapse(h, parent, plan, fans);
                 true
             }
             Err(_) => false,
@@ -263,6 +262,8 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         while base < self.v.len() {
             let n = (self.v.len() - base).min(BATCH);
             let nodes = &self.v.node[base..base + n];
+            let touched = nodes.iter().fold(0u8, |acc, &node| acc ^ h.touch(node));
+            core::hint::black_box(touched);
             for (b, &node) in bounds.iter_mut().zip(nodes) {
                 *b = h.bounds(node);
             }
@@ -274,14 +275,19 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                     NONE
                 };
             }
+            let touched = parents[..n]
+                .iter()
+                .filter(|&&p| p != NONE)
+                .fold(0u8, |acc, &p| acc ^ h.touch(p));
+            core::hint::black_box(touched);
             for (b, &p) in parent_bounds.iter_mut().zip(&parents[..n]) {
                 if p != NONE {
                     *b = h.bounds(p);
                 }
             }
             for k in 0..n {
-                let (b, p, pb) = (bounds[k], parents[k], parent_bounds[k]);
-                self.decide(h, view, policy, base + k, &b, p, &pb, frame);
+                let (b, p, pb) = (&bounds[k], parents[k], &parent_bounds[k]);
+                self.decide(h, view, policy, base + k, b, p, pb, frame);
             }
             base += n;
         }
@@ -333,6 +339,11 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             return;
         }
         let j = self.v.mate(i) as usize;
+        if self.v.flags[i] & self.v.flags[j] & BLOCKED != 0 {
+            // Found illegal before, and nothing around has collapsed since; a collapse that
+            // clears the mark lists the pair again (`list_unblocked`).
+            return;
+        }
         let e = pair_error(policy.demand(parent_bounds, view));
         if e > t {
             // The parent is wanted: a collapse under way blends back.
@@ -365,6 +376,11 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         frame: &mut Frame,
     ) {
         let frames = self.geomorph_frames;
+        if self.pairs.len() == 0 {
+            return;
+        }
+        // Scratch for the fans of every collapse tried (made once: making one costs a memset).
+        let mut fans = PairFans::default();
         // Rounds: a pair found illegal is kept for another round while collapses happen, since
         // one of them may be what it waited for.
         loop {
@@ -397,20 +413,12 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                     return;
                 }
                 let (fa, fb) = (self.v.flags[a], self.v.flags[b]);
-                if fa & fb & BLOCKED != 0 {
-                    // Found illegal before, and nothing around collapsed since: wait for a
-                    // collapse of this frame to clear the mark.
-                    self.pairs.as_mut_slice()[kept] = pair;
-                    kept += 1;
-                    continue;
-                }
                 let blending = fa & fb & COLLAPSING != 0;
                 if blending && (fa | fb) & BLENDING != 0 {
                     continue;
                 }
                 let seen = e >= 0.0 && (fa | fb) & WAS_VISIBLE != 0;
                 let split = h.split(p);
-                let mut fans = PairFans::default();
                 let legal = self.collapse_legal_at(h, p, &split, a as u32, b as u32, &mut fans);
                 if legal.is_err() && !blending {
                     self.block(a, b);
@@ -433,6 +441,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                         frame.ops += 1;
                         progress = true;
                         self.list_new_pair(h, view, policy, s as usize, frame);
+                        self.list_unblocked(h, view, policy, s, frame);
                     }
                     Err(_) => {
                         // Arrived, but the neighbourhood changed meanwhile: blend back.
@@ -482,6 +491,29 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         }
     }
 
+    /// After a collapse into slot `s`: lists the pairs around it whose illegal mark the collapse
+    /// cleared, when their parent is no longer needed (they may be legal now).
+    fn list_unblocked<P: Policy>(
+        &mut self,
+        h: &HierarchyView<'_>,
+        view: &View,
+        policy: &P,
+        s: u32,
+        frame: &mut Frame,
+    ) {
+        let mut fan = crate::cut::Fan::new();
+        if !self.complete_fan(s, &mut fan) {
+            return;
+        }
+        for &f in &fan {
+            for x in self.t.at(f) {
+                if x != s {
+                    self.list_new_pair(h, view, policy, x as usize, frame);
+                }
+            }
+        }
+    }
+
     /// Lists every active pair with its parent's error, least needed first (for trades and
     /// for [`Cut::enforce_max`]).
     fn list_all_pairs<P: Policy>(
@@ -522,6 +554,8 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
     ) {
         let t = frame.threshold;
         let frames = self.geomorph_frames;
+        // Scratch for trades, made when the first is tried (making one costs a memset).
+        let mut fans: Option<PairFans> = None;
         let mut traded = 0usize;
         let mut listed = false;
         while let Some((bits, v)) = self.candidates.heap_pop() {
@@ -598,7 +632,8 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                             break;
                         }
                         traded += 1;
-                        if self.collapse_now(h, pair.parent) {
+                        let fans = fans.get_or_insert_with(PairFans::default);
+                        if self.collapse_now(h, pair.parent, fans) {
                             frame.stats.ecols += 1;
                             frame.ops += 1;
                             freed = true;
@@ -636,6 +671,10 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         budget: &Budget,
         stats: &mut FrameStats,
     ) {
+        if self.t.len() as u32 <= budget.max_triangles {
+            return;
+        }
+        let mut fans = PairFans::default();
         for _ in 0..64 {
             if self.t.len() as u32 <= budget.max_triangles {
                 return;
@@ -646,7 +685,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 if self.t.len() as u32 <= budget.max_triangles {
                     return;
                 }
-                if self.collapse_now(h, self.pairs.as_slice()[k].parent) {
+                if self.collapse_now(h, self.pairs.as_slice()[k].parent, &mut fans) {
                     stats.ecols += 1;
                     stats.budget_ecols += 1;
                     progress = true;

@@ -20,10 +20,10 @@
 //! | section | size | content |
 //! |---|---|---|
 //! | header | 64 | see below |
-//! | nodes | 8 per node | position `3 x u16` (`origin + q * extent / 65535`); normal octahedral `2 x i8` (also the axis of the cone of normals) |
+//! | nodes | 8 per leaf, then 12 per parent | position `3 x u16` (`origin + q * extent / 65535`); normal octahedral `2 x i8` (also the axis of the cone of normals); for a parent then the codes of its radius, spheroid `a`, spheroid `b` ([`decode_length`]) and the cone's sine (`ceil(255 sin)`; 255: no useful cone), 8 bits each, so that everything the refinement test reads of a vertex is one record |
 //! | colours | 3 per node, only with flag bit 0 | `3 x u8` |
 //! | parents | `w_n` bits per node, padded to a byte | parent id, all ones for a root |
-//! | splits | `2 w_n + 4 w_f + 32` bits per parent, padded to a byte | children `c0`, `c1` (`w_n` bits each); neighbour triangles `n0..n3` (`w_f` bits each, all ones for none); codes of the radius, spheroid `a`, spheroid `b` ([`decode_length`]) and the cone's sine (`ceil(255 sin)`; 255: no useful cone), 8 bits each |
+//! | splits | `2 w_n + 4 w_f` bits per parent, padded to a byte | children `c0`, `c1` (`w_n` bits each); neighbour triangles `n0..n3` (`w_f` bits each, all ones for none) |
 //! | base triangles | 12 each | `3 x u32` root ids, counter-clockwise |
 //!
 //! Header: offset 0 magic `VDLH`; 4 version `u16` = 3; 6 flags `u16` (bit 0: colours); 8
@@ -59,8 +59,10 @@ pub const CRC_OFFSET: usize = 20;
 pub const COUNT_OFFSETS: [usize; 3] = [8, 12, 16];
 /// Offset of the bounding-box origin, extent and length unit in the header.
 pub const BOX_OFFSET: usize = 24;
-/// Bytes per node record.
+/// Bytes per leaf record.
 pub const NODE_SIZE: usize = 8;
+/// Bytes per parent record (a node record and four bound codes).
+pub const PARENT_SIZE: usize = 12;
 /// Bytes per colour record.
 pub const COLOR_SIZE: usize = 3;
 /// Bytes per base triangle.
@@ -204,17 +206,36 @@ const OCTAVE: [f32; 16] = [
 ];
 
 /// The length an 8-bit code stands for, in units of the file's length unit: 0 for code 0, else
-/// `2^((code - 224) / 16)` (from about `6e-5` to `3.8`, 4.4% apart). Two multiplications, no
-/// `exp`: the same bits on every target.
+/// `2^((code - 224) / 16)` (from about `6e-5` to `3.8`, 4.4% apart): a table made at compile time
+/// (one multiplication each, exact on every target), no `exp`.
 #[inline]
 #[must_use]
 pub fn decode_length(code: u8) -> f32 {
-    if code == 0 {
-        return 0.0;
-    }
-    let octave = (code >> 4) as i32 - 14;
-    OCTAVE[(code & 15) as usize] * f32::from_bits(((octave + 127) as u32) << 23)
+    LENGTHS[code as usize]
 }
+
+/// [`decode_length`] of every code.
+const LENGTHS: [f32; 256] = {
+    let mut t = [0.0f32; 256];
+    let mut k = 1;
+    while k < 256 {
+        let octave = (k >> 4) as i32 - 14;
+        t[k] = OCTAVE[k & 15] * f32::from_bits(((octave + 127) as u32) << 23);
+        k += 1;
+    }
+    t
+};
+
+/// `k / 255` for every cone code `k`, the sine it stands for.
+const CONE_SINES: [f32; 256] = {
+    let mut t = [0.0f32; 256];
+    let mut k = 0;
+    while k < 256 {
+        t[k] = k as f32 / 255.0;
+        k += 1;
+    }
+    t
+};
 
 /// The smallest code whose length is at least `v` (in the file's unit), so that a bound stays a
 /// bound; 0 for `v <= 0` or NaN; 255 (the largest length) above it.
@@ -244,7 +265,7 @@ pub const fn id_width(count: u32) -> u32 {
 /// The bits of one split record.
 #[must_use]
 pub const fn split_bits(node_width: u32, face_width: u32) -> u64 {
-    2 * node_width as u64 + 4 * face_width as u64 + 32
+    2 * node_width as u64 + 4 * face_width as u64
 }
 
 /// Encodes a unit vector as octahedral coordinates in `[-127, 127]` (nearest).
@@ -264,21 +285,20 @@ pub fn oct_encode(n: [f32; 3]) -> (i8, i8) {
     (q(u), q(v))
 }
 
-/// Decodes octahedral coordinates in `[-127, 127]` to a unit vector.
+/// Decodes octahedral coordinates in `[-127, 127]` to a unit vector (one square root and one
+/// division: the policies decode an axis per vertex per frame).
 pub fn oct_decode(x: i8, y: i8) -> [f32; 3] {
-    let (mut u, mut v) = (x as f32 / 127.0, y as f32 / 127.0);
-    let z = 1.0 - u.abs() - v.abs();
+    // In units of 1/127: |u| + |v| + |z| = 127 before normalizing.
+    let (mut u, mut v) = (x as f32, y as f32);
+    let z = 127.0 - u.abs() - v.abs();
     if z < 0.0 {
         let (ou, ov) = (u, v);
-        u = (1.0 - ov.abs()) * if ou >= 0.0 { 1.0 } else { -1.0 };
-        v = (1.0 - ou.abs()) * if ov >= 0.0 { 1.0 } else { -1.0 };
+        u = (127.0 - ov.abs()) * if ou >= 0.0 { 1.0 } else { -1.0 };
+        v = (127.0 - ou.abs()) * if ov >= 0.0 { 1.0 } else { -1.0 };
     }
-    let l = libm::sqrtf(u * u + v * v + z * z);
-    if l > 0.0 {
-        [u / l, v / l, z / l]
-    } else {
-        [0.0, 0.0, 1.0]
-    }
+    // Never zero: the components' magnitudes add up to 127.
+    let inv = 1.0 / libm::sqrtf(u * u + v * v + z * z);
+    [u * inv, v * inv, z * inv]
 }
 
 /// A validated hierarchy, borrowed in place.
@@ -292,8 +312,9 @@ pub struct HierarchyView<'a> {
     /// Bits of a node id and of a triangle id.
     node_width: u32,
     face_width: u32,
-    /// Byte offsets of the node, colour, parent, split and base-triangle sections.
-    offsets: [usize; 5],
+    /// Byte offsets of the node, colour, parent, split and base-triangle sections, and of the
+    /// parents' records inside the node section.
+    offsets: [usize; 6],
     /// Position of quantum 0 and size of one quantum, per axis.
     origin: [f32; 3],
     step: [f32; 3],
@@ -437,7 +458,7 @@ impl<'a> HierarchyView<'a> {
     fn layout(leaves: u32, nodes: u32, base: u32, colors: bool) -> [u64; 6] {
         let (wn, wf) = (id_width(nodes), id_width(faces_of(leaves, nodes, base)));
         let n = HEADER_SIZE as u64;
-        let c = n + nodes as u64 * NODE_SIZE as u64;
+        let c = n + leaves as u64 * NODE_SIZE as u64 + (nodes - leaves) as u64 * PARENT_SIZE as u64;
         let p = c + if colors {
             nodes as u64 * COLOR_SIZE as u64
         } else {
@@ -514,7 +535,14 @@ impl<'a> HierarchyView<'a> {
             base_triangles: base,
             node_width: id_width(nodes),
             face_width: id_width(faces_of(leaves, nodes, base)),
-            offsets: [0, 1, 2, 3, 4].map(|k| layout[k] as usize),
+            offsets: [
+                layout[0] as usize,
+                layout[1] as usize,
+                layout[2] as usize,
+                layout[3] as usize,
+                layout[4] as usize,
+                HEADER_SIZE + leaves as usize * NODE_SIZE,
+            ],
             origin,
             step: extent.map(|e| e / POSITION_STEPS),
             unit,
@@ -662,27 +690,68 @@ impl<'a> HierarchyView<'a> {
         self.bytes.get(o..end)?.try_into().ok()
     }
 
-    /// Node `i`'s position and normal (zeros out of range).
-    #[inline]
-    fn geometry(&self, i: u32) -> ([f32; 3], [f32; 3]) {
-        let r: [u8; NODE_SIZE] = self
-            .fixed(record(self.offsets[0], i, NODE_SIZE))
-            .unwrap_or([0; NODE_SIZE]);
-        let q = |k: usize| u16::from_le_bytes([r[2 * k], r[2 * k + 1]]) as f32;
-        let position = [0, 1, 2].map(|k| self.origin[k] + q(k) * self.step[k]);
-        (position, oct_decode(r[6] as i8, r[7] as i8))
+    /// The first byte of node `i`'s record, and of its parent id (0 out of range): reading it
+    /// brings the record into the cache. A caller that touches a batch of nodes before decoding
+    /// them has the processor fetch all their records at once instead of one after the other.
+    #[inline(always)]
+    #[must_use]
+    pub fn touch(&self, i: u32) -> u8 {
+        let o = if i < self.leaves {
+            self.offsets[0].wrapping_add(i as usize * NODE_SIZE)
+        } else {
+            self.offsets[5]
+                .wrapping_add((i.wrapping_sub(self.leaves) as usize).wrapping_mul(PARENT_SIZE))
+        };
+        let p =
+            self.offsets[2].wrapping_add((i as usize).wrapping_mul(self.node_width as usize) / 8);
+        self.bytes.get(o).copied().unwrap_or(0) ^ self.bytes.get(p).copied().unwrap_or(0)
     }
 
-    /// The bound codes of parent `p` (radius, `a`, `b`, cone sine); a leaf's (and anything out
-    /// of range) are zeros and no cone.
+    /// Leaf `i`'s position.
     #[inline]
-    fn bound_codes(&self, p: u32) -> [u8; 4] {
-        if p < self.leaves || p >= self.nodes {
-            return [0, 0, 0, 255];
+    fn leaf_position(&self, i: u32) -> [f32; 3] {
+        let r: [u8; 6] = self
+            .fixed(record(self.offsets[0], i, NODE_SIZE))
+            .unwrap_or([0; 6]);
+        self.position_of(&r)
+    }
+
+    /// Node `i`'s record: position, normal and (for a parent) its bound codes (radius, `a`, `b`,
+    /// cone sine); a leaf's codes (and anything out of range) are zeros and no cone.
+    #[inline]
+    fn node_record(&self, i: u32) -> ([f32; 3], [f32; 3], [u8; 4]) {
+        let mut r = [0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 255];
+        if i < self.leaves {
+            if let Some(leaf) = self.fixed::<NODE_SIZE>(record(self.offsets[0], i, NODE_SIZE)) {
+                r[..NODE_SIZE].copy_from_slice(&leaf);
+            }
+        } else if let Some(parent) = self.parent_record(i) {
+            r = parent;
         }
-        let (wn, wf) = (self.node_width, self.face_width);
-        let bit = self.split_bit(p) + 2 * wn as u64 + 4 * wf as u64;
-        bits_at(self.bytes, bit, 32).to_le_bytes()
+        let normal = oct_decode(r[6] as i8, r[7] as i8);
+        (self.position_of(&r), normal, [r[8], r[9], r[10], r[11]])
+    }
+
+    /// Parent `i`'s 12-byte record (`None` for a leaf or an id out of range).
+    #[inline(always)]
+    fn parent_record(&self, i: u32) -> Option<[u8; PARENT_SIZE]> {
+        if i < self.leaves || i >= self.nodes {
+            return None;
+        }
+        // In range: `parse` proved the section inside the file, so no overflow.
+        let o = self.offsets[5] + (i - self.leaves) as usize * PARENT_SIZE;
+        self.fixed(o)
+    }
+
+    /// The position in a node record.
+    #[inline(always)]
+    fn position_of(&self, r: &[u8]) -> [f32; 3] {
+        let q = |k: usize| u16::from_le_bytes([r[2 * k], r[2 * k + 1]]) as f32;
+        [
+            self.origin[0] + q(0) * self.step[0],
+            self.origin[1] + q(1) * self.step[1],
+            self.origin[2] + q(2) * self.step[2],
+        ]
     }
 
     #[inline]
@@ -694,8 +763,7 @@ impl<'a> HierarchyView<'a> {
     /// Node `i` (`i < nodes()`; out-of-range ids read as zeros with no parent, never panic).
     #[must_use]
     pub fn node(&self, i: u32) -> NodeView {
-        let (position, normal) = self.geometry(i);
-        let [r, a, b, cone] = self.bound_codes(i);
+        let (position, normal, [r, a, b, cone]) = self.node_record(i);
         let color = if self.has_colors() {
             self.fixed::<COLOR_SIZE>(record(self.offsets[1], i, COLOR_SIZE))
                 .unwrap_or([0; 3])
@@ -707,7 +775,7 @@ impl<'a> HierarchyView<'a> {
             radius: decode_length(r) * self.unit,
             spheroid: [decode_length(a) * self.unit, decode_length(b) * self.unit],
             normal,
-            cone_sin: cone as f32 / 255.0,
+            cone_sin: CONE_SINES[cone as usize],
             color,
             depth: self.depth(i),
             parent: self.parent(i),
@@ -726,18 +794,31 @@ impl<'a> HierarchyView<'a> {
         d
     }
 
-    /// What the refinement policies need of node `i`, decoded without the rest of the record.
+    /// What the refinement policies need of node `i`, decoded without the rest of the record. A
+    /// leaf has no bounds (it never splits): radius and spheroid 0, no cone, and its axis is not
+    /// decoded (+z).
     #[inline]
     #[must_use]
     pub fn bounds(&self, i: u32) -> crate::policy::Bounds {
-        let (center, axis) = self.geometry(i);
-        let [r, a, b, cone] = self.bound_codes(i);
-        let (a, b) = (decode_length(a) * self.unit, decode_length(b) * self.unit);
+        let Some(r) = self.parent_record(i) else {
+            return crate::policy::Bounds {
+                center: self.leaf_position(i),
+                radius: 0.0,
+                axis: [0.0, 0.0, 1.0],
+                cone_sin: 1.0,
+                a2: 0.0,
+                b2: 0.0,
+            };
+        };
+        let (a, b) = (
+            LENGTHS[r[9] as usize] * self.unit,
+            LENGTHS[r[10] as usize] * self.unit,
+        );
         crate::policy::Bounds {
-            center,
-            radius: decode_length(r) * self.unit,
-            axis,
-            cone_sin: cone as f32 / 255.0,
+            center: self.position_of(&r),
+            radius: LENGTHS[r[8] as usize] * self.unit,
+            axis: oct_decode(r[6] as i8, r[7] as i8),
+            cone_sin: CONE_SINES[r[11] as usize],
             a2: a * a,
             b2: b * b,
         }

@@ -123,12 +123,21 @@ impl Hierarchy {
             let o = BOX_OFFSET + 4 * k;
             out[o..o + 4].copy_from_slice(&v.to_le_bytes());
         }
-        for node in &self.nodes {
+        for (i, node) in self.nodes.iter().enumerate() {
             for q in quantize(node.position) {
                 out.extend_from_slice(&q.to_le_bytes());
             }
             let (x, y) = oct_encode(node.normal);
             out.extend_from_slice(&[x as u8, y as u8]);
+            if i >= leaves as usize {
+                let cone = libm::ceilf(node.cone_sin.clamp(0.0, 1.0) * 255.0) as u8;
+                out.extend_from_slice(&[
+                    code(node.radius),
+                    code(node.spheroid[0]),
+                    code(node.spheroid[1]),
+                    cone,
+                ]);
+            }
         }
         if colors {
             for node in &self.nodes {
@@ -148,14 +157,6 @@ impl Hierarchy {
             for &f in &node.neighbours {
                 bits.push_id(f, wf);
             }
-            let cone = libm::ceilf(node.cone_sin.clamp(0.0, 1.0) * 255.0) as u8;
-            let codes = [
-                code(node.radius),
-                code(node.spheroid[0]),
-                code(node.spheroid[1]),
-                cone,
-            ];
-            bits.push(u32::from_le_bytes(codes), 32);
         }
         bits.finish();
         for t in &self.base_triangles {

@@ -85,8 +85,8 @@ mod store;
 pub(crate) use blend::Blend;
 pub use blend::VertexOut;
 pub use check::Defect;
-pub(crate) use fan::PairFans;
 pub use fan::MAX_FAN;
+pub(crate) use fan::{Fan, PairFans};
 pub use slot::SlotIndex;
 
 use slot::Arena;
