@@ -294,3 +294,51 @@ fn the_cut_does_not_depend_on_the_model_scale() {
         );
     }
 }
+
+/// `adapt` and the draw of its output need little stack: 150 frames of the bunny under a
+/// 5,000-triangle budget with geomorphs (splits, collapses, forced splits, trades), each drawn at
+/// 320x240, on a thread whose whole stack is `STACK` bytes. Rust threads have a guard page, so an
+/// overflow aborts the test process instead of passing unnoticed.
+#[test]
+fn adapt_and_draw_fit_a_small_stack() {
+    use vdlod_core::policy::QRefine;
+    use vdlod_demo::camera::Orbit;
+    use vdlod_demo::frame::Frame;
+    use vdlod_demo::lod::{policy_view, CutVertices};
+    use vdlod_demo::render::camera_params;
+    use vdlod_raster::Shading;
+    const STACK: usize = 16 * 1024;
+    let mesh = fixture("bunny.obj");
+    let bytes = hierarchy_bytes(&mesh);
+    let bounds = mesh.bounds();
+    let mut cut = Cut::<2600, 5000, 325>::boxed();
+    let mut frame = Frame::new(320, 240).unwrap();
+    let mut vertices = CutVertices::default();
+    let worker = std::thread::Builder::new()
+        .stack_size(STACK)
+        .spawn(move || {
+            let h = HierarchyView::parse(&bytes).unwrap();
+            cut.reset(&h).unwrap();
+            cut.set_geomorph_frames(4);
+            let orbit = Orbit::peer(&bounds, 100);
+            let budget = Budget {
+                max_triangles: 5000,
+                ..Budget::default()
+            };
+            let mut drawn = 0;
+            for i in 0..150 {
+                let camera = orbit.camera(i);
+                let view = policy_view(&camera, frame.aspect(), 240, 1.0);
+                let tolerance = [0.25, 1.0, 4.0][(i / 50) as usize];
+                cut.adapt(&h, &view, &QRefine::new(tolerance), &budget);
+                vertices.gather(&*cut, &h);
+                let params = camera_params(&camera, frame.aspect(), Shading::Gouraud, false);
+                drawn += frame
+                    .draw(&vertices.mesh(&*cut, false), &params)
+                    .unwrap()
+                    .rasterized;
+            }
+            drawn
+        });
+    assert!(worker.unwrap().join().unwrap() > 0);
+}

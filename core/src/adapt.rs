@@ -61,11 +61,11 @@
 //! # }
 //! ```
 
-use crate::cut::NIL;
 use crate::cut::{
     Cut, Pair, PairFans, Refused, SlotIndex, BLENDING, BLOCKED, COLLAPSING, FIRST_CHILD, VISIBLE,
     WAS_VISIBLE,
 };
+use crate::cut::{Fan, NIL};
 use crate::format::{HierarchyView, NONE};
 use crate::policy::{Bounds, Demand, Policy, View};
 
@@ -243,6 +243,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
     /// One pass over the active vertices: blends advance, the policy speaks for every vertex
     /// (split candidates go to the heap) and every sibling pair (collapse candidates to the
     /// pair list).
+    #[inline(never)]
     fn evaluate<P: Policy>(
         &mut self,
         h: &HierarchyView<'_>,
@@ -367,6 +368,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
     /// allows; with geomorphs, visible pairs first blend to the parent and collapse on arrival.
     /// A collapse that makes a new pair lists it too, so coarsening goes as far as the view asks
     /// in one call.
+    #[inline(never)]
     fn coarsen<P: Policy>(
         &mut self,
         h: &HierarchyView<'_>,
@@ -436,12 +438,12 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 }
                 match legal {
                     Ok(plan) => {
-                        let s = self.apply_collapse(h, p, plan, &fans);
+                        let s = self.apply_collapse(h, p, plan, &mut fans);
                         frame.stats.ecols += 1;
                         frame.ops += 1;
                         progress = true;
                         self.list_new_pair(h, view, policy, s as usize, frame);
-                        self.list_unblocked(h, view, policy, s, frame);
+                        self.list_unblocked(h, view, policy, s, &mut fans.0[0], frame);
                     }
                     Err(_) => {
                         // Arrived, but the neighbourhood changed meanwhile: blend back.
@@ -499,13 +501,13 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         view: &View,
         policy: &P,
         s: u32,
+        fan: &mut Fan,
         frame: &mut Frame,
     ) {
-        let mut fan = crate::cut::Fan::new();
-        if !self.complete_fan(s, &mut fan) {
+        if !self.complete_fan(s, fan) {
             return;
         }
-        for &f in &fan {
+        for &f in fan.iter() {
             for x in self.t.at(f) {
                 if x != s {
                     self.list_new_pair(h, view, policy, x as usize, frame);
@@ -544,6 +546,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
     /// Splits the candidates largest error first, each forcing what it needs, within the
     /// budget; when the budget binds, pairs whose parent is needed less than the next split are
     /// collapsed to pay for it.
+    #[inline(never)]
     fn refine<P: Policy>(
         &mut self,
         h: &HierarchyView<'_>,
@@ -554,8 +557,6 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
     ) {
         let t = frame.threshold;
         let frames = self.geomorph_frames;
-        // Scratch for trades, made when the first is tried (making one costs a memset).
-        let mut fans: Option<PairFans> = None;
         let mut traded = 0usize;
         let mut listed = false;
         while let Some((bits, v)) = self.candidates.heap_pop() {
@@ -624,24 +625,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                         self.list_all_pairs(h, view, policy, &mut frame.stats);
                         listed = true;
                     }
-                    let e = f32::from_bits(bits);
-                    let mut freed = false;
-                    while traded < self.pairs.len() && frame.ops < budget.max_ops {
-                        let pair = self.pairs.as_slice()[traded];
-                        if pair.error >= e {
-                            break;
-                        }
-                        traded += 1;
-                        let fans = fans.get_or_insert_with(PairFans::default);
-                        if self.collapse_now(h, pair.parent, fans) {
-                            frame.stats.ecols += 1;
-                            frame.ops += 1;
-                            freed = true;
-                            if budget.admits(self.t.len() as u32, 2) {
-                                break;
-                            }
-                        }
-                    }
+                    let freed = self.trade(h, budget, f32::from_bits(bits), &mut traded, frame);
                     if freed && self.candidates.heap_push((bits, v)).is_ok() {
                         continue;
                     }
@@ -661,8 +645,41 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         }
     }
 
+    /// Collapses listed pairs (`self.pairs`, least needed first, from `*traded` on) whose parent
+    /// is needed less than `error`, until two triangles are free; whether any collapsed. Not
+    /// inlined, so that its scratch fans are not on the stack while splits run.
+    #[inline(never)]
+    fn trade(
+        &mut self,
+        h: &HierarchyView<'_>,
+        budget: &Budget,
+        error: f32,
+        traded: &mut usize,
+        frame: &mut Frame,
+    ) -> bool {
+        let mut fans = PairFans::default();
+        let mut freed = false;
+        while *traded < self.pairs.len() && frame.ops < budget.max_ops {
+            let pair = self.pairs.as_slice()[*traded];
+            if pair.error >= error {
+                break;
+            }
+            *traded += 1;
+            if self.collapse_now(h, pair.parent, &mut fans) {
+                frame.stats.ecols += 1;
+                frame.ops += 1;
+                freed = true;
+                if budget.admits(self.t.len() as u32, 2) {
+                    break;
+                }
+            }
+        }
+        freed
+    }
+
     /// Collapses the least needed pairs until the cut fits [`Budget::max_triangles`] (after the
     /// budget was lowered, or while collapse blends still hold triangles).
+    #[inline(never)]
     fn enforce_max<P: Policy>(
         &mut self,
         h: &HierarchyView<'_>,

@@ -782,6 +782,21 @@ impl<'a> HierarchyView<'a> {
         }
     }
 
+    /// Node `i`'s position, normal and colour (white without colours): what drawing it needs,
+    /// without the walk up the parents that [`HierarchyView::node`]'s depth takes.
+    #[inline]
+    #[must_use]
+    pub fn vertex(&self, i: u32) -> ([f32; 3], [f32; 3], [u8; 3]) {
+        let (position, normal, _) = self.node_record(i);
+        let color = if self.has_colors() {
+            self.fixed::<COLOR_SIZE>(record(self.offsets[1], i, COLOR_SIZE))
+                .unwrap_or([0; 3])
+        } else {
+            [255; 3]
+        };
+        (position, normal, color)
+    }
+
     /// Node `i`'s depth in the forest, counted up its parents (0 for roots and ids out of range).
     #[must_use]
     pub fn depth(&self, i: u32) -> u16 {

@@ -12,7 +12,7 @@
 
 use super::slot::SlotIndex;
 use super::{depth_color, Coloring, Cut, BLENDING, COLLAPSING, NIL};
-use crate::format::{HierarchyView, NodeView};
+use crate::format::HierarchyView;
 
 /// A vertex as drawn this frame.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -61,20 +61,15 @@ fn lerp3(a: [f32; 3], b: [f32; 3], s: f32) -> [f32; 3] {
 }
 
 impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, I> {
-    /// The colour a node is drawn with.
-    pub(crate) fn tint_of(&self, n: &NodeView) -> [u8; 3] {
-        match self.coloring {
-            Coloring::Node => n.color,
-            Coloring::Depth => depth_color(n.depth),
-        }
-    }
-
     fn node_out(&self, h: &HierarchyView<'_>, node: u32) -> VertexOut {
-        let n = h.node(node);
+        let (position, normal, color) = h.vertex(node);
         VertexOut {
-            position: n.position,
-            normal: n.normal,
-            color: self.tint_of(&n),
+            position,
+            normal,
+            color: match self.coloring {
+                Coloring::Node => color,
+                Coloring::Depth => depth_color(h.depth(node)),
+            },
         }
     }
 

@@ -21,7 +21,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
     pub fn collapse(&mut self, h: &HierarchyView<'_>, node: u32) -> Result<u32, Refused> {
         let mut fans = PairFans::default();
         let plan = self.collapse_legal(h, node, &mut fans)?;
-        Ok(self.apply_collapse(h, node, plan, &fans))
+        Ok(self.apply_collapse(h, node, plan, &mut fans))
     }
 
     /// Proves the collapse of `node`'s children legal.
@@ -111,14 +111,14 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         })
     }
 
-    /// Performs a collapse [`Cut::collapse_legal`] approved, with the fans it found; returns the
-    /// parent's slot.
+    /// Performs a collapse [`Cut::collapse_legal`] approved, with the fans it found (used as
+    /// scratch afterwards); returns the parent's slot.
     pub(crate) fn apply_collapse(
         &mut self,
         h: &HierarchyView<'_>,
         node: u32,
         plan: CollapsePlan,
-        fans: &PairFans,
+        fans: &mut PairFans,
     ) -> u32 {
         let CollapsePlan {
             a,
@@ -201,7 +201,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         self.map.remove(self.v.node[b as usize], self.v.nodes());
         self.unlink_mate(b as usize);
         self.rename_vertex(h, a as usize, node);
-        match self.remove_vertex(b) {
+        match self.remove_vertex(b, &mut fans.0[0]) {
             Some(moved_from) if moved_from == a => b,
             _ => a,
         }

@@ -520,16 +520,15 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
     }
 
     /// Swap-removes vertex slot `v` (its node already out of the map, its triangles gone or
-    /// renamed). Returns the slot the last vertex moved from, if it moved.
-    fn remove_vertex(&mut self, v: u32) -> Option<u32> {
+    /// renamed), with `fan` as scratch. Returns the slot the last vertex moved from, if it moved.
+    fn remove_vertex(&mut self, v: u32, fan: &mut Fan) -> Option<u32> {
         self.unlink_mate(v as usize);
         self.free_blend(v as usize);
         let last = self.v.len() as u32 - 1;
         let moved = (v != last).then(|| {
-            let mut fan = fan::Fan::new();
             // Proven whole before the collapse that removes `v`.
-            let _ = self.complete_fan(last, &mut fan);
-            for &f in &fan {
+            let _ = self.complete_fan(last, fan);
+            for &f in fan.iter() {
                 if let Some(k) = corner(self.t.at(f), last) {
                     self.t.set_corner(f, k, v);
                 }
