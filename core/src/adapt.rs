@@ -253,19 +253,43 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
     ) {
         self.candidates.clear();
         self.pairs.clear();
-        // In batches: first every read of the hierarchy the batch needs (independent loads the
-        // processor overlaps, where one vertex at a time would wait for each), then the decisions.
+        // Most vertices are far from wanting a split: the policy's bound from the cut's digest
+        // of the node (position and largest spheroid radius) proves it without reading the file.
+        // The others, and the parents of sibling pairs, are read in batches: first every record
+        // the batch needs is touched (independent loads the processor overlaps), then decoded.
         const BATCH: usize = 32;
+        // Float rounding between the bound and the exact test stays far below this.
+        const SLACK: f32 = 1.0 + 1e-5;
+        let t = frame.threshold;
+        let blends = self.geomorph_frames > 0;
         let mut bounds = [Bounds::default(); BATCH];
+        let mut quick = [false; BATCH];
         let mut parents = [NONE; BATCH];
         let mut parent_bounds = [Bounds::default(); BATCH];
         let mut base = 0;
         while base < self.v.len() {
             let n = (self.v.len() - base).min(BATCH);
+            for k in 0..n {
+                let digest = &self.v.digest[base + k];
+                let center = h.digest_center(digest);
+                let s = h.length(digest.spheroid);
+                quick[k] = policy.error_bound(center, s * s, view) * SLACK <= t;
+                bounds[k].center = center;
+                bounds[k].radius = h.length(digest.radius);
+            }
             let nodes = &self.v.node[base..base + n];
-            let touched = nodes.iter().fold(0u8, |acc, &node| acc ^ h.touch(node));
+            let touched = nodes
+                .iter()
+                .zip(&quick)
+                .filter(|(_, &q)| !q)
+                .fold(0u8, |acc, (&node, _)| acc ^ h.touch(node));
             core::hint::black_box(touched);
-            for (b, &node) in bounds.iter_mut().zip(nodes) {
+            for ((b, &node), _) in bounds
+                .iter_mut()
+                .zip(nodes)
+                .zip(&quick)
+                .filter(|(_, &q)| !q)
+            {
                 *b = h.bounds(node);
             }
             for (k, p) in parents[..n].iter_mut().enumerate() {
@@ -287,14 +311,25 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 }
             }
             for k in 0..n {
-                let (b, p, pb) = (&bounds[k], parents[k], &parent_bounds[k]);
-                self.decide(h, view, policy, base + k, b, p, pb, frame);
+                let d = if quick[k] {
+                    // Wants no split; seen if its sphere reaches into the frustum (the flag only
+                    // decides whether changes blend, so without geomorphs it is not computed).
+                    let b = &bounds[k];
+                    Demand {
+                        visible: blends && view.sphere_visible(b.center, b.radius),
+                        error: 0.0,
+                    }
+                } else {
+                    policy.demand(&bounds[k], view)
+                };
+                let (p, pb) = (parents[k], &parent_bounds[k]);
+                self.decide(h, view, policy, base + k, d, p, pb, frame);
             }
             base += n;
         }
     }
 
-    /// The decisions for slot `i` (see [`Cut::evaluate`]), with its bounds and, for a first child
+    /// The decisions for slot `i` (see [`Cut::evaluate`]), with its demand and, for a first child
     /// whose sibling is active, its parent and the parent's bounds.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
@@ -304,7 +339,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         view: &View,
         policy: &P,
         i: usize,
-        bounds: &Bounds,
+        d: Demand,
         p: u32,
         parent_bounds: &Bounds,
         frame: &mut Frame,
@@ -314,7 +349,6 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             self.advance(i);
         }
         let node = self.v.node[i];
-        let d = policy.demand(bounds, view);
         let flags = self.v.flags[i];
         let was = if flags & VISIBLE != 0 { WAS_VISIBLE } else { 0 };
         self.v.flags[i] = (flags & !(VISIBLE | WAS_VISIBLE)) | was | d.visible as u8;

@@ -355,6 +355,29 @@ pub struct NodeView {
     pub parent: u32,
 }
 
+/// What a cut keeps of an active node so that most frames need not read its record: the
+/// quantized position, and the codes of its larger spheroid radius and of its bounding radius
+/// (zeros for a leaf). Eight bytes; [`HierarchyView::digest_center`] and
+/// [`HierarchyView::length`] decode them exactly as [`HierarchyView::bounds`] does.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Digest {
+    /// Position as 16-bit fractions of the bounding box.
+    pub position: [u16; 3],
+    /// Code of `max(a, b)`.
+    pub spheroid: u8,
+    /// Code of the bounding radius.
+    pub radius: u8,
+}
+
+impl Digest {
+    /// All zeros.
+    pub const ZERO: Digest = Digest {
+        position: [0; 3],
+        spheroid: 0,
+        radius: 0,
+    };
+}
+
 /// One parent's split record.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct SplitView {
@@ -705,6 +728,50 @@ impl<'a> HierarchyView<'a> {
         let p =
             self.offsets[2].wrapping_add((i as usize).wrapping_mul(self.node_width as usize) / 8);
         self.bytes.get(o).copied().unwrap_or(0) ^ self.bytes.get(p).copied().unwrap_or(0)
+    }
+
+    /// Node `i`'s [`Digest`] (zeros out of range).
+    #[inline]
+    #[must_use]
+    pub fn digest(&self, i: u32) -> Digest {
+        let (r, leaf) = match self.parent_record(i) {
+            Some(r) => (r, false),
+            None => {
+                let mut r = [0; PARENT_SIZE];
+                let at = record(self.offsets[0], i, NODE_SIZE);
+                if let Some(leaf) =
+                    self.fixed::<NODE_SIZE>(if i < self.leaves { at } else { usize::MAX })
+                {
+                    r[..NODE_SIZE].copy_from_slice(&leaf);
+                }
+                (r, true)
+            }
+        };
+        let q = |k: usize| u16::from_le_bytes([r[2 * k], r[2 * k + 1]]);
+        Digest {
+            position: [q(0), q(1), q(2)],
+            spheroid: if leaf { 0 } else { r[9].max(r[10]) },
+            radius: if leaf { 0 } else { r[8] },
+        }
+    }
+
+    /// The position a [`Digest`] holds, as [`HierarchyView::bounds`] decodes it.
+    #[inline(always)]
+    #[must_use]
+    pub fn digest_center(&self, d: &Digest) -> [f32; 3] {
+        let q = d.position;
+        [
+            self.origin[0] + q[0] as f32 * self.step[0],
+            self.origin[1] + q[1] as f32 * self.step[1],
+            self.origin[2] + q[2] as f32 * self.step[2],
+        ]
+    }
+
+    /// The length a bound code stands for in this file's units.
+    #[inline(always)]
+    #[must_use]
+    pub fn length(&self, code: u8) -> f32 {
+        LENGTHS[code as usize] * self.unit
     }
 
     /// Leaf `i`'s position.

@@ -247,6 +247,16 @@ impl View {
 pub trait Policy {
     /// The policy's demand for a vertex with bounds `b` seen from `view`.
     fn demand(&self, b: &Bounds, view: &View) -> Demand;
+
+    /// An upper bound on `demand(b, view).error` over every `b` centred at `center` whose
+    /// spheroid radii `a` and `b` are at most `sqrt(s2)` (whatever its radius, axis and cone),
+    /// or infinity when the policy cannot bound it (the default). A cut skips decoding a vertex
+    /// whose bound is below the threshold: it cannot want a split.
+    #[inline]
+    fn error_bound(&self, center: [f32; 3], s2: f32, view: &View) -> f32 {
+        let _ = (center, s2, view);
+        f32::INFINITY
+    }
 }
 
 impl<A: Policy, B: Policy> Policy for (A, B) {
@@ -265,12 +275,24 @@ impl<A: Policy, B: Policy> Policy for (A, B) {
             error: x.error.max(y.error),
         }
     }
+
+    #[inline]
+    fn error_bound(&self, center: [f32; 3], s2: f32, view: &View) -> f32 {
+        self.0
+            .error_bound(center, s2, view)
+            .max(self.1.error_bound(center, s2, view))
+    }
 }
 
 impl<P: Policy + ?Sized> Policy for &P {
     #[inline]
     fn demand(&self, b: &Bounds, view: &View) -> Demand {
         (**self).demand(b, view)
+    }
+
+    #[inline]
+    fn error_bound(&self, center: [f32; 3], s2: f32, view: &View) -> f32 {
+        (**self).error_bound(center, s2, view)
     }
 }
 
@@ -286,6 +308,11 @@ impl Policy for Frustum {
         } else {
             Demand::CULLED
         }
+    }
+
+    #[inline]
+    fn error_bound(&self, _: [f32; 3], _: f32, _: &View) -> f32 {
+        0.0
     }
 }
 
@@ -303,6 +330,11 @@ impl Policy for BackFace {
         } else {
             Demand::NONE
         }
+    }
+
+    #[inline]
+    fn error_bound(&self, _: [f32; 3], _: f32, _: &View) -> f32 {
+        0.0
     }
 }
 
@@ -362,6 +394,23 @@ impl Policy for ScreenError {
             error: self.ratio(b, Eye::of(b, view), view),
         }
     }
+
+    /// `lhs <= max(a^2, b^2) |d|^2` for any axis (wavelet paper eq. 4-5), so the ratio is at most
+    /// `s2 ppu^2 / (tol^2 |d|^2)` with the smaller tolerance.
+    #[inline]
+    fn error_bound(&self, center: [f32; 3], s2: f32, view: &View) -> f32 {
+        let r = sub(center, view.eye);
+        let d2 = dot(r, r);
+        let tol = self.silhouette.min(self.interior);
+        let rhs = tol * tol * d2;
+        if s2 <= 0.0 {
+            0.0
+        } else if rhs > 0.0 {
+            s2 * (view.pixels_per_unit * view.pixels_per_unit) / rhs
+        } else {
+            f32::INFINITY
+        }
+    }
 }
 
 /// The LOD lecture's `qrefine`: [`Frustum`], [`BackFace`] and [`ScreenError`] in one pass that
@@ -395,6 +444,11 @@ impl Policy for QRefine {
             visible: true,
             error: self.error.ratio(b, e, view),
         }
+    }
+
+    #[inline]
+    fn error_bound(&self, center: [f32; 3], s2: f32, view: &View) -> f32 {
+        self.error.error_bound(center, s2, view)
     }
 }
 
@@ -588,7 +642,26 @@ mod tests {
                 b2: if next() < 0.5 { 0.0 } else { a * a * next() },
             };
             assert_eq!(composed.demand(&b, &v), fused.demand(&b, &v), "{b:?}");
+            // The bound the cut skips vertices with holds for both forms.
+            let s2 = b.a2.max(b.b2);
+            for bound in [
+                composed.error_bound(c, s2, &v),
+                fused.error_bound(c, s2, &v),
+            ] {
+                assert!(fused.demand(&b, &v).error <= bound * (1.0 + 1e-5), "{b:?}");
+            }
+            assert_eq!(
+                composed.error_bound(c, s2, &v),
+                fused.error_bound(c, s2, &v)
+            );
         }
+        // Policies that cannot bound their error say so.
+        let c = [0.0; 3];
+        assert_eq!(
+            MergeTree { near: 1.0 }.error_bound(c, 1.0, &v),
+            f32::INFINITY
+        );
+        assert_eq!(Frustum.error_bound(c, 1.0, &v), 0.0);
     }
 
     #[test]

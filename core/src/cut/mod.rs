@@ -27,15 +27,15 @@
 //!
 //! | per | bytes | what |
 //! |---|---|---|
-//! | vertex slot | `4 + 3i + 3` (13 with `u16`) | node, fan triangle, mate, blend entry; triangle count (`u16`) and flags (`u8`) |
+//! | vertex slot | `4 + 3i + 3 + 8` (21 with `u16`) | node, fan triangle, mate, blend entry; triangle count (`u16`) and flags (`u8`); the node's [`crate::format::Digest`] (quantized position and two bound codes: most frames decide a vertex from it without reading the file) |
 //! | triangle slot | `6i + 4 + i` (18 with `u16`) | corners, neighbours, id; one node-map entry |
 //! | queue entry | `4 + 8 + 12 + 28 = 52` | forcing stack, split heap, collapse pairs, blend arena |
 //!
 //! plus 40 bytes of lengths and settings. With the recommended `F = 2 V` and `Q = V / 8` that is
-//! 13 + 36 + 6.5 = 55.5 bytes per vertex slot, **27.75 bytes per triangle of capacity** with `u16`
-//! (44.75 with `u32`). A cut for a 10,000-triangle budget, `Cut<5120, 10240, 640>`, is 284,200
-//! bytes. The queues only bound how much one frame can do: when one overflows, the rest waits for
-//! the next frame and [`crate::adapt::FrameStats`] says so.
+//! 21 + 36 + 6.5 = 63.5 bytes per vertex slot, **31.75 bytes per triangle of capacity** with
+//! `u16` (48.75 with `u32`). A cut for a 10,000-triangle budget, `Cut<5008, 10000, 626>`, is
+//! 317,760 bytes. The queues only bound how much one frame can do: when one overflows, the rest
+//! waits for the next frame and [`crate::adapt::FrameStats`] says so.
 //!
 //! [`Cut::new`] is `const` and all zeros, so `static CUT: Mutex<RefCell<Cut<..>>>` lands in
 //! `.bss` and never passes through the stack; [`Cut::boxed`] (feature `build`) puts one on the heap
@@ -93,9 +93,9 @@ use slot::Arena;
 use store::{Triangles, Vertices};
 
 // The documented figure, checked when the crate is compiled for any target (CI builds it for
-// x86_64 and a 32-bit Cortex-M): a cut for a 10,000-triangle budget with the recommended
-// capacities is 284,200 bytes, at most 32 bytes per triangle of capacity.
-const _: () = assert!(Cut::<5120, 10240, 640>::BYTES == 284_200);
+// x86_64 and a 32-bit Cortex-M): a cut of 10,240 triangle slots with the recommended
+// capacities is 325,160 bytes, at most 32 bytes per triangle of capacity.
+const _: () = assert!(Cut::<5120, 10240, 640>::BYTES == 325_160);
 const _: () = assert!(Cut::<5120, 10240, 640>::BYTES <= 32 * 10240);
 
 /// A slot that holds nothing (no neighbour across a border edge, no incident triangle).
@@ -446,10 +446,11 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             .then(|| h.parent(self.v.node[i]))
     }
 
-    /// Sets slot `s`'s first-child flag and its mate links from the file and the node map.
+    /// Sets slot `s`'s digest, first-child flag and mate links from the file and the node map.
     fn link_family(&mut self, h: &HierarchyView<'_>, s: u32) {
         let i = s as usize;
         let node = self.v.node[i];
+        self.v.digest[i] = h.digest(node);
         let p = h.parent(node);
         self.v.flags[i] &= !FIRST_CHILD;
         self.v.set_mate(i, NIL);

@@ -1,15 +1,18 @@
 //! The cut's vertex and triangle tables: structure-of-arrays records with one length each, and
 //! the only code that appends, moves or drops a record.
 //!
-//! A vertex record is 13 bytes with 16-bit slots: its node (`u32`), one triangle of its fan, its
+//! A vertex record is 21 bytes with 16-bit slots: its node (`u32`), one triangle of its fan, its
 //! triangle count, its sibling's slot when both are active ("mate"), its geomorph's entry in the
-//! blend arena, and a flag byte. Positions, normals and colours are not stored: they are read
-//! from the hierarchy in place ([`super::Cut::vertex`]), except for vertices in a geomorph. A
+//! blend arena, a flag byte, and the node's 8-byte [`Digest`] (quantized position and two bound
+//! codes), with which the per-frame pass skips most vertices without reading the file. Normals,
+//! colours and the rest of the bounds are not stored: they are read from the hierarchy in place
+//! ([`super::Cut::vertex`]), except for vertices in a geomorph. A
 //! triangle record is 16 bytes: three corner slots, the three neighbouring triangles' slots
 //! (across edges `t[k] -> t[k + 1]`) and its id in the hierarchy's numbering.
 
 use super::slot::{load3, store3, SlotIndex};
 use super::NIL;
+use crate::format::Digest;
 
 /// The vertex records.
 #[derive(Clone, Debug)]
@@ -24,6 +27,8 @@ pub(crate) struct Vertices<const V: usize, I: SlotIndex> {
     mate: [I; V],
     blend: [I; V],
     pub flags: [u8; V],
+    /// What the per-frame pass needs of the node without reading the file (see [`Digest`]).
+    pub digest: [Digest; V],
 }
 
 impl<const V: usize, I: SlotIndex> Vertices<V, I> {
@@ -36,6 +41,7 @@ impl<const V: usize, I: SlotIndex> Vertices<V, I> {
             mate: [I::ZERO; V],
             blend: [I::ZERO; V],
             flags: [0; V],
+            digest: [Digest::ZERO; V],
         }
     }
 
@@ -122,6 +128,7 @@ impl<const V: usize, I: SlotIndex> Vertices<V, I> {
         self.mate[to] = self.mate[from];
         self.blend[to] = self.blend[from];
         self.flags[to] = self.flags[from];
+        self.digest[to] = self.digest[from];
     }
 
     /// Drops the last record.
