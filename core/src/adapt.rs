@@ -61,11 +61,11 @@
 //! # }
 //! ```
 
+use crate::cut::NIL;
 use crate::cut::{
     Cut, Pair, PairFans, Refused, SlotIndex, BLENDING, BLOCKED, COLLAPSING, FIRST_CHILD, VISIBLE,
     WAS_VISIBLE,
 };
-use crate::cut::{Fan, NIL};
 use crate::format::{HierarchyView, NONE};
 use crate::policy::{Bounds, Demand, Policy, View};
 
@@ -417,79 +417,68 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         }
         // Scratch for the fans of every collapse tried (made once: making one costs a memset).
         let mut fans = PairFans::default();
-        // Rounds: a pair found illegal is kept for another round while collapses happen, since
-        // one of them may be what it waited for.
-        loop {
-            let mut kept = 0usize;
-            let mut progress = false;
-            let mut k = 0;
-            while k < self.pairs.len() {
-                let pair = self.pairs.as_slice()[k];
-                k += 1;
-                let Pair {
-                    error: e,
-                    parent: p,
-                    first,
-                } = pair;
-                // The first child's slot from the pass, unless a collapse since moved it.
-                let a = if (first as usize) < self.v.len()
-                    && self.pair_parent(h, first as usize) == Some(p)
-                {
-                    first
-                } else {
-                    match self.slot(h.split(p).children[0]) {
-                        Some(a) if self.pair_parent(h, a as usize) == Some(p) => a,
-                        _ => continue,
-                    }
-                };
-                let b = self.v.mate(a as usize);
-                let (a, b) = (a as usize, b as usize);
-                if frame.ops >= budget.max_ops {
-                    frame.stats.ops_limited = true;
-                    return;
+        // One pass over a list that grows: a collapse lists the pair it makes and the pairs
+        // around it whose illegal mark it cleared, so a pair that waited for it is tried again.
+        let mut k = 0;
+        while k < self.pairs.len() {
+            let pair = self.pairs.as_slice()[k];
+            k += 1;
+            let Pair {
+                error: e,
+                parent: p,
+                first,
+            } = pair;
+            // The first child's slot from the pass, unless a collapse since moved it.
+            let a = if (first as usize) < self.v.len()
+                && self.pair_parent(h, first as usize) == Some(p)
+            {
+                first
+            } else {
+                match self.slot(h.children(p)[0]) {
+                    Some(a) if self.pair_parent(h, a as usize) == Some(p) => a,
+                    _ => continue,
                 }
-                let (fa, fb) = (self.v.flags[a], self.v.flags[b]);
-                let blending = fa & fb & COLLAPSING != 0;
-                if blending && (fa | fb) & BLENDING != 0 {
-                    continue;
-                }
-                let seen = e >= 0.0 && (fa | fb) & WAS_VISIBLE != 0;
-                let split = h.split(p);
-                let legal = self.collapse_legal_at(h, p, &split, a as u32, b as u32, &mut fans);
-                if legal.is_err() && !blending {
-                    self.block(a, b);
-                    self.pairs.as_mut_slice()[kept] = pair;
-                    kept += 1;
-                    continue;
-                }
-                if !blending && frames > 0 && seen {
-                    if self.blends.len() + 2 <= Q {
-                        self.start_blend(h, a, true);
-                        self.start_blend(h, b, true);
-                        continue;
-                    }
-                    frame.stats.blend_limited = true;
-                }
-                match legal {
-                    Ok(plan) => {
-                        let s = self.apply_collapse(h, p, plan, &mut fans);
-                        frame.stats.ecols += 1;
-                        frame.ops += 1;
-                        progress = true;
-                        self.list_new_pair(h, view, policy, s as usize, frame);
-                        self.list_unblocked(h, view, policy, s, &mut fans.0[0], frame);
-                    }
-                    Err(_) => {
-                        // Arrived, but the neighbourhood changed meanwhile: blend back.
-                        self.start_blend(h, a, false);
-                        self.start_blend(h, b, false);
-                    }
-                }
-            }
-            if !progress || kept == 0 {
+            };
+            let b = self.v.mate(a as usize);
+            let (a, b) = (a as usize, b as usize);
+            if frame.ops >= budget.max_ops {
+                frame.stats.ops_limited = true;
                 return;
             }
-            self.pairs.truncate(kept);
+            let (fa, fb) = (self.v.flags[a], self.v.flags[b]);
+            let blending = fa & fb & COLLAPSING != 0;
+            if blending && (fa | fb) & BLENDING != 0 {
+                continue;
+            }
+            let seen = e >= 0.0 && (fa | fb) & WAS_VISIBLE != 0;
+            let split = h.split(p);
+            let legal = self.collapse_legal_at(h, p, &split, a as u32, b as u32, &mut fans);
+            if legal.is_err() && !blending {
+                self.block(a, b);
+                continue;
+            }
+            if !blending && frames > 0 && seen {
+                if self.blends.len() + 2 <= Q {
+                    self.start_blend(h, a, true);
+                    self.start_blend(h, b, true);
+                    continue;
+                }
+                frame.stats.blend_limited = true;
+            }
+            match legal {
+                Ok(plan) => {
+                    let s = self.apply_collapse(h, p, plan, &mut fans);
+                    frame.stats.ecols += 1;
+                    frame.ops += 1;
+                    self.list_new_pair(h, view, policy, s as usize, frame);
+                    self.list_unblocked(h, view, policy, s, &mut fans, frame);
+                }
+                Err(_) => {
+                    // Arrived, but the neighbourhood changed meanwhile: blend back.
+                    self.start_blend(h, a, false);
+                    self.start_blend(h, b, false);
+                }
+            }
         }
     }
 
@@ -528,21 +517,31 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
     }
 
     /// After a collapse into slot `s`: lists the pairs around it whose illegal mark the collapse
-    /// cleared, when their parent is no longer needed (they may be legal now).
+    /// cleared (`fans.unblocked`; all pairs around it when it could not remember them all), when
+    /// their parent is no longer needed: they may be legal now.
     fn list_unblocked<P: Policy>(
         &mut self,
         h: &HierarchyView<'_>,
         view: &View,
         policy: &P,
         s: u32,
-        fan: &mut Fan,
+        fans: &mut PairFans,
         frame: &mut Frame,
     ) {
+        if !fans.overflow {
+            for k in 0..fans.unblocked.len() {
+                if let Some(x) = self.slot(fans.unblocked[k]) {
+                    self.list_new_pair(h, view, policy, x as usize, frame);
+                }
+            }
+            return;
+        }
+        let fan = &mut fans.fans[0];
         if !self.complete_fan(s, fan) {
             return;
         }
-        for &f in fan.iter() {
-            for x in self.t.at(f) {
+        for k in 0..fan.len() {
+            for x in self.t.at(fan[k]) {
                 if x != s {
                     self.list_new_pair(h, view, policy, x as usize, frame);
                 }
@@ -636,7 +635,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 if self.is_active(node) {
                     continue; // refused after all
                 }
-                for c in h.split(node).children {
+                for c in h.children(node) {
                     let Some(cs) = self.slot(c) else {
                         continue;
                     };

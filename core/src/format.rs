@@ -465,6 +465,33 @@ fn bits_at(b: &[u8], bit: u64, width: u32) -> u32 {
     (word >> shift) as u32 & mask
 }
 
+/// The low `width` bits set (all for 32 and more).
+#[inline(always)]
+fn low(width: u32) -> u32 {
+    if width >= 32 {
+        u32::MAX
+    } else {
+        (1u32 << width) - 1
+    }
+}
+
+/// The 128 bits from bit `bit` of `b` on, least significant first, shifted so that bit `bit` is
+/// bit 0 (the top `bit % 8` bits are zeros); bytes past the end read as ones.
+#[inline]
+fn window(b: &[u8], bit: u64) -> u128 {
+    let byte = usize::try_from(bit / 8).unwrap_or(usize::MAX);
+    let mut w = [0xFFu8; 16];
+    match b.get(byte..byte.saturating_add(16)) {
+        Some(s) => w.copy_from_slice(s),
+        None => {
+            for (k, x) in w.iter_mut().enumerate() {
+                *x = b.get(byte.saturating_add(k)).copied().unwrap_or(0xFF);
+            }
+        }
+    }
+    u128::from_le_bytes(w) >> (bit % 8)
+}
+
 /// An id read at `width` bits: all ones becomes [`NONE`].
 #[inline]
 fn id(raw: u32, width: u32) -> u32 {
@@ -919,6 +946,15 @@ impl<'a> HierarchyView<'a> {
         }
         let (wn, wf) = (self.node_width, self.face_width);
         let at = self.split_bit(p);
+        if 2 * wn + 4 * wf + 7 <= 128 {
+            // The whole record in one 16-byte window (every hierarchy below a million nodes).
+            let w = window(self.bytes, at);
+            let field = |offset: u32, width: u32| id((w >> offset) as u32 & low(width), width);
+            return SplitView {
+                children: [field(0, wn), field(wn, wn)],
+                neighbours: [0, 1, 2, 3].map(|k| field(2 * wn + k * wf, wf)),
+            };
+        }
         let node = |k: u64| id(bits_at(self.bytes, at + k * wn as u64, wn), wn);
         let face = |k: u64| {
             let bit = at + 2 * wn as u64 + k * wf as u64;
@@ -928,6 +964,22 @@ impl<'a> HierarchyView<'a> {
             children: [node(0), node(1)],
             neighbours: [face(0), face(1), face(2), face(3)],
         }
+    }
+
+    /// The children of parent `p` (`[NONE; 2]` for anything else): [`HierarchyView::split`]
+    /// without the neighbours.
+    #[inline]
+    #[must_use]
+    pub fn children(&self, p: u32) -> [u32; 2] {
+        if p < self.leaves || p >= self.nodes {
+            return [NONE; 2];
+        }
+        let wn = self.node_width;
+        let w = window(self.bytes, self.split_bit(p));
+        [
+            id(w as u32 & low(wn), wn),
+            id((w >> wn) as u32 & low(wn), wn),
+        ]
     }
 
     /// Base triangle `t`.

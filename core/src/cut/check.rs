@@ -88,7 +88,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             let (first, sibling) = if p == NONE {
                 (false, None)
             } else {
-                let [c0, c1] = h.split(p).children;
+                let [c0, c1] = h.children(p);
                 (c0 == node, self.slot(if c0 == node { c1 } else { c0 }))
             };
             if (self.v.flags[i] & FIRST_CHILD != 0) != first {

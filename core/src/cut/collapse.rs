@@ -51,7 +51,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         b: u32,
         fans: &mut PairFans,
     ) -> Result<CollapsePlan, Refused> {
-        let [fan_a, fan_b] = &mut fans.0;
+        let [fan_a, fan_b] = &mut fans.fans;
         if !self.complete_fan(a, fan_a) {
             return Err(Refused::Inconsistent);
         }
@@ -126,13 +126,22 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             left: fl,
             right: fr,
         } = plan;
-        let [fan_a, fan_b] = &fans.0;
+        let [fan_a, fan_b] = &fans.fans;
         // Collapses around here may become legal: clear the marks on every corner of the
-        // triangles around both vertices (the parent's fan and its neighbours).
+        // triangles around both vertices (the parent's fan and its neighbours), and remember
+        // whose mark was cleared.
+        fans.unblocked.clear();
+        fans.overflow = false;
         for &f in fan_a.iter().chain(fan_b.iter()) {
             for v in self.t.at(f) {
                 if let Some(flags) = self.v.flags.get_mut(v as usize) {
-                    *flags &= !BLOCKED;
+                    if *flags & BLOCKED != 0 {
+                        *flags &= !BLOCKED;
+                        if v != a && v != b && fans.unblocked.push(self.v.node[v as usize]).is_err()
+                        {
+                            fans.overflow = true;
+                        }
+                    }
                 }
             }
         }
@@ -201,7 +210,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         self.map.remove(self.v.node[b as usize], self.v.nodes());
         self.unlink_mate(b as usize);
         self.rename_vertex(h, a as usize, node);
-        match self.remove_vertex(b, &mut fans.0[0]) {
+        match self.remove_vertex(b, &mut fans.fans[0]) {
             Some(moved_from) if moved_from == a => b,
             _ => a,
         }

@@ -17,13 +17,27 @@ pub const MAX_FAN: usize = 1024;
 /// vector (making one writes no memory; an arena would zero its 4 KiB each time).
 pub(crate) type Fan = heapless::Vec<u32, MAX_FAN>;
 
+/// Most nodes whose illegal mark one collapse clears that it remembers (more: it remembers that
+/// there were more).
+pub(crate) const MAX_UNBLOCKED: usize = 32;
+
 /// The triangles around the two vertices of a collapse, found while proving it legal and used
-/// again to do it.
-pub(crate) struct PairFans(pub [Fan; 2]);
+/// again to do it; and the nodes around it whose illegal mark the collapse cleared.
+pub(crate) struct PairFans {
+    pub fans: [Fan; 2],
+    /// Nodes of the vertices the last collapse unblocked (see `crate::cut::BLOCKED`).
+    pub unblocked: heapless::Vec<u32, MAX_UNBLOCKED>,
+    /// More vertices were unblocked than `unblocked` holds.
+    pub overflow: bool,
+}
 
 impl Default for PairFans {
     fn default() -> Self {
-        PairFans([Fan::new(), Fan::new()])
+        PairFans {
+            fans: [Fan::new(), Fan::new()],
+            unblocked: heapless::Vec::new(),
+            overflow: false,
+        }
     }
 }
 

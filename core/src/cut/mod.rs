@@ -457,7 +457,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         if p == NONE {
             return;
         }
-        let [c0, c1] = h.split(p).children;
+        let [c0, c1] = h.children(p);
         let sibling = if c0 == node {
             self.v.flags[i] |= FIRST_CHILD;
             c1

@@ -114,12 +114,6 @@ impl<T: Copy, const N: usize> Arena<T, N> {
         self.len = 0;
     }
 
-    /// Keeps the first `len` items (no-op when there are fewer).
-    #[inline]
-    pub fn truncate(&mut self, len: usize) {
-        self.len = self.len.min(len as u32);
-    }
-
     /// Appends `x` and returns its index, or hands `x` back when full.
     #[inline]
     pub fn push(&mut self, x: T) -> Result<u32, T> {

@@ -149,7 +149,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         moved: &Fan,
         frames: u16,
     ) -> [u32; 2] {
-        let [c0, c1] = h.split(node).children;
+        let [c0, c1] = h.children(node);
         let SplitPlan {
             parent: ps,
             neighbours: ns,
