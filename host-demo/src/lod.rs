@@ -9,7 +9,10 @@ use std::time::Instant;
 use vdlod_core::adapt::{Budget, FrameStats};
 use vdlod_core::cut::{Coloring, Cut, SlotIndex};
 use vdlod_core::format::HierarchyView;
-use vdlod_core::policy::{Frustum, Importance, MergeTree, Policy, QRefine, ScreenError, View};
+use vdlod_core::policy::{
+    Bounds as NodeBounds, Demand, Frustum, Importance, MergeTree, Policy, QRefine, ScreenError,
+    View,
+};
 use vdlod_raster::{Mesh, Rgba8, Shading, VertexIndex};
 
 use crate::camera::{Camera, Orbit};
@@ -238,22 +241,56 @@ pub fn policy_view(camera: &Camera, aspect: f32, height: usize, frustum: f32) ->
     )
 }
 
-/// The policy for `choice`, as a trait object.
-pub fn make_policy(choice: PolicyChoice) -> Box<dyn Policy + Send> {
+/// The policy a [`PolicyChoice`] names, dispatched by a `match` per call (a trait object would
+/// cost an indirect call per vertex, about half of a frame's adaptation time).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum DemoPolicy {
+    /// [`QRefine`].
+    Screen(QRefine),
+    /// [`MergeTree`].
+    MergeTree(MergeTree),
+    /// [`Importance`] in the [`Frustum`].
+    Importance((Frustum, Importance)),
+}
+
+impl Policy for DemoPolicy {
+    #[inline]
+    fn demand(&self, b: &NodeBounds, view: &View) -> Demand {
+        match self {
+            DemoPolicy::Screen(p) => p.demand(b, view),
+            DemoPolicy::MergeTree(p) => p.demand(b, view),
+            DemoPolicy::Importance(p) => p.demand(b, view),
+        }
+    }
+
+    #[inline]
+    fn error_bound(&self, center: [f32; 3], s2: f32, view: &View) -> f32 {
+        match self {
+            DemoPolicy::Screen(p) => p.error_bound(center, s2, view),
+            DemoPolicy::MergeTree(p) => p.error_bound(center, s2, view),
+            DemoPolicy::Importance(p) => p.error_bound(center, s2, view),
+        }
+    }
+}
+
+/// The policy for `choice`.
+pub fn make_policy(choice: PolicyChoice) -> DemoPolicy {
     match choice {
         PolicyChoice::Screen {
             silhouette,
             interior,
-        } => Box::new(QRefine {
+        } => DemoPolicy::Screen(QRefine {
             error: ScreenError {
                 silhouette,
                 interior,
             },
         }),
-        PolicyChoice::MergeTree => Box::new(MergeTree {
+        PolicyChoice::MergeTree => DemoPolicy::MergeTree(MergeTree {
             near: f32::INFINITY,
         }),
-        PolicyChoice::Importance { threshold } => Box::new((Frustum, Importance { threshold })),
+        PolicyChoice::Importance { threshold } => {
+            DemoPolicy::Importance((Frustum, Importance { threshold }))
+        }
     }
 }
 
@@ -604,7 +641,7 @@ fn fly_orbit<const V: usize, const F: usize, const Q: usize, I: SlotIndex + Vert
         let camera = orbit.camera(i);
         let view = policy_view(&camera, frame.aspect(), opts.height, opts.frustum);
         let start = Instant::now();
-        let stats = cut.adapt(&h, &view, &&*policy, &opts.budget);
+        let stats = cut.adapt(&h, &view, &policy, &opts.budget);
         if stats.over_budget && !warned && h.base_triangles() > opts.budget.max_triangles {
             eprintln!(
                 "vdlod-demo: warning: the base mesh has {} triangles, more than the budget of {}: \
