@@ -528,7 +528,8 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         let last = self.v.len() as u32 - 1;
         let moved = (v != last).then(|| {
             // Proven whole before the collapse that removes `v`.
-            let _ = self.complete_fan(last, fan);
+            let whole = self.complete_fan(last, fan);
+            debug_assert!(whole, "the last vertex's fan was proven whole");
             for &f in fan.iter() {
                 if let Some(k) = corner(self.t.at(f), last) {
                     self.t.set_corner(f, k, v);

@@ -187,14 +187,16 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         }
         let fl = self.t.len() as u32;
         let fr = if second { fl + 1 } else { NIL };
-        // Room was proven.
-        let _ = self
+        // `split_legal` proved room for both.
+        let first = self
             .t
             .push([ps, c1s, wl], [fr, ns[0], ns[1]], h.split_face(node, false));
+        debug_assert_eq!(first, Some(fl), "room for a split's triangles was proven");
         if second {
-            let _ = self
+            let pushed = self
                 .t
                 .push([c1s, ps, wr], [fl, ns[2], ns[3]], h.split_face(node, true));
+            debug_assert_eq!(pushed, Some(fr), "room for a split's triangles was proven");
         }
         self.point_edge(ns[0], wl, c1s, fl);
         self.point_edge(ns[1], ps, wl, fl);
