@@ -11,11 +11,12 @@ mod common;
 use common::{fixture, sorted, topology};
 use vdlod_core::adapt::Budget;
 use vdlod_core::build::{build, BuildOptions, InputMesh};
-use vdlod_core::cut::Cut;
+use vdlod_core::cut::{Cut, SlotIndex};
 use vdlod_core::format::HierarchyView;
 use vdlod_core::policy::{BackFace, Frustum, ScreenError, View};
 use vdlod_demo::mesh::IndexedMesh;
 
+/// A desktop cut (32-bit indices) that holds every fixture at full detail.
 type TestCut = Cut<{ 1 << 16 }, { 1 << 17 }, { 1 << 13 }, u32>;
 
 fn hierarchy_bytes(mesh: &IndexedMesh) -> Vec<u8> {
@@ -29,12 +30,14 @@ fn hierarchy_bytes(mesh: &IndexedMesh) -> Vec<u8> {
         .to_bytes(false)
 }
 
-fn node_triangles(cut: &TestCut) -> Vec<[u32; 3]> {
+fn node_triangles<const V: usize, const F: usize, const Q: usize, I: SlotIndex>(
+    cut: &Cut<V, F, Q, I>,
+) -> Vec<[u32; 3]> {
     let nodes = cut.nodes();
     let t: Vec<[u32; 3]> = cut
         .triangles()
         .iter()
-        .map(|t| t.map(|s| nodes[s as usize]))
+        .map(|t| t.map(|s| nodes[s.index()]))
         .collect();
     sorted(&t)
 }
@@ -96,12 +99,17 @@ impl Path {
 }
 
 /// Flies `frames` random frames; returns a fingerprint of every frame's cut.
-fn fly(bytes: &[u8], mesh: &IndexedMesh, frames: u32, seed: u64) -> Vec<u64> {
+fn fly<const V: usize, const F: usize, const Q: usize, I: SlotIndex>(
+    bytes: &[u8],
+    mesh: &IndexedMesh,
+    frames: u32,
+    seed: u64,
+) -> Vec<u64> {
     let h = HierarchyView::parse(bytes).unwrap();
     let expected = topology(&mesh.triangles);
     let b = mesh.bounds();
     let (c, r) = (b.center().to_array(), b.radius());
-    let mut cut: Box<TestCut> = Cut::boxed();
+    let mut cut = Cut::<V, F, Q, I>::boxed();
     cut.reset(&h).unwrap();
     let mut path = Path::new(seed);
     let mut prints = Vec::new();
@@ -149,9 +157,19 @@ fn fly(bytes: &[u8], mesh: &IndexedMesh, frames: u32, seed: u64) -> Vec<u64> {
 fn long_path(name: &str, frames: u32) {
     let mesh = fixture(name);
     let bytes = hierarchy_bytes(&mesh);
-    let first = fly(&bytes, &mesh, frames, 7);
-    let second = fly(&bytes, &mesh, frames, 7);
+    let first = fly::<{ 1 << 16 }, { 1 << 17 }, { 1 << 13 }, u32>(&bytes, &mesh, frames, 7);
+    let second = fly::<{ 1 << 16 }, { 1 << 17 }, { 1 << 13 }, u32>(&bytes, &mesh, frames, 7);
     assert_eq!(first, second, "{name}: a second run differs");
+    // A 16-bit cut with the same queues flies the same path to the same cuts when the mesh fits
+    // it (the index width is not part of the input; capacities are only where one binds).
+    if mesh.triangles.len() < 65_534 {
+        let small = fly::<32_767, 65_534, { 1 << 13 }, u16>(&bytes, &mesh, frames, 7);
+        let differs = first.iter().zip(&small).position(|(a, b)| a != b);
+        assert_eq!(
+            differs, None,
+            "{name}: the 16-bit cut differs from frame {differs:?} on"
+        );
+    }
     // The path moved the cut.
     let mut distinct = first.clone();
     distinct.sort_unstable();
