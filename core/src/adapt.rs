@@ -1,14 +1,16 @@
 //! One frame of selective refinement: [`Cut::adapt`].
 //!
-//! Incremental from the previous frame's cut, as in the merge-tree paper (§3.5) and Hoppe's
-//! `adapt_refinement`: one pass over the active vertices asks the [`Policy`] about each, then
+//! Incremental from the previous frame's cut, as in the merge-tree paper (Berkey and Song, §3.5)
+//! and Hoppe's `adapt_refinement` ("View-dependent refinement of progressive meshes", 1997): one
+//! pass over the active vertices asks the [`Policy`] about each (a vertex whose digest proves,
+//! through [`Policy::error_bound`], that it wants no split is decided without reading the file),
+//! then
 //!
 //! 1. **coarsen**: sibling pairs whose parent the policy no longer needs are collapsed where
-//!    Hoppe's condition allows; a pair it forbids is retried in the same frame after other
-//!    collapses (one of them may be what it waited for), and a collapse that makes a new pair
-//!    lists it, so when no budget, queue or operation cap binds, one call reaches the cut the
-//!    view asks for and a second call with the same view does nothing (a test over the peer
-//!    orbit at 0.25-4 px);
+//!    Hoppe's condition allows; a collapse lists the pair it makes and the pairs around it whose
+//!    illegal mark it cleared, so when no budget, queue or operation cap binds, one call reaches
+//!    the cut the view asks for and a second call with the same view does nothing (a test over
+//!    the peer orbit at 0.25-4 px);
 //! 2. **refine**: vertices over tolerance are split largest error first (a priority queue), each
 //!    forcing the splits it depends on, and their children join the queue;
 //! 3. **budget**: splits stop at [`Budget::max_triangles`]; when the budget binds, pairs whose

@@ -20,8 +20,9 @@
 //!
 //! Capacities are in the type: `V` vertex slots, `F` triangle slots, `Q` entries of each work
 //! queue (and of the blend arena), and `I` the stored index ([`SlotIndex`]: `u16`, the default,
-//! for `V` and `F` below 65,535; `u32` above). Nothing else is kept: positions, normals, colours
-//! and bounds are read from the hierarchy in place, a vertex's family from its sibling link.
+//! for `V` and `F` below 65,535; `u32` above). Nothing else is kept: normals, colours and bounds
+//! are read from the hierarchy in place (an 8-byte digest of each active node lets most frames
+//! skip that read), a vertex's family from its sibling link.
 //! [`Cut::BYTES`] is, with `i` the index size (2 or 4 bytes), the same on 32- and 64-bit
 //! targets (all lengths are `u32`):
 //!
