@@ -12,7 +12,7 @@
 //! mesh stays a manifold with the input's topology and orientation after every operation;
 //! [`Cut::check`] proves it (Hoppe's `ok()`).
 //!
-//! The rooms: [`slot`] (index widths and the queue arena), [`store`] (vertex and triangle
+//! The rooms: [`slot`] (index widths and the queue arena), `store` (vertex and triangle
 //! records), `fan` (walks around a vertex), `split`, `collapse`, `blend` (geomorph state and the
 //! vertex output), `check` (the invariants).
 //!
@@ -39,7 +39,7 @@
 //! waits for the next frame and [`crate::adapt::FrameStats`] says so.
 //!
 //! [`Cut::new`] is `const` and all zeros, so `static CUT: Mutex<RefCell<Cut<..>>>` lands in
-//! `.bss` and never passes through the stack; [`Cut::boxed`] (feature `build`) puts one on the heap
+//! `.bss` and never passes through the stack; `Cut::boxed` (feature `build`) puts one on the heap
 //! the same way.
 //!
 //! # Determinism

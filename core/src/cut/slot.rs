@@ -7,7 +7,7 @@
 //! larger cuts a desktop uses. The cut's logic computes with `u32` slots and [`NIL`]; only the
 //! arrays narrow them.
 //!
-//! [`Arena`] is the one fixed-capacity list of the cut's queues: its `push` hands the item back
+//! `Arena` is the one fixed-capacity list of the cut's queues: its `push` hands the item back
 //! when full (nothing is dropped silently), and its all-zero state is the empty arena, so a
 //! `static` cut lands in `.bss`.
 
