@@ -199,8 +199,10 @@ fn full_vs_adapted(mesh: &IndexedMesh) {
     let (_, bytes, secs) = build_with_progress(&big, &Default::default(), false).expect("builds");
     big.reorder_for_locality();
     println!(
-        "{} triangles; hierarchy built in {secs:.1} s\n",
-        big.triangles.len()
+        "{} triangles; hierarchy built in {secs:.1} s, {} bytes ({:.1} bytes per input vertex)\n",
+        big.triangles.len(),
+        bytes.len(),
+        bytes.len() as f64 / big.positions.len() as f64
     );
     let h = HierarchyView::parse(&bytes).expect("valid");
     println!("| frustum | mean tris | adapt + render ms (median) | full detail ms (median) | speed-up | merge-tree paper |");
