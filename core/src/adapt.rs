@@ -266,6 +266,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         let blends = self.geomorph_frames > 0;
         let mut bounds = [Bounds::default(); BATCH];
         let mut quick = [false; BATCH];
+        let mut demands = [Demand::NONE; BATCH];
         let mut parents = [NONE; BATCH];
         let mut parent_bounds = [Bounds::default(); BATCH];
         let mut base = 0;
@@ -294,9 +295,30 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             {
                 *b = h.bounds(node);
             }
+            for k in 0..n {
+                demands[k] = if quick[k] {
+                    // Wants no split; seen if its sphere reaches into the frustum (the flag only
+                    // decides whether changes blend, so without geomorphs it is not computed).
+                    let b = &bounds[k];
+                    Demand {
+                        visible: blends && view.sphere_visible(b.center, b.radius),
+                        error: 0.0,
+                    }
+                } else {
+                    policy.demand(&bounds[k], view)
+                };
+            }
+            // The parent of a pair matters unless the first child is to be split or both were
+            // found illegal to collapse (see `decide`).
             for (k, p) in parents[..n].iter_mut().enumerate() {
                 let i = base + k;
-                *p = if self.v.flags[i] & FIRST_CHILD != 0 && self.v.mate(i) != NIL {
+                let m = self.v.mate(i);
+                let splits = demands[k].error > t && self.v.node[i] >= h.leaves();
+                *p = if self.v.flags[i] & FIRST_CHILD != 0
+                    && m != NIL
+                    && !splits
+                    && self.v.flags[i] & self.v.flags[m as usize] & BLOCKED == 0
+                {
                     h.parent(self.v.node[i])
                 } else {
                     NONE
@@ -313,19 +335,8 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 }
             }
             for k in 0..n {
-                let d = if quick[k] {
-                    // Wants no split; seen if its sphere reaches into the frustum (the flag only
-                    // decides whether changes blend, so without geomorphs it is not computed).
-                    let b = &bounds[k];
-                    Demand {
-                        visible: blends && view.sphere_visible(b.center, b.radius),
-                        error: 0.0,
-                    }
-                } else {
-                    policy.demand(&bounds[k], view)
-                };
                 let (p, pb) = (parents[k], &parent_bounds[k]);
-                self.decide(h, view, policy, base + k, d, p, pb, frame);
+                self.decide(h, view, policy, base + k, demands[k], p, pb, frame);
             }
             base += n;
         }
