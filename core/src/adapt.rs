@@ -401,14 +401,20 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             }
             return;
         }
+        self.list_pair(e, p, i, &mut frame.stats);
+    }
+
+    /// Appends the pair of first child `first` and parent `parent` (error `error`) to the
+    /// collapse list; `false`, and the overflow noted, when the list is full.
+    fn list_pair(&mut self, error: f32, parent: u32, first: usize, stats: &mut FrameStats) -> bool {
         let pair = Pair {
-            error: e,
-            parent: p,
-            first: i as u32,
+            error,
+            parent,
+            first: first as u32,
         };
-        if self.pairs.push(pair).is_err() {
-            frame.stats.queue_overflow = true;
-        }
+        let listed = self.pairs.push(pair).is_ok();
+        stats.queue_overflow |= !listed;
+        listed
     }
 
     /// Collapses the listed pairs where the parent is no longer needed and Hoppe's condition
@@ -516,16 +522,8 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         };
         let p = h.parent(self.v.node[first]);
         let error = pair_error(policy.demand(&h.bounds(p), view));
-        if error > frame.threshold {
-            return;
-        }
-        let pair = Pair {
-            error,
-            parent: p,
-            first: first as u32,
-        };
-        if self.pairs.push(pair).is_err() {
-            frame.stats.queue_overflow = true;
+        if error <= frame.threshold {
+            self.list_pair(error, p, first, &mut frame.stats);
         }
     }
 
@@ -575,13 +573,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         for i in 0..self.v.len() {
             if let Some(p) = self.pair_parent(h, i) {
                 let e = pair_error(policy.demand(&h.bounds(p), view));
-                let pair = Pair {
-                    error: e,
-                    parent: p,
-                    first: i as u32,
-                };
-                if self.pairs.push(pair).is_err() {
-                    stats.queue_overflow = true;
+                if !self.list_pair(e, p, i, stats) {
                     break;
                 }
             }

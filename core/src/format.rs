@@ -442,27 +442,13 @@ fn f32_at(b: &[u8], o: usize) -> f32 {
 /// read as ones.
 #[inline]
 fn bits_at(b: &[u8], bit: u64, width: u32) -> u32 {
-    let mask = if width >= 32 {
-        u32::MAX
-    } else {
-        (1u32 << width) - 1
-    };
     let byte = usize::try_from(bit / 8).unwrap_or(usize::MAX);
-    let shift = (bit % 8) as u32;
     let word = match b.get(byte..byte.saturating_add(8)) {
         Some(s) => u64::from_le_bytes([s[0], s[1], s[2], s[3], s[4], s[5], s[6], s[7]]),
-        None => {
-            // Near the end of the file: byte by byte, ones past it.
-            let mut w = u64::MAX;
-            for k in 0..8 {
-                let v = b.get(byte.saturating_add(k)).copied().unwrap_or(0xFF);
-                w &= !(0xFFu64 << (8 * k));
-                w |= (v as u64) << (8 * k);
-            }
-            w
-        }
+        // Near the end of the file: the slow window, ones past the end.
+        None => window(b, bit & !7) as u64,
     };
-    (word >> shift) as u32 & mask
+    (word >> (bit % 8)) as u32 & low(width)
 }
 
 /// The low `width` bits set (all for 32 and more).
@@ -740,45 +726,30 @@ impl<'a> HierarchyView<'a> {
         self.bytes.get(o..end)?.try_into().ok()
     }
 
-    /// The first byte of node `i`'s record, and of its parent id (0 out of range): reading it
-    /// brings the record into the cache. A caller that touches a batch of nodes before decoding
-    /// them has the processor fetch all their records at once instead of one after the other.
+    /// The first byte of node `i`'s record (0 out of range): reading it brings the record into
+    /// the cache. A caller that touches a batch of nodes before decoding them has the processor
+    /// fetch all their records at once instead of one after the other.
     #[inline(always)]
     #[must_use]
     pub fn touch(&self, i: u32) -> u8 {
         let o = if i < self.leaves {
-            self.offsets[0].wrapping_add(i as usize * NODE_SIZE)
+            record(self.offsets[0], i, NODE_SIZE)
         } else {
-            self.offsets[5]
-                .wrapping_add((i.wrapping_sub(self.leaves) as usize).wrapping_mul(PARENT_SIZE))
+            record(self.offsets[5], i.wrapping_sub(self.leaves), PARENT_SIZE)
         };
-        let p =
-            self.offsets[2].wrapping_add((i as usize).wrapping_mul(self.node_width as usize) / 8);
-        self.bytes.get(o).copied().unwrap_or(0) ^ self.bytes.get(p).copied().unwrap_or(0)
+        self.bytes.get(o).copied().unwrap_or(0)
     }
 
     /// Node `i`'s [`Digest`] (zeros out of range).
     #[inline]
     #[must_use]
     pub fn digest(&self, i: u32) -> Digest {
-        let (r, leaf) = match self.parent_record(i) {
-            Some(r) => (r, false),
-            None => {
-                let mut r = [0; PARENT_SIZE];
-                let at = record(self.offsets[0], i, NODE_SIZE);
-                if let Some(leaf) =
-                    self.fixed::<NODE_SIZE>(if i < self.leaves { at } else { usize::MAX })
-                {
-                    r[..NODE_SIZE].copy_from_slice(&leaf);
-                }
-                (r, true)
-            }
-        };
+        let r = self.record_bytes(i);
         let q = |k: usize| u16::from_le_bytes([r[2 * k], r[2 * k + 1]]);
         Digest {
             position: [q(0), q(1), q(2)],
-            spheroid: if leaf { 0 } else { r[9].max(r[10]) },
-            radius: if leaf { 0 } else { r[8] },
+            spheroid: r[9].max(r[10]),
+            radius: r[8],
         }
     }
 
@@ -786,7 +757,12 @@ impl<'a> HierarchyView<'a> {
     #[inline(always)]
     #[must_use]
     pub fn digest_center(&self, d: &Digest) -> [f32; 3] {
-        let q = d.position;
+        self.dequantize(d.position)
+    }
+
+    /// A quantized position in the model's coordinates.
+    #[inline(always)]
+    fn dequantize(&self, q: [u16; 3]) -> [f32; 3] {
         [
             self.origin[0] + q[0] as f32 * self.step[0],
             self.origin[1] + q[1] as f32 * self.step[1],
@@ -804,9 +780,12 @@ impl<'a> HierarchyView<'a> {
     /// Leaf `i`'s position.
     #[inline]
     fn leaf_position(&self, i: u32) -> [f32; 3] {
-        let r: [u8; 6] = self
-            .fixed(record(self.offsets[0], i, NODE_SIZE))
-            .unwrap_or([0; 6]);
+        let at = if i < self.leaves {
+            record(self.offsets[0], i, NODE_SIZE)
+        } else {
+            usize::MAX
+        };
+        let r: [u8; 6] = self.fixed(at).unwrap_or([0; 6]);
         self.position_of(&r)
     }
 
@@ -814,16 +793,25 @@ impl<'a> HierarchyView<'a> {
     /// cone sine); a leaf's codes (and anything out of range) are zeros and no cone.
     #[inline]
     fn node_record(&self, i: u32) -> ([f32; 3], [f32; 3], [u8; 4]) {
+        let r = self.record_bytes(i);
+        let normal = oct_decode(r[6] as i8, r[7] as i8);
+        (self.position_of(&r), normal, [r[8], r[9], r[10], r[11]])
+    }
+
+    /// Node `i`'s record as a parent's: a leaf's padded with zero codes and no cone, anything
+    /// out of range all zeros but no cone.
+    #[inline]
+    fn record_bytes(&self, i: u32) -> [u8; PARENT_SIZE] {
+        if let Some(r) = self.parent_record(i) {
+            return r;
+        }
         let mut r = [0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 255];
         if i < self.leaves {
             if let Some(leaf) = self.fixed::<NODE_SIZE>(record(self.offsets[0], i, NODE_SIZE)) {
                 r[..NODE_SIZE].copy_from_slice(&leaf);
             }
-        } else if let Some(parent) = self.parent_record(i) {
-            r = parent;
         }
-        let normal = oct_decode(r[6] as i8, r[7] as i8);
-        (self.position_of(&r), normal, [r[8], r[9], r[10], r[11]])
+        r
     }
 
     /// Parent `i`'s 12-byte record (`None` for a leaf or an id out of range).
@@ -840,12 +828,8 @@ impl<'a> HierarchyView<'a> {
     /// The position in a node record.
     #[inline(always)]
     fn position_of(&self, r: &[u8]) -> [f32; 3] {
-        let q = |k: usize| u16::from_le_bytes([r[2 * k], r[2 * k + 1]]) as f32;
-        [
-            self.origin[0] + q(0) * self.step[0],
-            self.origin[1] + q(1) * self.step[1],
-            self.origin[2] + q(2) * self.step[2],
-        ]
+        let q = |k: usize| u16::from_le_bytes([r[2 * k], r[2 * k + 1]]);
+        self.dequantize([q(0), q(1), q(2)])
     }
 
     #[inline]
@@ -858,19 +842,13 @@ impl<'a> HierarchyView<'a> {
     #[must_use]
     pub fn node(&self, i: u32) -> NodeView {
         let (position, normal, [r, a, b, cone]) = self.node_record(i);
-        let color = if self.has_colors() {
-            self.fixed::<COLOR_SIZE>(record(self.offsets[1], i, COLOR_SIZE))
-                .unwrap_or([0; 3])
-        } else {
-            [255; 3]
-        };
         NodeView {
             position,
-            radius: decode_length(r) * self.unit,
-            spheroid: [decode_length(a) * self.unit, decode_length(b) * self.unit],
+            radius: self.length(r),
+            spheroid: [self.length(a), self.length(b)],
             normal,
             cone_sin: CONE_SINES[cone as usize],
-            color,
+            color: self.color(i),
             depth: self.depth(i),
             parent: self.parent(i),
         }
@@ -882,13 +860,17 @@ impl<'a> HierarchyView<'a> {
     #[must_use]
     pub fn vertex(&self, i: u32) -> ([f32; 3], [f32; 3], [u8; 3]) {
         let (position, normal, _) = self.node_record(i);
-        let color = if self.has_colors() {
-            self.fixed::<COLOR_SIZE>(record(self.offsets[1], i, COLOR_SIZE))
-                .unwrap_or([0; 3])
-        } else {
-            [255; 3]
-        };
-        (position, normal, color)
+        (position, normal, self.color(i))
+    }
+
+    /// Node `i`'s colour: white without colours, black out of range.
+    #[inline]
+    fn color(&self, i: u32) -> [u8; 3] {
+        if !self.has_colors() {
+            return [255; 3];
+        }
+        self.fixed(record(self.offsets[1], i, COLOR_SIZE))
+            .unwrap_or([0; 3])
     }
 
     /// Node `i`'s depth in the forest, counted up its parents (0 for roots and ids out of range).
@@ -919,13 +901,10 @@ impl<'a> HierarchyView<'a> {
                 b2: 0.0,
             };
         };
-        let (a, b) = (
-            LENGTHS[r[9] as usize] * self.unit,
-            LENGTHS[r[10] as usize] * self.unit,
-        );
+        let (a, b) = (self.length(r[9]), self.length(r[10]));
         crate::policy::Bounds {
             center: self.position_of(&r),
-            radius: LENGTHS[r[8] as usize] * self.unit,
+            radius: self.length(r[8]),
             axis: oct_decode(r[6] as i8, r[7] as i8),
             cone_sin: CONE_SINES[r[11] as usize],
             a2: a * a,

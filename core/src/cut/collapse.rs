@@ -207,8 +207,9 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         if lo != NIL {
             self.remove_triangle(lo);
         }
+        // `b` leaves the map first (remove_vertex expects it gone); renaming `a` breaks their
+        // mate link.
         self.map.remove(self.v.node[b as usize], self.v.nodes());
-        self.unlink_mate(b as usize);
         self.rename_vertex(h, a as usize, node);
         match self.remove_vertex(b, &mut fans.fans[0]) {
             Some(moved_from) if moved_from == a => b,

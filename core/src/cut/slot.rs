@@ -143,10 +143,10 @@ impl<T: Copy, const N: usize> Arena<T, N> {
     /// the index the last one moved from (`None` when `i` was the last).
     pub fn swap_remove(&mut self, i: usize) -> Option<(T, Option<u32>)> {
         let last = self.len().checked_sub(1)?;
-        let removed = *self.items.get(i)?;
         if i > last {
             return None;
         }
+        let removed = self.items[i];
         self.items[i] = self.items[last];
         self.len = last as u32;
         Some((removed, (i != last).then_some(last as u32)))

@@ -161,7 +161,9 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         // because the first replaces the parent's entry.
         self.rename_vertex(h, ps as usize, c0);
         let Some(c1s) = self.push_vertex(c1) else {
-            // Only a full node map can refuse (never at half load): undo.
+            // `split_legal` proved room in the vertex arena and the node map, so this cannot
+            // happen; should it, the parent comes back rather than the cut breaking.
+            debug_assert!(false, "room for a split's second child was proven");
             self.rename_vertex(h, ps as usize, node);
             return [ps, ps];
         };
