@@ -1,9 +1,14 @@
 //! Drawing an indexed triangle mesh: the pipeline from vertices to pixels.
 //!
-//! [`draw_indexed`] runs the vertex stage once per vertex into caller-provided scratch, then for
-//! each triangle: rejects it if all three vertices are outside one clipping plane, clips it if any
-//! vertex is outside the clipping volume, culls back faces, and fills it with a strict-less depth
-//! test. The wireframe overlay, when asked for, is drawn afterwards over the filled frame.
+//! [`shade`] runs the vertex stage once per vertex into caller-provided scratch; [`ShadedMesh::draw`]
+//! then takes each triangle: rejects it if all three vertices are outside one clipping plane, clips
+//! it if any vertex is outside the clipping volume, culls back faces, skips it if it misses the
+//! target's window, and fills it with a strict-less depth test. The wireframe overlay, when asked
+//! for, is drawn afterwards over the filled window. [`draw_indexed`] does both for a whole frame.
+//!
+//! A frame drawn in bands shades once and draws once per band: each band re-reads every
+//! triangle's three shaded vertices and its bounding box (a few nanoseconds per triangle on a
+//! desktop, no per-frame memory), and clips again the few triangles that need it.
 
 use core::fmt;
 
@@ -14,7 +19,7 @@ use crate::edge::{
     fill_triangle, pixel_bounds, scan, signed_area2, signed_area2_xy, Coverage, Facing, Fragment,
     ScreenVertex,
 };
-use crate::target::{Pixel, Target};
+use crate::target::{check_frame, Depth, Pixel, Target, TargetError};
 use crate::vertex::{
     shade_vertices, to_clip, Light, PreparedLighting, ShadedVertex, VertexLighting, Viewport,
 };
@@ -168,6 +173,15 @@ pub enum DrawError {
     },
     /// Gouraud shading needs vertex normals.
     MissingNormals,
+    /// The frame size given to [`shade`] is zero or too large.
+    Frame(TargetError),
+    /// The target is for a frame of another size than the one the mesh was shaded for.
+    FrameMismatch {
+        /// The frame [`shade`] was given.
+        shaded: (usize, usize),
+        /// The target's frame.
+        target: (usize, usize),
+    },
 }
 
 impl fmt::Display for DrawError {
@@ -191,6 +205,12 @@ impl fmt::Display for DrawError {
                 actual,
             } => write!(f, "{attribute} has {actual} entries, expected {expected}"),
             DrawError::MissingNormals => write!(f, "Gouraud shading needs vertex normals"),
+            DrawError::Frame(e) => write!(f, "{e}"),
+            DrawError::FrameMismatch { shaded, target } => write!(
+                f,
+                "the mesh was shaded for a {}x{} frame, the target is part of a {}x{} frame",
+                shaded.0, shaded.1, target.0, target.1
+            ),
         }
     }
 }
@@ -249,7 +269,7 @@ fn rgb_f32(c: [u8; 3]) -> [f32; 3] {
     c.map(|v| v as f32)
 }
 
-/// Draws an indexed mesh.
+/// Draws an indexed mesh into a whole frame: [`shade`], then [`ShadedMesh::draw`].
 ///
 /// `scratch` must hold at least one [`ShadedVertex`] per mesh vertex; it is overwritten. Nothing
 /// is drawn when an error is returned.
@@ -271,18 +291,62 @@ fn rgb_f32(c: [u8; 3]) -> [f32; 3] {
 /// assert_eq!(stats.rasterized, 1);
 /// assert!(target.color().iter().any(|p| p.0[0] > 0));
 /// ```
-pub fn draw_indexed<P: Pixel, I: VertexIndex>(
-    target: &mut Target<'_, P>,
+pub fn draw_indexed<P: Pixel, D: Depth, I: VertexIndex>(
+    target: &mut Target<'_, P, D>,
     mesh: &Mesh<'_, I>,
     params: &DrawParams,
     scratch: &mut [ShadedVertex],
 ) -> Result<DrawStats, DrawError> {
-    validate(mesh, params, scratch.len())?;
-    let viewport = Viewport::new(target.width, target.height);
-    let scratch = &mut scratch[..mesh.positions.len()];
-    let base = rgb_f32(params.base_color);
+    shade(mesh, params, target.width, target.height, scratch)?.draw(target)
+}
 
-    // Vertex stage.
+/// A mesh after the vertex stage of one frame, ready to be drawn into the whole frame or into any
+/// window of it, as often as needed (once per band), without shading its vertices again.
+#[derive(Clone, Copy, Debug)]
+pub struct ShadedMesh<'a, I: VertexIndex = u32> {
+    mesh: Mesh<'a, I>,
+    params: &'a DrawParams,
+    vertices: &'a [ShadedVertex],
+    lighting: Option<PreparedLighting>,
+    viewport: Viewport,
+    frame: (usize, usize),
+}
+
+/// Runs the vertex stage of `mesh` for a `width` by `height` frame into `scratch` (at least one
+/// [`ShadedVertex`] per vertex; it is overwritten).
+///
+/// ```
+/// use glam::{Mat4, Vec3};
+/// use vdlod_raster::{shade, DrawParams, Mesh, Rgb565, ShadedVertex, Shading, Target, Window};
+/// let positions = [[-1.0, -1.0, 0.0], [1.0, -1.0, 0.0], [0.0, 1.0, 0.0]];
+/// let mesh = Mesh { positions: &positions, triangles: &[[0u16, 1, 2]], ..Mesh::default() };
+/// let proj = Mat4::perspective_rh(1.0, 1.0, 0.1, 10.0);
+/// let view = Mat4::look_at_rh(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, Vec3::Y);
+/// let params = DrawParams { mvp: proj * view, shading: Shading::Flat, ..DrawParams::default() };
+/// let mut scratch = [ShadedVertex::default(); 3];
+/// let shaded = shade(&mesh, &params, 32, 32, &mut scratch).unwrap();
+/// // A 32x32 frame in bands of 8 rows, through one band-sized pair of buffers.
+/// let (mut color, mut depth) = ([Rgb565(0); 32 * 8], [0u16; 32 * 8]);
+/// let mut lit = 0;
+/// for band in Window::bands(32, 32, 8) {
+///     let mut target = Target::window(&mut color, &mut depth, 32, 32, band, 32).unwrap();
+///     target.clear(Rgb565(0));
+///     shaded.draw(&mut target).unwrap();
+///     lit += target.color().iter().filter(|p| p.0 != 0).count();
+/// }
+/// assert!(lit > 100);
+/// ```
+pub fn shade<'a, I: VertexIndex>(
+    mesh: &Mesh<'a, I>,
+    params: &'a DrawParams,
+    width: usize,
+    height: usize,
+    scratch: &'a mut [ShadedVertex],
+) -> Result<ShadedMesh<'a, I>, DrawError> {
+    check_frame(width, height).map_err(DrawError::Frame)?;
+    validate(mesh, params, scratch.len())?;
+    let viewport = Viewport::new(width, height);
+    let scratch = &mut scratch[..mesh.positions.len()];
     let lighting = match (params.shading, mesh.normals) {
         (Shading::Gouraud, Some(normals)) => Some(VertexLighting {
             normal_matrix: &params.normal_matrix,
@@ -299,101 +363,129 @@ pub fn draw_indexed<P: Pixel, I: VertexIndex>(
         mesh.positions,
         prepared.as_ref().zip(mesh.normals),
         mesh.colors,
-        base,
+        rgb_f32(params.base_color),
         scratch,
     );
+    Ok(ShadedMesh {
+        mesh: *mesh,
+        params,
+        vertices: scratch,
+        lighting: prepared,
+        viewport,
+        frame: (width, height),
+    })
+}
 
-    let facing = if params.cull_back_faces {
-        Facing::Front
-    } else {
-        Facing::Both
-    };
-    let mut stats = DrawStats {
-        submitted: mesh.triangles.len() as u32,
-        ..DrawStats::default()
-    };
-    let fill = |target: &mut Target<'_, P>, stats: &mut DrawStats, tri: &[ScreenVertex; 3]| {
-        let coverage = fill_triangle(target, tri, facing, depth_test::<P>);
-        match coverage {
-            Coverage::Scanned => stats.rasterized += 1,
-            Coverage::Culled => stats.culled += 1,
-        }
-    };
-    for (t, tri) in mesh.triangles.iter().enumerate() {
-        let tri = &tri.map(I::to_u32);
-        // References, not copies: a culled triangle reads only positions and outcodes.
-        let v = tri.map(|i| &scratch[i as usize]);
-        let union = v[0].outcode | v[1].outcode | v[2].outcode;
-        if union == 0 {
-            // Cull before any colour work: half the triangles of a closed mesh face away.
-            let xy = v.map(|v| [v.x, v.y]);
-            let area = signed_area2_xy(xy);
-            if area == 0 || (area > 0 && params.cull_back_faces) {
-                stats.culled += 1;
-                continue;
-            }
-            stats.rasterized += 1;
-            // Smaller than a pixel and between pixel centres: nothing to draw, no set-up to pay.
-            let Some(bounds) = pixel_bounds(xy, target.width, target.height) else {
-                continue;
-            };
-            let colors = triangle_colors(mesh, params, prepared.as_ref(), t, tri, &v);
-            // Clockwise on screen, as the pixel loop wants it.
-            let order = if area < 0 { [0, 2, 1] } else { [0, 1, 2] };
-            let s = order.map(|k| ScreenVertex {
-                x: v[k].x,
-                y: v[k].y,
-                z: v[k].z,
-                rgb: colors[k],
+impl<I: VertexIndex> ShadedMesh<'_, I> {
+    /// Draws the triangles into `target`, which must be (a window of) the frame the mesh was
+    /// shaded for. The statistics are those of the whole frame, whatever the window.
+    pub fn draw<P: Pixel, D: Depth>(
+        &self,
+        target: &mut Target<'_, P, D>,
+    ) -> Result<DrawStats, DrawError> {
+        if (target.width, target.height) != self.frame {
+            return Err(DrawError::FrameMismatch {
+                shaded: self.frame,
+                target: (target.width, target.height),
             });
-            scan(target, &s, area.abs(), bounds, depth_test::<P>);
-        } else if union & clip::INVALID != 0 {
-            stats.invalid += 1;
-        } else if v[0].outcode & v[1].outcode & v[2].outcode != 0 {
-            stats.outside += 1;
+        }
+        let (mesh, params, scratch) = (&self.mesh, self.params, self.vertices);
+        let viewport = &self.viewport;
+        let prepared = self.lighting.as_ref();
+        let facing = if params.cull_back_faces {
+            Facing::Front
         } else {
-            stats.clipped += 1;
-            let colors = triangle_colors(mesh, params, prepared.as_ref(), t, tri, &v);
-            for_each_clipped(&viewport, params, mesh, tri, colors, union, |s| {
-                fill(target, &mut stats, s)
-            });
-        }
-    }
-
-    if let Some(wire) = params.wireframe {
-        let color = P::from_rgb(wire[0], wire[1], wire[2]);
-        for tri in mesh.triangles {
-            let tri = &tri.map(I::to_u32);
-            let v = tri.map(|i| scratch[i as usize]);
-            let union = v[0].outcode | v[1].outcode | v[2].outcode;
-            if union & clip::INVALID != 0 || v[0].outcode & v[1].outcode & v[2].outcode != 0 {
-                continue;
-            }
-            let mut edges = |s: &[ScreenVertex; 3]| {
-                if params.cull_back_faces && signed_area2(s) >= 0 {
-                    return;
-                }
-                for k in 0..3 {
-                    draw_line(target, &s[k], &s[(k + 1) % 3], color);
+            Facing::Both
+        };
+        let mut stats = DrawStats {
+            submitted: mesh.triangles.len() as u32,
+            ..DrawStats::default()
+        };
+        let fill =
+            |target: &mut Target<'_, P, D>, stats: &mut DrawStats, tri: &[ScreenVertex; 3]| {
+                let coverage = fill_triangle(target, tri, facing, depth_test::<P, D>);
+                match coverage {
+                    Coverage::Scanned => stats.rasterized += 1,
+                    Coverage::Culled => stats.culled += 1,
                 }
             };
+        for (t, tri) in mesh.triangles.iter().enumerate() {
+            let tri = &tri.map(I::to_u32);
+            // References, not copies: a culled triangle reads only positions and outcodes.
+            let v = tri.map(|i| &scratch[i as usize]);
+            let union = v[0].outcode | v[1].outcode | v[2].outcode;
             if union == 0 {
-                edges(&v.map(|v| v.screen()));
+                // Cull before any colour work: half the triangles of a closed mesh face away.
+                let xy = v.map(|v| [v.x, v.y]);
+                let area = signed_area2_xy(xy);
+                if area == 0 || (area > 0 && params.cull_back_faces) {
+                    stats.culled += 1;
+                    continue;
+                }
+                stats.rasterized += 1;
+                // Smaller than a pixel and between pixel centres: nothing to draw, no set-up to pay.
+                let Some(bounds) = pixel_bounds(xy, &target.window) else {
+                    continue;
+                };
+                let colors = triangle_colors(mesh, params, prepared, t, tri, &v);
+                // Clockwise on screen, as the pixel loop wants it.
+                let order = if area < 0 { [0, 2, 1] } else { [0, 1, 2] };
+                let s = order.map(|k| ScreenVertex {
+                    x: v[k].x,
+                    y: v[k].y,
+                    z: v[k].z,
+                    rgb: colors[k],
+                });
+                scan(target, &s, area.abs(), bounds, depth_test::<P, D>);
+            } else if union & clip::INVALID != 0 {
+                stats.invalid += 1;
+            } else if v[0].outcode & v[1].outcode & v[2].outcode != 0 {
+                stats.outside += 1;
             } else {
-                for_each_clipped(&viewport, params, mesh, tri, [[0.0; 3]; 3], union, |s| {
-                    edges(s)
+                stats.clipped += 1;
+                let colors = triangle_colors(mesh, params, prepared, t, tri, &v);
+                for_each_clipped(viewport, params, mesh, tri, colors, union, |s| {
+                    fill(target, &mut stats, s)
                 });
             }
         }
+
+        if let Some(wire) = params.wireframe {
+            let color = P::from_rgb(wire[0], wire[1], wire[2]);
+            for tri in mesh.triangles {
+                let tri = &tri.map(I::to_u32);
+                let v = tri.map(|i| scratch[i as usize]);
+                let union = v[0].outcode | v[1].outcode | v[2].outcode;
+                if union & clip::INVALID != 0 || v[0].outcode & v[1].outcode & v[2].outcode != 0 {
+                    continue;
+                }
+                let mut edges = |s: &[ScreenVertex; 3]| {
+                    if params.cull_back_faces && signed_area2(s) >= 0 {
+                        return;
+                    }
+                    for k in 0..3 {
+                        draw_line(target, &s[k], &s[(k + 1) % 3], color);
+                    }
+                };
+                if union == 0 {
+                    edges(&v.map(|v| v.screen()));
+                } else {
+                    for_each_clipped(viewport, params, mesh, tri, [[0.0; 3]; 3], union, |s| {
+                        edges(s)
+                    });
+                }
+            }
+        }
+        Ok(stats)
     }
-    Ok(stats)
 }
 
 /// Writes a fragment nearer than what the pixel holds (strict less: the first of equal depths wins).
 #[inline(always)]
-fn depth_test<P: Pixel>(c: &mut P, d: &mut u32, f: Fragment<'_>) {
-    if f.z < *d {
-        *d = f.z;
+fn depth_test<P: Pixel, D: Depth>(c: &mut P, d: &mut D, f: Fragment<'_>) {
+    let z = D::from_depth(f.z);
+    if z < *d {
+        *d = z;
         let [r, g, b] = f.rgb();
         *c = P::from_rgb(r, g, b);
     }

@@ -18,7 +18,7 @@
 //! loop, and no set-up at all for the many triangles of a detailed mesh that cover no pixel
 //! centre. Only IEEE basic operations are used, so the result is the same on every target.
 
-use crate::target::{Pixel, Target};
+use crate::target::{Depth, Pixel, Target, Window};
 use crate::vertex::saturate_u8;
 
 /// Fractional bits of snapped screen coordinates.
@@ -96,19 +96,20 @@ pub fn signed_area2_xy(p: [[i32; 2]; 3]) -> i64 {
     (p[1][0] as i64 - x0) * (p[2][1] as i64 - y0) - (p[1][1] as i64 - y0) * (p[2][0] as i64 - x0)
 }
 
-/// The pixels whose centres the bounding box of three snapped points can contain, clipped to a
-/// `width` by `height` viewport, as inclusive `(x0, x1, y0, y1)`; `None` when there are none.
+/// The pixels whose centres the bounding box of three snapped points can contain, clipped to
+/// `window` (in frame pixels), as inclusive `(x0, x1, y0, y1)`; `None` when there are none.
 #[inline(always)]
-pub fn pixel_bounds(p: [[i32; 2]; 3], width: usize, height: usize) -> Option<[i64; 4]> {
+pub fn pixel_bounds(p: [[i32; 2]; 3], window: &Window) -> Option<[i64; 4]> {
     let min_x = p[0][0].min(p[1][0]).min(p[2][0]) as i64;
     let max_x = p[0][0].max(p[1][0]).max(p[2][0]) as i64;
     let min_y = p[0][1].min(p[1][1]).min(p[2][1]) as i64;
     let max_y = p[0][1].max(p[1][1]).max(p[2][1]) as i64;
     // First and last pixel whose centre (i + 1/2) can lie inside [min, max].
-    let x0 = ((min_x - HALF + SUBPIXEL_ONE as i64 - 1) >> SUBPIXEL_BITS).max(0);
-    let x1 = ((max_x - HALF) >> SUBPIXEL_BITS).min(width as i64 - 1);
-    let y0 = ((min_y - HALF + SUBPIXEL_ONE as i64 - 1) >> SUBPIXEL_BITS).max(0);
-    let y1 = ((max_y - HALF) >> SUBPIXEL_BITS).min(height as i64 - 1);
+    let (wx, wy) = (window.x as i64, window.y as i64);
+    let x0 = ((min_x - HALF + SUBPIXEL_ONE as i64 - 1) >> SUBPIXEL_BITS).max(wx);
+    let x1 = ((max_x - HALF) >> SUBPIXEL_BITS).min(wx + window.width as i64 - 1);
+    let y0 = ((min_y - HALF + SUBPIXEL_ONE as i64 - 1) >> SUBPIXEL_BITS).max(wy);
+    let y1 = ((max_y - HALF) >> SUBPIXEL_BITS).min(wy + window.height as i64 - 1);
     (x0 <= x1 && y0 <= y1).then_some([x0, x1, y0, y1])
 }
 
@@ -188,7 +189,9 @@ fn depth(z: f32) -> u32 {
 ///
 /// `plot` receives the pixel's colour and depth slots and the interpolated fragment; the depth test
 /// and the write are its business, so the same loop serves drawing, coverage queries and tests.
-/// Pixels outside the target are never visited, whatever the coordinates.
+/// Pixels outside the target's window are never visited, whatever the coordinates; those inside
+/// it get exactly the fragments a scan of the whole frame gives them (edge functions are exact
+/// integers, evaluated from the frame's origin).
 ///
 /// ```
 /// use vdlod_raster::edge::{fill_triangle, Facing, ScreenVertex, SUBPIXEL_ONE};
@@ -202,14 +205,14 @@ fn depth(z: f32) -> u32 {
 /// assert_eq!(covered, 28); // centres on the hypotenuse (a right edge) stay out
 /// ```
 #[inline(always)]
-pub fn fill_triangle<P: Pixel, F>(
-    target: &mut Target<'_, P>,
+pub fn fill_triangle<P: Pixel, D: Depth, F>(
+    target: &mut Target<'_, P, D>,
     tri: &[ScreenVertex; 3],
     facing: Facing,
     plot: F,
 ) -> Coverage
 where
-    F: FnMut(&mut P, &mut u32, Fragment<'_>),
+    F: FnMut(&mut P, &mut D, Fragment<'_>),
 {
     let area = signed_area2(tri);
     let v = if area < 0 {
@@ -219,7 +222,7 @@ where
     } else {
         return Coverage::Culled;
     };
-    if let Some(bounds) = pixel_bounds(v.map(|v| [v.x, v.y]), target.width, target.height) {
+    if let Some(bounds) = pixel_bounds(v.map(|v| [v.x, v.y]), &target.window) {
         scan(target, &v, area.abs(), bounds, plot);
     }
     Coverage::Scanned
@@ -229,14 +232,14 @@ where
 /// [`signed_area2`] `area`) and its non-empty [`pixel_bounds`]: for callers that computed those
 /// anyway.
 #[inline(always)]
-pub(crate) fn scan<P: Pixel, F>(
-    target: &mut Target<'_, P>,
+pub(crate) fn scan<P: Pixel, D: Depth, F>(
+    target: &mut Target<'_, P, D>,
     v: &[ScreenVertex; 3],
     area: i64,
     [x0, x1, y0, y1]: [i64; 4],
     mut plot: F,
 ) where
-    F: FnMut(&mut P, &mut u32, Fragment<'_>),
+    F: FnMut(&mut P, &mut D, Fragment<'_>),
 {
     let px = (x0 << SUBPIXEL_BITS) + HALF;
     let py = (y0 << SUBPIXEL_BITS) + HALF;
@@ -247,12 +250,11 @@ pub(crate) fn scan<P: Pixel, F>(
     ];
     let attrs = Attrs::new(v, area);
     let (x0, x1) = (x0 as usize, x1 as usize);
-    let width = target.width;
     let mut row = [e[0].start, e[1].start, e[2].start];
     for y in y0 as usize..=y1 as usize {
-        let base = y * width;
-        let crow = &mut target.color[base + x0..=base + x1];
-        let drow = &mut target.depth[base + x0..=base + x1];
+        let (first, last) = (target.index(x0, y), target.index(x1, y));
+        let crow = &mut target.color[first..=last];
+        let drow = &mut target.depth[first..=last];
         let [mut e0, mut e1, mut e2] = row;
         let mut entered = false;
         for (c, d) in crow.iter_mut().zip(drow.iter_mut()) {

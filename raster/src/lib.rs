@@ -47,6 +47,10 @@ pub mod target;
 pub mod vertex;
 pub mod wire;
 
-pub use draw::{draw_indexed, DrawError, DrawParams, DrawStats, Mesh, Shading, VertexIndex};
-pub use target::{Pixel, Rgb565, Rgba8, Target, TargetError, DEPTH_CLEAR, MAX_DIMENSION};
+pub use draw::{
+    draw_indexed, shade, DrawError, DrawParams, DrawStats, Mesh, ShadedMesh, Shading, VertexIndex,
+};
+pub use target::{
+    Depth, Pixel, Rgb565, Rgb565Be, Rgba8, Target, TargetError, Window, DEPTH_CLEAR, MAX_DIMENSION,
+};
 pub use vertex::{Light, ShadedVertex};

@@ -2,17 +2,17 @@
 //!
 //! Lines are stepped with a fixed-point DDA along their major axis, one pixel per step, and pass the
 //! depth test when they are no farther than [`WIRE_DEPTH_BIAS`] behind what is already drawn, so the
-//! edges of visible faces show and hidden edges do not. Pixels outside the target are skipped.
+//! edges of visible faces show and hidden edges do not. Pixels outside the target's window are
+//! skipped; a line is stepped from its first end whatever the window, so the bands of a frame get
+//! the pixels of the whole frame's lines.
 
 use crate::edge::{ScreenVertex, DEPTH_MAX, SUBPIXEL_BITS};
-use crate::target::{Pixel, Target};
-
-/// How far (in depth units of `0..=DEPTH_MAX`) a line may lie behind the surface and still show.
-pub const WIRE_DEPTH_BIAS: u32 = DEPTH_MAX / 4096;
+pub use crate::target::WIRE_DEPTH_BIAS;
+use crate::target::{Depth, Pixel, Target};
 
 /// Draws the segment `a -> b` in `color` over what the target holds.
-pub fn draw_line<P: Pixel>(
-    target: &mut Target<'_, P>,
+pub fn draw_line<P: Pixel, D: Depth>(
+    target: &mut Target<'_, P, D>,
     a: &ScreenVertex,
     b: &ScreenVertex,
     color: P,
@@ -20,21 +20,28 @@ pub fn draw_line<P: Pixel>(
     const FRAC: u32 = 16;
     let (ax, ay) = (a.x as i64, a.y as i64);
     let (dx, dy) = (b.x as i64 - ax, b.y as i64 - ay);
+    let w = target.window;
+    // Every step lies between the ends, so a line whose rows miss the window has nothing to draw.
+    let (top, bottom) = (ay.min(b.y as i64), ay.max(b.y as i64));
+    if (bottom >> SUBPIXEL_BITS) < w.y as i64 || (top >> SUBPIXEL_BITS) >= (w.y + w.height) as i64 {
+        return;
+    }
     // One step per pixel along the major axis (coordinates are in 1/256 pixels).
     let steps = (dx.abs().max(dy.abs()) >> SUBPIXEL_BITS) + 1;
     let (sx, sy) = ((dx << FRAC) / steps, (dy << FRAC) / steps);
     let z0 = a.z as i64;
     let sz = (b.z as i64 - z0) / steps;
     let (mut x, mut y, mut z) = (ax << FRAC, ay << FRAC, z0);
-    let (w, h) = (target.width as i64, target.height as i64);
+    let (x0, y0) = (w.x as i64, w.y as i64);
+    let (x1, y1) = (x0 + w.width as i64, y0 + w.height as i64);
     for _ in 0..=steps {
         let px = x >> (FRAC + SUBPIXEL_BITS);
         let py = y >> (FRAC + SUBPIXEL_BITS);
-        if px >= 0 && py >= 0 && px < w && py < h {
-            let i = (py * w + px) as usize;
+        if px >= x0 && py >= y0 && px < x1 && py < y1 {
+            let i = target.index(px as usize, py as usize);
             let zi = z.clamp(0, DEPTH_MAX as i64) as u32;
-            if let (Some(d), Some(c)) = (target.depth.get(i), target.color.get_mut(i)) {
-                if zi <= d.saturating_add(WIRE_DEPTH_BIAS) {
+            if let (Some(&d), Some(c)) = (target.depth.get(i), target.color.get_mut(i)) {
+                if D::shows_line(zi, d) {
                     *c = color;
                 }
             }
