@@ -655,6 +655,24 @@ impl<'a> HierarchyView<'a> {
         Ok(())
     }
 
+    /// The box every position of the file lies in, as its minimum and maximum corners.
+    #[must_use]
+    pub fn bounding_box(&self) -> ([f32; 3], [f32; 3]) {
+        let max = core::array::from_fn(|k| self.origin[k] + self.step[k] * POSITION_STEPS);
+        (self.origin, max)
+    }
+
+    /// The centre of [`HierarchyView::bounding_box`] and the radius of the sphere through its
+    /// corners: what a camera needs to frame the whole model.
+    #[must_use]
+    pub fn bounding_sphere(&self) -> ([f32; 3], f32) {
+        let (min, max) = self.bounding_box();
+        let center = core::array::from_fn(|k| 0.5 * (min[k] + max[k]));
+        let d = [0, 1, 2].map(|k| max[k] - min[k]);
+        let radius = 0.5 * libm::sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        (center, radius)
+    }
+
     /// Input vertices: nodes `0..leaves()`.
     #[must_use]
     pub fn leaves(&self) -> u32 {

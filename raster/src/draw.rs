@@ -19,61 +19,12 @@ use crate::edge::{
     fill_triangle, pixel_bounds, scan, signed_area2, signed_area2_xy, Coverage, Facing, Fragment,
     ScreenVertex,
 };
+use crate::mesh::{MeshSource, VertexIndex};
 use crate::target::{check_frame, Depth, Pixel, Target, TargetError};
 use crate::vertex::{
     shade_vertices, to_clip, Light, PreparedLighting, ShadedVertex, VertexLighting, Viewport,
 };
 use crate::wire::draw_line;
-
-/// A vertex index type of [`Mesh::triangles`]: `u32`, or `u16` for meshes of up to 65,535
-/// vertices (as a 16-bit cut hands them out).
-pub trait VertexIndex: Copy + core::fmt::Debug {
-    /// The index as a `u32`.
-    fn to_u32(self) -> u32;
-}
-
-impl VertexIndex for u16 {
-    #[inline(always)]
-    fn to_u32(self) -> u32 {
-        self as u32
-    }
-}
-
-impl VertexIndex for u32 {
-    #[inline(always)]
-    fn to_u32(self) -> u32 {
-        self
-    }
-}
-
-/// Borrowed mesh data: per-vertex arrays of equal length and triangles indexing them (with
-/// `u32` or `u16` indices).
-#[derive(Clone, Copy, Debug)]
-pub struct Mesh<'a, I: VertexIndex = u32> {
-    /// Object-space positions.
-    pub positions: &'a [[f32; 3]],
-    /// Object-space vertex normals (needed by [`Shading::Gouraud`]).
-    pub normals: Option<&'a [[f32; 3]]>,
-    /// Per-vertex colours; [`DrawParams::base_color`] is used without them.
-    pub colors: Option<&'a [[u8; 3]]>,
-    /// Triangles, counter-clockwise when seen from the front.
-    pub triangles: &'a [[I; 3]],
-    /// Per-triangle colours that replace the vertex or base colour (for example a false colour by
-    /// hierarchy depth); lighting still applies.
-    pub face_colors: Option<&'a [[u8; 3]]>,
-}
-
-impl<I: VertexIndex> Default for Mesh<'_, I> {
-    fn default() -> Self {
-        Mesh {
-            positions: &[],
-            normals: None,
-            colors: None,
-            triangles: &[],
-            face_colors: None,
-        }
-    }
-}
 
 /// How colour is spread over a triangle.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -217,43 +168,24 @@ impl fmt::Display for DrawError {
 
 impl core::error::Error for DrawError {}
 
-fn check_len(attribute: &'static str, expected: usize, actual: usize) -> Result<(), DrawError> {
-    if expected == actual {
-        Ok(())
-    } else {
-        Err(DrawError::AttributeLength {
-            attribute,
-            expected,
-            actual,
-        })
-    }
-}
-
-fn validate<I: VertexIndex>(
-    mesh: &Mesh<'_, I>,
-    params: &DrawParams,
-    scratch: usize,
-) -> Result<(), DrawError> {
-    let n = mesh.positions.len();
+fn validate<M: MeshSource>(mesh: &M, params: &DrawParams, scratch: usize) -> Result<(), DrawError> {
+    let n = mesh.vertex_count();
     if scratch < n {
         return Err(DrawError::ScratchTooSmall {
             needed: n,
             available: scratch,
         });
     }
-    if let Some(normals) = mesh.normals {
-        check_len("normals", n, normals.len())?;
-    } else if params.shading == Shading::Gouraud {
+    mesh.check()?;
+    if params.shading == Shading::Gouraud && !mesh.has_normals() {
         return Err(DrawError::MissingNormals);
     }
-    if let Some(colors) = mesh.colors {
-        check_len("colors", n, colors.len())?;
-    }
-    if let Some(faces) = mesh.face_colors {
-        check_len("face_colors", mesh.triangles.len(), faces.len())?;
-    }
-    for (triangle, tri) in mesh.triangles.iter().enumerate() {
-        if let Some(index) = tri.map(I::to_u32).into_iter().find(|&i| i as usize >= n) {
+    for (triangle, tri) in mesh.triangles().iter().enumerate() {
+        if let Some(index) = tri
+            .map(VertexIndex::to_u32)
+            .into_iter()
+            .find(|&i| i as usize >= n)
+        {
             return Err(DrawError::IndexOutOfRange {
                 triangle,
                 index,
@@ -291,9 +223,9 @@ fn rgb_f32(c: [u8; 3]) -> [f32; 3] {
 /// assert_eq!(stats.rasterized, 1);
 /// assert!(target.color().iter().any(|p| p.0[0] > 0));
 /// ```
-pub fn draw_indexed<P: Pixel, D: Depth, I: VertexIndex>(
+pub fn draw_indexed<P: Pixel, D: Depth, M: MeshSource>(
     target: &mut Target<'_, P, D>,
-    mesh: &Mesh<'_, I>,
+    mesh: &M,
     params: &DrawParams,
     scratch: &mut [ShadedVertex],
 ) -> Result<DrawStats, DrawError> {
@@ -303,8 +235,8 @@ pub fn draw_indexed<P: Pixel, D: Depth, I: VertexIndex>(
 /// A mesh after the vertex stage of one frame, ready to be drawn into the whole frame or into any
 /// window of it, as often as needed (once per band), without shading its vertices again.
 #[derive(Clone, Copy, Debug)]
-pub struct ShadedMesh<'a, I: VertexIndex = u32> {
-    mesh: Mesh<'a, I>,
+pub struct ShadedMesh<'a, M: MeshSource> {
+    mesh: &'a M,
     params: &'a DrawParams,
     vertices: &'a [ShadedVertex],
     lighting: Option<PreparedLighting>,
@@ -336,38 +268,35 @@ pub struct ShadedMesh<'a, I: VertexIndex = u32> {
 /// }
 /// assert!(lit > 100);
 /// ```
-pub fn shade<'a, I: VertexIndex>(
-    mesh: &Mesh<'a, I>,
+pub fn shade<'a, M: MeshSource>(
+    mesh: &'a M,
     params: &'a DrawParams,
     width: usize,
     height: usize,
     scratch: &'a mut [ShadedVertex],
-) -> Result<ShadedMesh<'a, I>, DrawError> {
+) -> Result<ShadedMesh<'a, M>, DrawError> {
     check_frame(width, height).map_err(DrawError::Frame)?;
     validate(mesh, params, scratch.len())?;
     let viewport = Viewport::new(width, height);
-    let scratch = &mut scratch[..mesh.positions.len()];
-    let lighting = match (params.shading, mesh.normals) {
-        (Shading::Gouraud, Some(normals)) => Some(VertexLighting {
+    let scratch = &mut scratch[..mesh.vertex_count()];
+    let prepared = (params.shading == Shading::Gouraud && mesh.has_normals()).then(|| {
+        VertexLighting {
             normal_matrix: &params.normal_matrix,
             light: &params.light,
-            normals,
             unit_normals: params.unit_normals,
-        }),
-        _ => None,
-    };
-    let prepared = lighting.map(|l| l.prepare());
+        }
+        .prepare()
+    });
     shade_vertices(
         &params.mvp,
         &viewport,
-        mesh.positions,
-        prepared.as_ref().zip(mesh.normals),
-        mesh.colors,
+        mesh,
+        prepared.as_ref(),
         rgb_f32(params.base_color),
         scratch,
     );
     Ok(ShadedMesh {
-        mesh: *mesh,
+        mesh,
         params,
         vertices: scratch,
         lighting: prepared,
@@ -376,7 +305,7 @@ pub fn shade<'a, I: VertexIndex>(
     })
 }
 
-impl<I: VertexIndex> ShadedMesh<'_, I> {
+impl<M: MeshSource> ShadedMesh<'_, M> {
     /// Draws the triangles into `target`, which must be (a window of) the frame the mesh was
     /// shaded for. The statistics are those of the whole frame, whatever the window.
     pub fn draw<P: Pixel, D: Depth>(
@@ -389,7 +318,7 @@ impl<I: VertexIndex> ShadedMesh<'_, I> {
                 target: (target.width, target.height),
             });
         }
-        let (mesh, params, scratch) = (&self.mesh, self.params, self.vertices);
+        let (mesh, params, scratch) = (self.mesh, self.params, self.vertices);
         let viewport = &self.viewport;
         let prepared = self.lighting.as_ref();
         let facing = if params.cull_back_faces {
@@ -398,7 +327,7 @@ impl<I: VertexIndex> ShadedMesh<'_, I> {
             Facing::Both
         };
         let mut stats = DrawStats {
-            submitted: mesh.triangles.len() as u32,
+            submitted: mesh.triangles().len() as u32,
             ..DrawStats::default()
         };
         let fill =
@@ -409,8 +338,8 @@ impl<I: VertexIndex> ShadedMesh<'_, I> {
                     Coverage::Culled => stats.culled += 1,
                 }
             };
-        for (t, tri) in mesh.triangles.iter().enumerate() {
-            let tri = &tri.map(I::to_u32);
+        for (t, tri) in mesh.triangles().iter().enumerate() {
+            let tri = &tri.map(VertexIndex::to_u32);
             // References, not copies: a culled triangle reads only positions and outcodes.
             let v = tri.map(|i| &scratch[i as usize]);
             let union = v[0].outcode | v[1].outcode | v[2].outcode;
@@ -452,8 +381,8 @@ impl<I: VertexIndex> ShadedMesh<'_, I> {
 
         if let Some(wire) = params.wireframe {
             let color = P::from_rgb(wire[0], wire[1], wire[2]);
-            for tri in mesh.triangles {
-                let tri = &tri.map(I::to_u32);
+            for tri in mesh.triangles() {
+                let tri = &tri.map(VertexIndex::to_u32);
                 let v = tri.map(|i| scratch[i as usize]);
                 let union = v[0].outcode | v[1].outcode | v[2].outcode;
                 if union & clip::INVALID != 0 || v[0].outcode & v[1].outcode & v[2].outcode != 0 {
@@ -493,28 +422,28 @@ fn depth_test<P: Pixel, D: Depth>(c: &mut P, d: &mut D, f: Fragment<'_>) {
 
 /// The colours the three corners of triangle `t` are drawn with.
 #[inline(always)]
-fn triangle_colors<I: VertexIndex>(
-    mesh: &Mesh<'_, I>,
+fn triangle_colors<M: MeshSource>(
+    mesh: &M,
     params: &DrawParams,
     lighting: Option<&PreparedLighting>,
     t: usize,
     tri: &[u32; 3],
     v: &[&ShadedVertex; 3],
 ) -> [[f32; 3]; 3] {
-    let face = mesh.face_colors.map(|f| rgb_f32(f[t]));
+    let face = mesh.face_colors().map(|f| rgb_f32(f[t]));
     match params.shading {
         Shading::Gouraud | Shading::Unlit => match face {
             Some(c) => tri.map(|i| {
-                let light = match (lighting, mesh.normals) {
-                    (Some(l), Some(n)) => l.intensity(Vec3::from(n[i as usize])),
-                    _ => 1.0,
+                let light = match lighting {
+                    Some(l) => l.intensity(Vec3::from(mesh.vertex(i as usize).normal)),
+                    None => 1.0,
                 };
                 c.map(|c| c * light)
             }),
             None => v.map(|v| rgb_f32(v.rgb)),
         },
         Shading::Flat => {
-            let p = tri.map(|i| Vec3::from(mesh.positions[i as usize]));
+            let p = tri.map(|i| Vec3::from(mesh.position(i as usize)));
             let normal = params.normal_matrix * (p[1] - p[0]).cross(p[2] - p[0]);
             let light = params.light.intensity(normal);
             let c = face.unwrap_or_else(|| {
@@ -533,17 +462,17 @@ fn triangle_colors<I: VertexIndex>(
 }
 
 /// Clips a triangle with its corner colours and calls `f` with each projected piece.
-fn for_each_clipped<I: VertexIndex>(
+fn for_each_clipped<M: MeshSource>(
     viewport: &Viewport,
     params: &DrawParams,
-    mesh: &Mesh<'_, I>,
+    mesh: &M,
     tri: &[u32; 3],
     colors: [[f32; 3]; 3],
     planes: u8,
     mut f: impl FnMut(&[ScreenVertex; 3]),
 ) {
     let tri: [ClipVertex; 3] = core::array::from_fn(|k| ClipVertex {
-        pos: to_clip(&params.mvp, Vec3::from(mesh.positions[tri[k] as usize])),
+        pos: to_clip(&params.mvp, Vec3::from(mesh.position(tri[k] as usize))),
         rgb: colors[k],
     });
     let poly = clip_triangle(&tri, planes);

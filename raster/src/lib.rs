@@ -12,9 +12,11 @@
 //! - [`clip`]: homogeneous clipping for the few triangles that cross the near plane or the guard band;
 //! - [`edge`]: fixed-point edge functions with the top-left fill rule, depth and colour stepping;
 //! - [`wire`]: the wireframe overlay;
-//! - [`target`]: caller-owned buffers and pixel formats ([`Rgba8`], [`Rgb565`]).
+//! - [`target`]: caller-owned buffers, whole frames or bands of them, pixel formats ([`Rgba8`],
+//!   [`Rgb565`], [`Rgb565Be`]) and depth types (`u32`, `u16`).
 //!
-//! [`draw_indexed`] composes them for an indexed mesh.
+//! [`shade`] and [`ShadedMesh::draw`] compose them for an indexed mesh ([`Mesh`], or any
+//! [`MeshSource`]); [`draw_indexed`] does both for a whole frame.
 //!
 //! ```
 //! use glam::{Mat4, Vec3};
@@ -43,13 +45,13 @@
 pub mod clip;
 mod draw;
 pub mod edge;
+mod mesh;
 pub mod target;
 pub mod vertex;
 pub mod wire;
 
-pub use draw::{
-    draw_indexed, shade, DrawError, DrawParams, DrawStats, Mesh, ShadedMesh, Shading, VertexIndex,
-};
+pub use draw::{draw_indexed, shade, DrawError, DrawParams, DrawStats, ShadedMesh, Shading};
+pub use mesh::{Mesh, MeshSource, SourceVertex, VertexIndex};
 pub use target::{
     Depth, Pixel, Rgb565, Rgb565Be, Rgba8, Target, TargetError, Window, DEPTH_CLEAR, MAX_DIMENSION,
 };

@@ -9,6 +9,7 @@ use glam::{Mat3, Mat4, Vec3, Vec4};
 
 use crate::clip::{self, GUARD_BAND};
 use crate::edge::{ScreenVertex, DEPTH_MAX, SUBPIXEL_ONE};
+use crate::mesh::MeshSource;
 
 /// One directional light plus an ambient term.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -173,8 +174,6 @@ pub struct VertexLighting<'a> {
     pub normal_matrix: &'a Mat3,
     /// The light.
     pub light: &'a Light,
-    /// One normal per vertex.
-    pub normals: &'a [[f32; 3]],
     /// The normals are of unit length after the normal matrix: skip renormalizing them.
     pub unit_normals: bool,
 }
@@ -231,51 +230,32 @@ const LANES: usize = 8;
 /// the compiler can use SIMD registers. Each lane runs the same per-vertex routines the clipping
 /// path uses ([`to_clip`]'s order of operations, [`Viewport::project`], [`clip::outcode`],
 /// [`PreparedLighting::intensity`]), so both agree to the bit, on every target (a SIMD lane rounds
-/// as a scalar operation does). `lighting` gives the normal matrix, the light and the
-/// vertex normals for lit shading; `colors` the vertex colours, else `base` is used.
+/// as a scalar operation does). `lighting`, when given, lights the vertices by their normals;
+/// vertices take the mesh's colours, or `base` when it has none.
 ///
-/// `out` must be exactly as long as `positions`, as must `normals` and `colors` when given
-/// ([`crate::draw_indexed`] checks this).
-pub fn shade_vertices(
+/// `out` must hold exactly the mesh's vertices ([`crate::shade`] checks this).
+pub fn shade_vertices<M: MeshSource>(
     mvp: &Mat4,
     viewport: &Viewport,
-    positions: &[[f32; 3]],
-    lighting: Option<(&PreparedLighting, &[[f32; 3]])>,
-    colors: Option<&[[u8; 3]]>,
+    mesh: &M,
+    lighting: Option<&PreparedLighting>,
     base: [f32; 3],
     out: &mut [ShadedVertex],
 ) {
     let m = mvp.to_cols_array_2d();
+    let colors = mesh.has_colors();
     for (first, out) in (0..).step_by(LANES).zip(out.chunks_mut(LANES)) {
         let len = out.len();
         // Gather the batch; lanes past the end of the mesh hold zeros and are not stored.
         let mut p = [[0.0f32; LANES]; 3];
         let mut n = [[0.0f32; LANES]; 3];
         let mut rgb = [[0.0f32; LANES]; 3];
-        for (k, q) in positions[first..first + len].iter().enumerate() {
+        for k in 0..len {
+            let v = mesh.vertex(first + k);
             for a in 0..3 {
-                p[a][k] = q[a];
-            }
-        }
-        match colors {
-            Some(colors) => {
-                for (k, c) in colors[first..first + len].iter().enumerate() {
-                    for a in 0..3 {
-                        rgb[a][k] = c[a] as f32;
-                    }
-                }
-            }
-            None => {
-                for a in 0..3 {
-                    rgb[a] = [base[a]; LANES];
-                }
-            }
-        }
-        if let Some((_, normals)) = lighting {
-            for (k, q) in normals[first..first + len].iter().enumerate() {
-                for a in 0..3 {
-                    n[a][k] = q[a];
-                }
+                p[a][k] = v.position[a];
+                n[a][k] = v.normal[a];
+                rgb[a][k] = if colors { v.color[a] as f32 } else { base[a] };
             }
         }
 
@@ -287,7 +267,7 @@ pub fn shade_vertices(
             }
         }
         let mut light = [1.0f32; LANES];
-        if let Some((p, _)) = lighting {
+        if let Some(p) = lighting {
             for (k, l) in light.iter_mut().enumerate() {
                 *l = p.intensity(Vec3::new(n[0][k], n[1][k], n[2][k]));
             }
@@ -359,15 +339,11 @@ mod tests {
     fn shade(positions: &[[f32; 3]], mvp: &Mat4, vp: &Viewport) -> [ShadedVertex; 19] {
         let mut out = [ShadedVertex::default(); 19];
         let n = positions.len();
-        shade_vertices(
-            mvp,
-            vp,
+        let mesh: crate::Mesh<'_> = crate::Mesh {
             positions,
-            None,
-            None,
-            [10.0, 20.0, 30.0],
-            &mut out[..n],
-        );
+            ..crate::Mesh::default()
+        };
+        shade_vertices(mvp, vp, &mesh, None, [10.0, 20.0, 30.0], &mut out[..n]);
         out
     }
 

@@ -1,0 +1,167 @@
+//! Where the rasterizer reads a mesh: borrowed arrays ([`Mesh`]), or anything that can hand out
+//! its vertices one by one ([`MeshSource`]).
+//!
+//! A device that keeps its geometry compressed in flash (vdlod's cut reads quantized positions,
+//! octahedral normals and colours from the hierarchy file in place) should not have to unpack every
+//! vertex into RAM before a draw: the vertex stage asks the source for each vertex once, and the
+//! rare clipped or flat-shaded triangle asks for its corners' positions again.
+
+use crate::draw::DrawError;
+
+/// A vertex index type of a mesh's triangles: `u32`, or `u16` for meshes of up to 65,535
+/// vertices (as a 16-bit cut hands them out).
+pub trait VertexIndex: Copy + core::fmt::Debug {
+    /// The index as a `u32`.
+    fn to_u32(self) -> u32;
+}
+
+impl VertexIndex for u16 {
+    #[inline(always)]
+    fn to_u32(self) -> u32 {
+        self as u32
+    }
+}
+
+impl VertexIndex for u32 {
+    #[inline(always)]
+    fn to_u32(self) -> u32 {
+        self
+    }
+}
+
+/// One vertex as a [`MeshSource`] hands it out; attributes the source does not have are zero.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SourceVertex {
+    /// Object-space position.
+    pub position: [f32; 3],
+    /// Object-space normal.
+    pub normal: [f32; 3],
+    /// Colour.
+    pub color: [u8; 3],
+}
+
+/// A triangle mesh the rasterizer can draw: triangles over vertices it reads by index.
+///
+/// Implementations must be consistent: the same index gives the same vertex for the whole draw.
+pub trait MeshSource {
+    /// The type of [`MeshSource::triangles`]' indices.
+    type Index: VertexIndex;
+    /// Vertices; indices run from 0 to this, exclusive.
+    fn vertex_count(&self) -> usize;
+    /// Triangles, counter-clockwise when seen from the front.
+    fn triangles(&self) -> &[[Self::Index; 3]];
+    /// Vertex `i` (below [`MeshSource::vertex_count`]).
+    fn vertex(&self, i: usize) -> SourceVertex;
+    /// The position of vertex `i`; override when it is cheaper than the whole vertex.
+    #[inline(always)]
+    fn position(&self, i: usize) -> [f32; 3] {
+        self.vertex(i).position
+    }
+    /// Whether [`SourceVertex::normal`] is meaningful (Gouraud shading needs it).
+    fn has_normals(&self) -> bool;
+    /// Whether [`SourceVertex::color`] is meaningful (else the draw's base colour is used).
+    fn has_colors(&self) -> bool;
+    /// Per-triangle colours that replace the vertex or base colour; lighting still applies.
+    fn face_colors(&self) -> Option<&[[u8; 3]]> {
+        None
+    }
+    /// Checks what the source itself can get wrong (attribute arrays of the wrong length).
+    fn check(&self) -> Result<(), DrawError> {
+        Ok(())
+    }
+}
+
+/// Borrowed mesh data: per-vertex arrays of equal length and triangles indexing them (with
+/// `u32` or `u16` indices).
+#[derive(Clone, Copy, Debug)]
+pub struct Mesh<'a, I: VertexIndex = u32> {
+    /// Object-space positions.
+    pub positions: &'a [[f32; 3]],
+    /// Object-space vertex normals (needed by [`crate::Shading::Gouraud`]).
+    pub normals: Option<&'a [[f32; 3]]>,
+    /// Per-vertex colours; [`crate::DrawParams::base_color`] is used without them.
+    pub colors: Option<&'a [[u8; 3]]>,
+    /// Triangles, counter-clockwise when seen from the front.
+    pub triangles: &'a [[I; 3]],
+    /// Per-triangle colours that replace the vertex or base colour (for example a false colour by
+    /// hierarchy depth); lighting still applies.
+    pub face_colors: Option<&'a [[u8; 3]]>,
+}
+
+impl<I: VertexIndex> Default for Mesh<'_, I> {
+    fn default() -> Self {
+        Mesh {
+            positions: &[],
+            normals: None,
+            colors: None,
+            triangles: &[],
+            face_colors: None,
+        }
+    }
+}
+
+fn check_len(attribute: &'static str, expected: usize, actual: usize) -> Result<(), DrawError> {
+    if expected == actual {
+        Ok(())
+    } else {
+        Err(DrawError::AttributeLength {
+            attribute,
+            expected,
+            actual,
+        })
+    }
+}
+
+impl<I: VertexIndex> MeshSource for Mesh<'_, I> {
+    type Index = I;
+
+    #[inline(always)]
+    fn vertex_count(&self) -> usize {
+        self.positions.len()
+    }
+
+    #[inline(always)]
+    fn triangles(&self) -> &[[I; 3]] {
+        self.triangles
+    }
+
+    #[inline(always)]
+    fn vertex(&self, i: usize) -> SourceVertex {
+        SourceVertex {
+            position: self.positions[i],
+            normal: self.normals.map_or([0.0; 3], |n| n[i]),
+            color: self.colors.map_or([0; 3], |c| c[i]),
+        }
+    }
+
+    #[inline(always)]
+    fn position(&self, i: usize) -> [f32; 3] {
+        self.positions[i]
+    }
+
+    fn has_normals(&self) -> bool {
+        self.normals.is_some()
+    }
+
+    fn has_colors(&self) -> bool {
+        self.colors.is_some()
+    }
+
+    fn face_colors(&self) -> Option<&[[u8; 3]]> {
+        self.face_colors
+    }
+
+    fn check(&self) -> Result<(), DrawError> {
+        let n = self.positions.len();
+        if let Some(normals) = self.normals {
+            check_len("normals", n, normals.len())?;
+        }
+        if let Some(colors) = self.colors {
+            check_len("colors", n, colors.len())?;
+        }
+        if let Some(faces) = self.face_colors {
+            check_len("face_colors", self.triangles.len(), faces.len())?;
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,279 @@
+//! The frame loop, written once: adapt a cut to a [`Camera`], then draw it into a whole frame or
+//! band by band, with drawing parameters that come from the same camera.
+//!
+//! [`CutMesh`] is the cut as the rasterizer reads it: its triangles as they are, its vertices
+//! read one at a time from the hierarchy in place (or from a running geomorph), so a device needs
+//! no per-vertex copy of positions, normals or colours, only the rasterizer's 16-byte scratch.
+
+use core::fmt;
+
+use glam::Vec3;
+use vdlod_core::adapt::{Budget, FrameStats};
+use vdlod_core::cut::{Cut, SlotIndex};
+use vdlod_core::format::HierarchyView;
+use vdlod_core::policy::Policy;
+use vdlod_raster::{
+    shade, Depth, DrawError, DrawParams, DrawStats, Light, MeshSource, Pixel, ShadedVertex,
+    Shading, SourceVertex, Target, TargetError, VertexIndex, Window,
+};
+
+use crate::camera::{Camera, CameraError};
+
+/// A cut as a mesh the rasterizer draws as is.
+#[derive(Clone, Copy, Debug)]
+pub struct CutMesh<'a, 'h, const V: usize, const F: usize, const Q: usize, I: SlotIndex> {
+    cut: &'a Cut<V, F, Q, I>,
+    h: &'a HierarchyView<'h>,
+    colors: bool,
+}
+
+impl<'a, 'h, const V: usize, const F: usize, const Q: usize, I: SlotIndex>
+    CutMesh<'a, 'h, V, F, Q, I>
+{
+    /// The cut `cut` of hierarchy `h`; with `colors`, vertices are drawn in the cut's colours
+    /// (the file's, or a false colour, see [`vdlod_core::cut::Coloring`]), else in the draw's base
+    /// colour.
+    pub fn new(cut: &'a Cut<V, F, Q, I>, h: &'a HierarchyView<'h>, colors: bool) -> Self {
+        CutMesh { cut, h, colors }
+    }
+}
+
+impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex + VertexIndex> MeshSource
+    for CutMesh<'_, '_, V, F, Q, I>
+{
+    type Index = I;
+
+    fn vertex_count(&self) -> usize {
+        self.cut.vertex_count()
+    }
+
+    fn triangles(&self) -> &[[I; 3]] {
+        self.cut.triangles()
+    }
+
+    #[inline]
+    fn vertex(&self, i: usize) -> SourceVertex {
+        let v = self.cut.vertex(self.h, i);
+        SourceVertex {
+            position: v.position,
+            normal: v.normal,
+            color: v.color,
+        }
+    }
+
+    fn has_normals(&self) -> bool {
+        true
+    }
+
+    fn has_colors(&self) -> bool {
+        self.colors
+    }
+}
+
+/// How a cut is drawn: everything but the camera and the target.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Style {
+    /// Shading mode.
+    pub shading: Shading,
+    /// Colour of the surface when vertex colours are off.
+    pub base_color: [u8; 3],
+    /// Draw in the cut's vertex colours (see [`CutMesh::new`]).
+    pub vertex_colors: bool,
+    /// Draw triangle edges in this colour over the filled frame.
+    pub wireframe: Option<[u8; 3]>,
+    /// Skip triangles facing away from the camera.
+    pub cull_back_faces: bool,
+    /// Light intensity everywhere; the key light comes from over the viewer's shoulder.
+    pub ambient: f32,
+}
+
+impl Default for Style {
+    fn default() -> Self {
+        Style {
+            shading: Shading::Gouraud,
+            base_color: [214, 200, 176],
+            vertex_colors: false,
+            wireframe: None,
+            cull_back_faces: true,
+            ambient: Light::default().ambient,
+        }
+    }
+}
+
+impl Style {
+    /// The rasterizer's parameters for `camera`: its view-projection, and a light from over the
+    /// viewer's shoulder.
+    pub fn params(&self, camera: &Camera) -> DrawParams {
+        let to_eye = (camera.eye - camera.target).normalize_or_zero();
+        DrawParams {
+            mvp: camera.view_projection(),
+            light: Light {
+                direction: to_eye + Vec3::Y * 0.6,
+                ambient: self.ambient,
+                diffuse: 1.0 - self.ambient,
+            },
+            shading: self.shading,
+            // The cut's normals are of unit length and the model matrix is the identity.
+            unit_normals: true,
+            base_color: self.base_color,
+            cull_back_faces: self.cull_back_faces,
+            wireframe: self.wireframe,
+            ..DrawParams::default()
+        }
+    }
+}
+
+/// Why a frame was not adapted or drawn.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum FrameError {
+    /// The camera cannot be used.
+    Camera(CameraError),
+    /// The band buffers cannot hold a band.
+    Target(TargetError),
+    /// The rasterizer refused the mesh or the target.
+    Draw(DrawError),
+}
+
+impl fmt::Display for FrameError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            FrameError::Camera(e) => e.fmt(f),
+            FrameError::Target(e) => e.fmt(f),
+            FrameError::Draw(e) => e.fmt(f),
+        }
+    }
+}
+
+impl core::error::Error for FrameError {}
+
+impl From<CameraError> for FrameError {
+    fn from(e: CameraError) -> Self {
+        FrameError::Camera(e)
+    }
+}
+
+impl From<TargetError> for FrameError {
+    fn from(e: TargetError) -> Self {
+        FrameError::Target(e)
+    }
+}
+
+impl From<DrawError> for FrameError {
+    fn from(e: DrawError) -> Self {
+        FrameError::Draw(e)
+    }
+}
+
+/// Adapts `cut` to `camera` (see [`Cut::adapt`]); a camera that cannot be used changes nothing.
+pub fn adapt<const V: usize, const F: usize, const Q: usize, I: SlotIndex, P: Policy>(
+    cut: &mut Cut<V, F, Q, I>,
+    h: &HierarchyView<'_>,
+    camera: &Camera,
+    policy: &P,
+    budget: &Budget,
+) -> Result<FrameStats, FrameError> {
+    camera.check()?;
+    Ok(cut.adapt(h, &camera.view(), policy, budget))
+}
+
+/// Draws `cut` as `camera` sees it into `target`, a whole frame of the camera's size (or a window
+/// of one). `scratch` needs one entry per vertex slot of the cut that is in use.
+#[allow(clippy::too_many_arguments)]
+pub fn draw<P: Pixel, D: Depth, const V: usize, const F: usize, const Q: usize, I>(
+    target: &mut Target<'_, P, D>,
+    cut: &Cut<V, F, Q, I>,
+    h: &HierarchyView<'_>,
+    camera: &Camera,
+    style: &Style,
+    scratch: &mut [ShadedVertex],
+) -> Result<DrawStats, FrameError>
+where
+    I: SlotIndex + VertexIndex,
+{
+    camera.check()?;
+    let mesh = CutMesh::new(cut, h, style.vertex_colors);
+    let params = style.params(camera);
+    let shaded = shade(&mesh, &params, camera.width, camera.height, scratch)?;
+    Ok(shaded.draw(target)?)
+}
+
+/// Band buffers: one colour and one depth buffer of `rows` full-width rows, reused for every
+/// band of a frame.
+pub struct Bands<'b, P: Pixel, D: Depth> {
+    /// Colour, at least `width * rows` pixels.
+    pub color: &'b mut [P],
+    /// Depth, at least `width * rows` values.
+    pub depth: &'b mut [D],
+    /// Rows per band (the last band of a frame may be shorter).
+    pub rows: usize,
+    /// What each band is cleared to before it is drawn.
+    pub background: P,
+}
+
+/// Draws `cut` as `camera` sees it, band by band through `bands`, calling `flush` with each
+/// drawn band (top to bottom) so it can be sent to a display. The vertices are shaded once; the
+/// bands together are bit-identical to [`draw`] into a whole frame. Returns the frame's
+/// statistics.
+///
+/// ```
+/// use vdlod::prelude::*;
+/// # fn main() -> Result<(), Box<dyn std::error::Error>> {
+/// # use vdlod::core::build::{build, InputMesh};
+/// # let positions = [[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]];
+/// # let triangles = [[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]];
+/// # let input = InputMesh { positions: &positions, colors: None, triangles: &triangles };
+/// # let bytes = build(&input, &Default::default(), &mut |_| {})?.to_bytes(false);
+/// // `bytes`: a hierarchy file, in flash on a device (`include_bytes!`).
+/// let h = HierarchyView::parse(&bytes)?;
+/// let mut cut = Cut::<64, 128, 8>::boxed();
+/// cut.reset(&h)?;
+/// let (center, radius) = h.bounding_sphere();
+/// let camera = Orbit::peer(center.into(), radius, 36).viewport(64, 48).camera(0);
+/// vdlod::adapt(&mut cut, &h, &camera, &QRefine::new(1.0), &Budget::default())?;
+/// let (mut color, mut depth) = ([Rgb565(0); 64 * 16], [0u16; 64 * 16]);
+/// let bands = Bands { color: &mut color, depth: &mut depth, rows: 16, background: Rgb565(0) };
+/// let mut scratch = [ShadedVertex::default(); 64];
+/// let mut lit = 0;
+/// vdlod::draw_bands(bands, &cut, &h, &camera, &Style::default(), &mut scratch, |band| {
+///     lit += band.color().iter().filter(|p| p.0 != 0).count(); // send the band to the panel
+/// })?;
+/// assert!(lit > 0);
+/// # Ok(())
+/// # }
+/// ```
+#[allow(clippy::too_many_arguments)]
+pub fn draw_bands<P: Pixel, D: Depth, const V: usize, const F: usize, const Q: usize, I>(
+    bands: Bands<'_, P, D>,
+    cut: &Cut<V, F, Q, I>,
+    h: &HierarchyView<'_>,
+    camera: &Camera,
+    style: &Style,
+    scratch: &mut [ShadedVertex],
+    mut flush: impl FnMut(&Target<'_, P, D>),
+) -> Result<DrawStats, FrameError>
+where
+    I: SlotIndex + VertexIndex,
+{
+    camera.check()?;
+    let (width, height) = (camera.width, camera.height);
+    let mesh = CutMesh::new(cut, h, style.vertex_colors);
+    let params = style.params(camera);
+    let shaded = shade(&mesh, &params, width, height, scratch)?;
+    let Bands {
+        color,
+        depth,
+        rows,
+        background,
+    } = bands;
+    if rows == 0 {
+        return Err(TargetError::ZeroSize.into());
+    }
+    let mut stats = DrawStats::default();
+    for band in Window::bands(width, height, rows) {
+        let mut target = Target::window(color, depth, width, height, band, width)?;
+        target.clear(background);
+        stats = shaded.draw(&mut target)?;
+        flush(&target);
+    }
+    Ok(stats)
+}
