@@ -30,12 +30,12 @@ use vdlod_core::adapt::Budget;
 use vdlod_core::cut::Cut;
 use vdlod_core::format::HierarchyView;
 use vdlod_core::policy::{MergeTree, QRefine, ScreenError};
-use vdlod_demo::camera::Orbit;
+use vdlod_demo::camera::{merge_tree_orbit, peer_orbit};
 use vdlod_demo::frame::Frame;
 use vdlod_demo::hierarchy::build_with_progress;
-use vdlod_demo::lod::{policy_view, psnr, CutVertices};
+use vdlod_demo::lod::psnr;
 use vdlod_demo::mesh::{load_obj_bytes, IndexedMesh, BUNNY_NAME, BUNNY_OBJ};
-use vdlod_demo::render::camera_params;
+use vdlod_demo::render::{camera_params, style};
 use vdlod_raster::Shading;
 
 /// The cut of the adaptation benchmark: room for the bunny at 0.25 px with margin.
@@ -73,13 +73,13 @@ fn adapt_orbit(
     tolerance: f32,
     revolutions: u32,
 ) -> Adapt {
-    let orbit = Orbit::peer(&mesh.bounds(), FRAMES);
+    let orbit = peer_orbit(&mesh.bounds(), FRAMES, W, H);
     let mut cut = BunnyCut::boxed();
     cut.reset(h).expect("base mesh fits");
     let policy = QRefine::new(tolerance);
     let mut out = Adapt::default();
     for i in 0..FRAMES * revolutions {
-        let view = policy_view(&orbit.camera(i), W as f32 / H as f32, H, 1.0);
+        let view = orbit.camera(i).view();
         let start = Instant::now();
         let s = cut.adapt(h, &view, &policy, &Budget::default());
         let us = start.elapsed().as_secs_f64() * 1e6;
@@ -208,24 +208,22 @@ fn full_vs_adapted(mesh: &IndexedMesh) {
     println!("| frustum | mean tris | adapt + render ms (median) | full detail ms (median) | speed-up | merge-tree paper |");
     println!("|---|---|---|---|---|---|");
     for (frustum, paper) in [(0.4f32, "5x"), (0.2, "10x"), (0.1, "12.5x")] {
-        let orbit = Orbit::merge_tree(&big.bounds(), 100);
+        let orbit = merge_tree_orbit(&big.bounds(), 100, W, H);
         let mut cut = BigCut::boxed();
         cut.reset(&h).expect("fits");
         let mut frame = Frame::new(W, H).expect("frame");
-        let mut vertices = CutVertices::default();
         let (mut ours, mut full, mut tris) = (Vec::new(), Vec::new(), Vec::new());
         let policy = MergeTree {
             near: f32::INFINITY,
         };
         for i in 0..100 {
             let camera = orbit.camera(i);
-            let view = policy_view(&camera, frame.aspect(), H, frustum);
-            let params = camera_params(&camera, frame.aspect(), Shading::Gouraud, false);
+            let view = camera.view_scaled(frustum);
+            let params = camera_params(&camera, Shading::Gouraud, false);
             let start = Instant::now();
             let s = cut.adapt(&h, &view, &policy, &Budget::default());
-            vertices.gather(&cut, &h);
             frame
-                .draw(&vertices.mesh(&cut, false), &params)
+                .draw_cut(&cut, &h, &camera, &style(Shading::Gouraud, false))
                 .expect("draws");
             let t_ours = start.elapsed().as_secs_f64() * 1e3;
             let start = Instant::now();
@@ -262,7 +260,7 @@ fn quality(h: &HierarchyView<'_>, mesh: &IndexedMesh) {
         (1.0, 3.0),
         (2.0, 6.0),
     ] {
-        let orbit = Orbit::peer(&mesh.bounds(), FRAMES);
+        let orbit = peer_orbit(&mesh.bounds(), FRAMES, W, H);
         let mut cut = BunnyCut::boxed();
         cut.reset(h).expect("fits");
         let policy = QRefine {
@@ -272,23 +270,21 @@ fn quality(h: &HierarchyView<'_>, mesh: &IndexedMesh) {
             },
         };
         let mut frame = Frame::new(W, H).expect("frame");
-        let mut vertices = CutVertices::default();
         let mut reference = Frame::new(W, H).expect("frame");
         let (mut ours, mut theirs, mut tris) = (Vec::new(), Vec::new(), Vec::new());
         for i in 0..FRAMES {
             let camera = orbit.camera(i);
-            let view = policy_view(&camera, frame.aspect(), H, 1.0);
+            let view = camera.view();
             let s = cut.adapt(h, &view, &policy, &Budget::default());
             if i % 10 != 5 {
                 continue;
             }
-            let params = camera_params(&camera, frame.aspect(), Shading::Gouraud, false);
+            let params = camera_params(&camera, Shading::Gouraud, false);
             reference
                 .draw(&mesh.as_raster_mesh(), &params)
                 .expect("draws");
-            vertices.gather(&cut, h);
             frame
-                .draw(&vertices.mesh(&cut, false), &params)
+                .draw_cut(&cut, h, &camera, &style(Shading::Gouraud, false))
                 .expect("draws");
             ours.push(psnr(frame.pixels(), reference.pixels()));
             let simplified = meshopt::simplify(
@@ -324,18 +320,16 @@ fn quality(h: &HierarchyView<'_>, mesh: &IndexedMesh) {
     let mut cut = BigCut::boxed();
     cut.reset(h).expect("fits");
     while cut.refine_everything(h) > 0 {}
-    let orbit = Orbit::peer(&mesh.bounds(), FRAMES);
+    let orbit = peer_orbit(&mesh.bounds(), FRAMES, W, H);
     let camera = orbit.camera(5);
     let mut frame = Frame::new(W, H).expect("frame");
     let mut reference = Frame::new(W, H).expect("frame");
-    let params = camera_params(&camera, frame.aspect(), Shading::Gouraud, false);
+    let params = camera_params(&camera, Shading::Gouraud, false);
     reference
         .draw(&mesh.as_raster_mesh(), &params)
         .expect("draws");
-    let mut vertices = CutVertices::default();
-    vertices.gather(&cut, h);
     frame
-        .draw(&vertices.mesh(&cut, false), &params)
+        .draw_cut(&cut, h, &camera, &style(Shading::Gouraud, false))
         .expect("draws");
     println!(
         "\nCeiling: the fully refined cut ({} tris, normals as the file stores them) scores {:.2} dB.",

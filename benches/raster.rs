@@ -21,7 +21,7 @@ use std::time::Instant;
 
 use criterion::{criterion_group, Criterion, Throughput};
 use euc::{buffer::Buffer2d, rasterizer, Pipeline};
-use vdlod_demo::camera::Orbit;
+use vdlod_demo::camera::peer_orbit;
 use vdlod_demo::frame::Frame;
 use vdlod_demo::mesh::{load_obj_bytes, IndexedMesh, BUNNY_NAME, BUNNY_OBJ};
 use vdlod_demo::render::camera_params;
@@ -75,8 +75,8 @@ struct Scene<'a> {
 
 impl<'a> Scene<'a> {
     fn new(name: &str, mesh: &'a IndexedMesh, w: usize, h: usize) -> Scene<'a> {
-        let camera = Orbit::peer(&mesh.bounds(), 12).camera(1); // azimuth 30 degrees
-        let params = camera_params(&camera, w as f32 / h as f32, Shading::Gouraud, false);
+        let camera = peer_orbit(&mesh.bounds(), 12, w, h).camera(1); // azimuth 30 degrees
+        let params = camera_params(&camera, Shading::Gouraud, false);
         Scene {
             name: format!("{name}_{w}x{h}"),
             triangles: mesh.triangles.len(),

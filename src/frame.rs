@@ -83,8 +83,10 @@ pub struct Style {
     pub wireframe: Option<[u8; 3]>,
     /// Skip triangles facing away from the camera.
     pub cull_back_faces: bool,
-    /// Light intensity everywhere; the key light comes from over the viewer's shoulder.
+    /// Light intensity everywhere.
     pub ambient: f32,
+    /// Intensity of the key light, which comes from over the viewer's shoulder.
+    pub diffuse: f32,
 }
 
 impl Default for Style {
@@ -96,6 +98,7 @@ impl Default for Style {
             wireframe: None,
             cull_back_faces: true,
             ambient: Light::default().ambient,
+            diffuse: Light::default().diffuse,
         }
     }
 }
@@ -110,7 +113,7 @@ impl Style {
             light: Light {
                 direction: to_eye + Vec3::Y * 0.6,
                 ambient: self.ambient,
-                diffuse: 1.0 - self.ambient,
+                diffuse: self.diffuse,
             },
             shading: self.shading,
             // The cut's normals are of unit length and the model matrix is the identity.

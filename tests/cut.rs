@@ -249,19 +249,18 @@ fn a_small_cut_reports_capacity_instead_of_failing() {
 #[test]
 fn one_call_converges_over_the_peer_orbit() {
     use vdlod_core::policy::QRefine;
-    use vdlod_demo::camera::Orbit;
-    use vdlod_demo::lod::policy_view;
+    use vdlod_demo::camera::peer_orbit;
     let mesh = fixture("bunny.obj");
     let bytes = hierarchy_bytes(&mesh);
     let h = HierarchyView::parse(&bytes).unwrap();
-    let orbit = Orbit::peer(&mesh.bounds(), 200);
+    let orbit = peer_orbit(&mesh.bounds(), 200, 640, 480);
     for tau in [0.25f32, 0.5, 1.0, 2.0, 4.0] {
         let mut cut = Cut::<16384, 32768, 2048>::boxed();
         cut.reset(&h).unwrap();
         let policy = QRefine::new(tau);
         let mut again = 0;
         for i in 0..40 {
-            let view = policy_view(&orbit.camera(i * 5), 640.0 / 480.0, 480, 1.0);
+            let view = orbit.camera(i * 5).view();
             let first = cut.adapt(&h, &view, &policy, &Budget::default());
             assert!(
                 !first.queue_overflow && !first.capacity_limited,
@@ -280,8 +279,7 @@ fn one_call_converges_over_the_peer_orbit() {
 #[test]
 fn the_cut_does_not_depend_on_the_model_scale() {
     use vdlod_core::policy::QRefine;
-    use vdlod_demo::camera::Orbit;
-    use vdlod_demo::lod::policy_view;
+    use vdlod_demo::camera::peer_orbit;
     let cow = fixture("cow.obj");
     let mut counts = Vec::new();
     for scale in [1e-5f32, 1.0, 1e3, 2e5] {
@@ -291,12 +289,12 @@ fn the_cut_does_not_depend_on_the_model_scale() {
         }
         let bytes = hierarchy_bytes(&mesh);
         let h = HierarchyView::parse(&bytes).unwrap();
-        let orbit = Orbit::peer(&mesh.bounds(), 200);
+        let orbit = peer_orbit(&mesh.bounds(), 200, 640, 480);
         let mut cut = Cut::<8192, 16384, 1024>::boxed();
         cut.reset(&h).unwrap();
         let mut total = 0u64;
         for i in 0..10 {
-            let view = policy_view(&orbit.camera(i * 20), 640.0 / 480.0, 480, 1.0);
+            let view = orbit.camera(i * 20).view();
             total += cut
                 .adapt(&h, &view, &QRefine::new(1.0), &Budget::default())
                 .triangles as u64;
@@ -320,10 +318,9 @@ fn the_cut_does_not_depend_on_the_model_scale() {
 #[test]
 fn adapt_and_draw_fit_a_small_stack() {
     use vdlod_core::policy::QRefine;
-    use vdlod_demo::camera::Orbit;
+    use vdlod_demo::camera::peer_orbit;
     use vdlod_demo::frame::Frame;
-    use vdlod_demo::lod::{policy_view, CutVertices};
-    use vdlod_demo::render::camera_params;
+    use vdlod_demo::render::style;
     use vdlod_raster::Shading;
     const STACK: usize = 16 * 1024;
     let mesh = fixture("bunny.obj");
@@ -331,14 +328,13 @@ fn adapt_and_draw_fit_a_small_stack() {
     let bounds = mesh.bounds();
     let mut cut = Cut::<2600, 5000, 325>::boxed();
     let mut frame = Frame::new(320, 240).unwrap();
-    let mut vertices = CutVertices::default();
     let worker = std::thread::Builder::new()
         .stack_size(STACK)
         .spawn(move || {
             let h = HierarchyView::parse(&bytes).unwrap();
             cut.reset(&h).unwrap();
             cut.set_geomorph_frames(4);
-            let orbit = Orbit::peer(&bounds, 100);
+            let orbit = peer_orbit(&bounds, 100, 320, 240);
             let budget = Budget {
                 max_triangles: 5000,
                 ..Budget::default()
@@ -346,13 +342,11 @@ fn adapt_and_draw_fit_a_small_stack() {
             let mut drawn = 0;
             for i in 0..150 {
                 let camera = orbit.camera(i);
-                let view = policy_view(&camera, frame.aspect(), 240, 1.0);
                 let tolerance = [0.25, 1.0, 4.0][(i / 50) as usize];
-                cut.adapt(&h, &view, &QRefine::new(tolerance), &budget);
-                vertices.gather(&*cut, &h);
-                let params = camera_params(&camera, frame.aspect(), Shading::Gouraud, false);
+                vdlod::adapt(&mut cut, &h, &camera, &QRefine::new(tolerance), &budget).unwrap();
+                let style = style(Shading::Gouraud, false);
                 drawn += frame
-                    .draw(&vertices.mesh(&*cut, false), &params)
+                    .draw_cut(&*cut, &h, &camera, &style)
                     .unwrap()
                     .rasterized;
             }
@@ -369,20 +363,18 @@ fn adapt_and_draw_fit_a_small_stack() {
 #[test]
 fn open_borders_honour_the_tolerance() {
     use vdlod_core::policy::{Frustum, ScreenError};
-    use vdlod_demo::camera::Orbit;
+    use vdlod_demo::camera::peer_orbit;
     use vdlod_demo::frame::{Frame, BACKGROUND};
-    use vdlod_demo::lod::{policy_view, CutVertices};
-    use vdlod_demo::render::camera_params;
+    use vdlod_demo::render::style;
     use vdlod_raster::Shading;
     let (w, h_px) = (240usize, 180usize);
     let mesh = fixture("head.obj");
     let bytes = hierarchy_bytes(&mesh);
     let h = HierarchyView::parse(&bytes).unwrap();
-    let orbit = Orbit::peer(&mesh.bounds(), 8);
+    let orbit = peer_orbit(&mesh.bounds(), 8, w, h_px);
     let mut cut = Cut::<4096, 8192, 512>::boxed();
     cut.reset(&h).unwrap();
     let (mut adapted, mut full) = (Frame::new(w, h_px).unwrap(), Frame::new(w, h_px).unwrap());
-    let mut vertices = CutVertices::default();
     let mask = |f: &Frame| -> Vec<bool> { f.pixels().iter().map(|p| *p != BACKGROUND).collect() };
     // The largest distance from a pixel covered in one mask to the nearest of the other.
     let stray = |a: &[bool], b: &[bool]| -> f64 {
@@ -405,22 +397,25 @@ fn open_borders_honour_the_tolerance() {
     let mut worst = 0.0f64;
     for i in 0..8 {
         let camera = orbit.camera(i);
-        let view = policy_view(&camera, adapted.aspect(), h_px, 1.0);
-        let s = cut.adapt(
+        let s = vdlod::adapt(
+            &mut cut,
             &h,
-            &view,
+            &camera,
             &(Frustum, ScreenError::new(1.0)),
             &Budget::default(),
-        );
+        )
+        .unwrap();
         assert!(
             s.triangles < mesh.triangles.len() as u32 / 2,
             "frame {i}: {s:?}"
         );
-        vertices.gather(&*cut, &h);
-        let mut params = camera_params(&camera, adapted.aspect(), Shading::Gouraud, false);
-        params.cull_back_faces = false;
-        adapted.draw(&vertices.mesh(&*cut, false), &params).unwrap();
-        full.draw(&mesh.as_raster_mesh(), &params).unwrap();
+        let style = vdlod::Style {
+            cull_back_faces: false,
+            ..style(Shading::Gouraud, false)
+        };
+        adapted.draw_cut(&*cut, &h, &camera, &style).unwrap();
+        full.draw(&mesh.as_raster_mesh(), &style.params(&camera))
+            .unwrap();
         let (a, b) = (mask(&adapted), mask(&full));
         worst = worst.max(stray(&a, &b)).max(stray(&b, &a));
     }

@@ -13,7 +13,7 @@ use std::path::PathBuf;
 
 use vdlod_demo::frame::{load_png, save_png, Frame};
 use vdlod_demo::mesh::{load_obj_bytes, IndexedMesh, BUNNY_NAME, BUNNY_OBJ, COW_NAME, COW_OBJ};
-use vdlod_demo::render::{camera_params, render_orbit_frame, RenderOptions};
+use vdlod_demo::render::{camera_params, render_orbit_frame, style, RenderOptions};
 use vdlod_raster::{
     draw_indexed, Pixel, Rgb565, Rgba8, ShadedVertex, Shading, Target, DEPTH_CLEAR,
 };
@@ -110,13 +110,8 @@ fn cow_face_colors_rgb565() {
         face_colors: Some(&face_colors),
         ..mesh.as_raster_mesh()
     };
-    let orbit = vdlod_demo::camera::Orbit::merge_tree(&mesh.bounds(), 36);
-    let params = camera_params(
-        &orbit.camera(30),
-        W as f32 / H as f32,
-        Shading::Gouraud,
-        false,
-    );
+    let orbit = vdlod_demo::camera::merge_tree_orbit(&mesh.bounds(), 36, W, H);
+    let params = camera_params(&orbit.camera(30), Shading::Gouraud, false);
     let mut color = vec![Rgb565(0); W * H];
     let mut depth = vec![DEPTH_CLEAR; W * H];
     let mut target = Target::new(&mut color, &mut depth, W, H).unwrap();
@@ -147,8 +142,7 @@ fn lod_frames(indices: &'static [u32], depth: bool) -> Vec<Vec<Rgba8>> {
     use vdlod_core::cut::{Coloring, Cut};
     use vdlod_core::format::HierarchyView;
     use vdlod_core::policy::{BackFace, Frustum, ScreenError};
-    use vdlod_demo::camera::Orbit;
-    use vdlod_demo::lod::{policy_view, CutVertices};
+    use vdlod_demo::camera::peer_orbit;
     {
         let mesh = bunny();
         let (_, bytes, _) =
@@ -162,19 +156,19 @@ fn lod_frames(indices: &'static [u32], depth: bool) -> Vec<Vec<Rgba8>> {
         });
         cut.reset(&h).unwrap();
         cut.set_geomorph_frames(4);
-        let orbit = Orbit::peer(&mesh.bounds(), 36);
+        let orbit = peer_orbit(&mesh.bounds(), 36, W, H);
         let mut frame = Frame::new(W, H).unwrap();
         let policy = (Frustum, (BackFace, ScreenError::new(1.0)));
         let mut out = Vec::new();
         for i in 0..=*indices.iter().max().unwrap() {
             let camera = orbit.camera(i);
-            let view = policy_view(&camera, frame.aspect(), H, 1.0);
-            cut.adapt(&h, &view, &policy, &Budget::default());
+            vdlod::adapt(&mut cut, &h, &camera, &policy, &Budget::default()).unwrap();
             if indices.contains(&i) {
-                let params = camera_params(&camera, frame.aspect(), Shading::Gouraud, false);
-                let mut vertices = CutVertices::default();
-                vertices.gather(&cut, &h);
-                frame.draw(&vertices.mesh(&cut, depth), &params).unwrap();
+                let style = vdlod::Style {
+                    vertex_colors: depth,
+                    ..style(Shading::Gouraud, false)
+                };
+                frame.draw_cut(&cut, &h, &camera, &style).unwrap();
                 out.push(frame.pixels().to_vec());
             }
         }

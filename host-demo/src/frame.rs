@@ -5,8 +5,11 @@
 
 use std::path::Path;
 
+use vdlod::core::cut::{Cut, SlotIndex};
+use vdlod::core::format::HierarchyView;
+use vdlod::{Camera, Style};
 use vdlod_raster::{
-    draw_indexed, DrawParams, DrawStats, Mesh, Rgba8, ShadedVertex, Target, VertexIndex,
+    draw_indexed, DrawParams, DrawStats, MeshSource, Rgba8, ShadedVertex, Target, VertexIndex,
 };
 
 /// Background colour of demo frames.
@@ -19,6 +22,8 @@ pub enum FrameError {
     Target(vdlod_raster::TargetError),
     /// The mesh does not fit the draw call.
     Draw(vdlod_raster::DrawError),
+    /// The camera cannot be used.
+    Camera(vdlod::CameraError),
     /// PNG encoding or decoding failed.
     Png(String),
     /// Writing or reading the file failed.
@@ -30,6 +35,7 @@ impl std::fmt::Display for FrameError {
         match self {
             FrameError::Target(e) => e.fmt(f),
             FrameError::Draw(e) => e.fmt(f),
+            FrameError::Camera(e) => e.fmt(f),
             FrameError::Png(e) => write!(f, "PNG: {e}"),
             FrameError::Io(e) => e.fmt(f),
         }
@@ -94,16 +100,12 @@ impl Frame {
     }
 
     /// Clears to [`BACKGROUND`] and draws `mesh`.
-    pub fn draw<I: VertexIndex>(
+    pub fn draw<M: MeshSource>(
         &mut self,
-        mesh: &Mesh<'_, I>,
+        mesh: &M,
         params: &DrawParams,
     ) -> Result<DrawStats, FrameError> {
-        if self.scratch.len() < mesh.positions.len() {
-            self.scratch
-                .resize(mesh.positions.len(), ShadedVertex::default());
-        }
-        let mut scratch = std::mem::take(&mut self.scratch);
+        let mut scratch = self.take_scratch(mesh.vertex_count());
         let result = {
             let mut target = self.target()?;
             target.clear(BACKGROUND);
@@ -111,6 +113,39 @@ impl Frame {
         };
         self.scratch = scratch;
         result
+    }
+
+    /// Clears to [`BACKGROUND`] and draws `cut` as `camera` sees it (see [`vdlod::draw`]).
+    pub fn draw_cut<const V: usize, const F: usize, const Q: usize, I>(
+        &mut self,
+        cut: &Cut<V, F, Q, I>,
+        h: &HierarchyView<'_>,
+        camera: &Camera,
+        style: &Style,
+    ) -> Result<DrawStats, FrameError>
+    where
+        I: SlotIndex + VertexIndex,
+    {
+        let mut scratch = self.take_scratch(cut.vertex_count());
+        let result = {
+            let mut target = self.target()?;
+            target.clear(BACKGROUND);
+            vdlod::draw(&mut target, cut, h, camera, style, &mut scratch).map_err(|e| match e {
+                vdlod::FrameError::Camera(e) => FrameError::Camera(e),
+                vdlod::FrameError::Target(e) => FrameError::Target(e),
+                vdlod::FrameError::Draw(e) => FrameError::Draw(e),
+            })
+        };
+        self.scratch = scratch;
+        result
+    }
+
+    /// The vertex scratch, at least `n` long, taken out of the frame while its target is borrowed.
+    fn take_scratch(&mut self, n: usize) -> Vec<ShadedVertex> {
+        if self.scratch.len() < n {
+            self.scratch.resize(n, ShadedVertex::default());
+        }
+        std::mem::take(&mut self.scratch)
     }
 
     /// Writes the frame as a PNG file.

@@ -13,13 +13,14 @@ use vdlod_core::policy::{
     Bounds as NodeBounds, Demand, Frustum, Importance, MergeTree, Policy, QRefine, ScreenError,
     View,
 };
-use vdlod_raster::{Mesh, Rgba8, Shading, VertexIndex};
+use vdlod_raster::{Rgba8, Shading, VertexIndex};
 
-use crate::camera::{Camera, Orbit};
+use crate::camera::{merge_tree_orbit, peer_orbit, Camera, Orbit};
 use crate::frame::{encode_png, Frame, FrameError};
 use crate::label;
 use crate::mesh::{vertex_normals, Bounds, IndexedMesh};
-use crate::render::camera_params;
+use crate::render::style;
+use vdlod::Style;
 
 /// Calls `$body` with `$cut` bound to a new boxed cut of the smallest capacity class that holds
 /// `$vertices` vertices and `$triangles` triangles: 16-bit cuts up to 32,767 vertices and 65,534
@@ -228,19 +229,6 @@ pub fn leaf_bounds(h: &HierarchyView<'_>) -> Bounds {
     Bounds { min, max }
 }
 
-/// The policy view of `camera`, with the refinement frustum scaled by `frustum`.
-pub fn policy_view(camera: &Camera, aspect: f32, height: usize, frustum: f32) -> View {
-    View::with_frustum_scale(
-        camera.eye.into(),
-        camera.target.into(),
-        camera.up.into(),
-        camera.fov_y,
-        aspect,
-        height as f32,
-        frustum,
-    )
-}
-
 /// The policy a [`PolicyChoice`] names, dispatched by a `match` per call (a trait object would
 /// cost an indirect call per vertex, about half of a frame's adaptation time).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -290,52 +278,6 @@ pub fn make_policy(choice: PolicyChoice) -> DemoPolicy {
         }),
         PolicyChoice::Importance { threshold } => {
             DemoPolicy::Importance((Frustum, Importance { threshold }))
-        }
-    }
-}
-
-/// The cut's vertices as drawn this frame, gathered from the hierarchy into host arrays for the
-/// rasterizer's slices.
-#[derive(Clone, Debug, Default)]
-pub struct CutVertices {
-    /// Positions by slot.
-    pub positions: Vec<[f32; 3]>,
-    /// Normals by slot.
-    pub normals: Vec<[f32; 3]>,
-    /// Colours by slot.
-    pub colors: Vec<[u8; 3]>,
-}
-
-impl CutVertices {
-    /// Reads every active vertex of `cut` (see [`Cut::vertex`]).
-    pub fn gather<const V: usize, const F: usize, const Q: usize, I: SlotIndex>(
-        &mut self,
-        cut: &Cut<V, F, Q, I>,
-        h: &HierarchyView<'_>,
-    ) {
-        self.positions.clear();
-        self.normals.clear();
-        self.colors.clear();
-        for s in 0..cut.vertex_count() {
-            let v = cut.vertex(h, s);
-            self.positions.push(v.position);
-            self.normals.push(v.normal);
-            self.colors.push(v.color);
-        }
-    }
-
-    /// The cut as a rasterizer mesh over these vertices.
-    pub fn mesh<'a, const V: usize, const F: usize, const Q: usize, I: SlotIndex + VertexIndex>(
-        &'a self,
-        cut: &'a Cut<V, F, Q, I>,
-        colors: bool,
-    ) -> Mesh<'a, I> {
-        Mesh {
-            positions: &self.positions,
-            normals: Some(&self.normals),
-            colors: colors.then_some(&self.colors[..]),
-            triangles: cut.triangles(),
-            face_colors: None,
         }
     }
 }
@@ -622,9 +564,9 @@ fn fly_orbit<const V: usize, const F: usize, const Q: usize, I: SlotIndex + Vert
     let picture = opts.depth_colors || opts.wireframe || opts.observer;
     let bounds = full.bounds();
     let orbit = if opts.peer_orbit {
-        Orbit::peer(&bounds, opts.frames)
+        peer_orbit(&bounds, opts.frames, opts.width, opts.height)
     } else {
-        Orbit::merge_tree(&bounds, opts.frames)
+        merge_tree_orbit(&bounds, opts.frames, opts.width, opts.height)
     };
     let policy = make_policy(opts.policy);
     let mut frame = Frame::new(opts.width, opts.height).map_err(|e| e.to_string())?;
@@ -634,12 +576,11 @@ fn fly_orbit<const V: usize, const F: usize, const Q: usize, I: SlotIndex + Vert
         "frame,triangles,vsplits,ecols,adapt_us,render_us,full_render_us,psnr_db,vertices,forced,blending,threshold,budget_limited\n",
     );
     let mut frames = Vec::with_capacity(opts.frames as usize);
-    let mut vertices = CutVertices::default();
     let mut warned = false;
     let compared = opts.frames / 2;
     for i in 0..opts.frames {
         let camera = orbit.camera(i);
-        let view = policy_view(&camera, frame.aspect(), opts.height, opts.frustum);
+        let view = camera.view_scaled(opts.frustum);
         let start = Instant::now();
         let stats = cut.adapt(&h, &view, &policy, &opts.budget);
         if stats.over_budget && !warned && h.base_triangles() > opts.budget.max_triangles {
@@ -652,11 +593,14 @@ fn fly_orbit<const V: usize, const F: usize, const Q: usize, I: SlotIndex + Vert
             warned = true;
         }
         let adapt_us = start.elapsed().as_secs_f64() * 1e6;
-        let params = camera_params(&camera, frame.aspect(), Shading::Gouraud, false);
+        let drawn = Style {
+            vertex_colors: true_colors,
+            ..style(Shading::Gouraud, false)
+        };
+        let params = drawn.params(&camera);
         let start = Instant::now();
-        vertices.gather(cut, &h);
         frame
-            .draw(&vertices.mesh(cut, true_colors), &params)
+            .draw_cut(cut, &h, &camera, &drawn)
             .map_err(|e| e.to_string())?;
         let render_us = start.elapsed().as_secs_f64() * 1e6;
         let start = Instant::now();
@@ -688,9 +632,12 @@ fn fly_orbit<const V: usize, const F: usize, const Q: usize, I: SlotIndex + Vert
             } else {
                 camera
             };
-            let drawn = camera_params(&seen_from, frame.aspect(), Shading::Gouraud, opts.wireframe);
+            let drawn = Style {
+                vertex_colors: colors,
+                ..style(Shading::Gouraud, opts.wireframe)
+            };
             frame
-                .draw(&vertices.mesh(cut, colors), &drawn)
+                .draw_cut(cut, &h, &seen_from, &drawn)
                 .map_err(|e| e.to_string())?;
         }
         if opts.write_frames {

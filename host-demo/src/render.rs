@@ -3,34 +3,26 @@
 use std::path::Path;
 use std::time::Instant;
 
-use glam::Vec3;
-use vdlod_raster::{DrawParams, Light, Shading};
+use vdlod::Style;
+use vdlod_raster::{DrawParams, Shading};
 
-use crate::camera::{Camera, Orbit};
+use crate::camera::{merge_tree_orbit, Camera};
 use crate::frame::{Frame, FrameError};
 use crate::mesh::IndexedMesh;
 
-/// Drawing parameters for a camera: view-projection, a light over the viewer's shoulder.
-pub fn camera_params(
-    camera: &Camera,
-    aspect: f32,
-    shading: Shading,
-    wireframe: bool,
-) -> DrawParams {
-    let to_eye = (camera.eye - camera.target).normalize_or_zero();
-    DrawParams {
-        mvp: camera.view_projection(aspect),
-        light: Light {
-            direction: to_eye + Vec3::Y * 0.6,
-            ..Light::default()
-        },
+/// The demo's drawing style: the facade's default, with dark edges when `wireframe` is set.
+pub fn style(shading: Shading, wireframe: bool) -> Style {
+    Style {
         shading,
-        // `IndexedMesh` normals are unit length (or zero) and the model matrix is the identity.
-        unit_normals: true,
-        base_color: [214, 200, 176],
         wireframe: wireframe.then_some([20, 20, 20]),
-        ..DrawParams::default()
+        ..Style::default()
     }
+}
+
+/// Drawing parameters for a camera: view-projection, a light over the viewer's shoulder
+/// ([`Style::params`]; `IndexedMesh` normals are unit length, as the cut's are).
+pub fn camera_params(camera: &Camera, shading: Shading, wireframe: bool) -> DrawParams {
+    style(shading, wireframe).params(camera)
 }
 
 /// Settings of [`render_orbit`].
@@ -80,13 +72,8 @@ pub fn render_orbit_frame(
     index: u32,
     opts: &RenderOptions,
 ) -> Result<FrameReport, FrameError> {
-    let orbit = Orbit::merge_tree(&mesh.bounds(), opts.frames);
-    let params = camera_params(
-        &orbit.camera(index),
-        frame.aspect(),
-        opts.shading,
-        opts.wireframe,
-    );
+    let orbit = merge_tree_orbit(&mesh.bounds(), opts.frames, frame.width(), frame.height());
+    let params = camera_params(&orbit.camera(index), opts.shading, opts.wireframe);
     let start = Instant::now();
     let stats = frame.draw(&mesh.as_raster_mesh(), &params)?;
     let ms = start.elapsed().as_secs_f64() * 1e3;

@@ -43,6 +43,8 @@
 #![warn(missing_docs)]
 
 pub mod clip;
+#[cfg(feature = "embedded-graphics")]
+pub mod display;
 mod draw;
 pub mod edge;
 mod mesh;
@@ -50,6 +52,8 @@ pub mod target;
 pub mod vertex;
 pub mod wire;
 
+#[cfg(feature = "embedded-graphics")]
+pub use display::{flush, flush_with};
 pub use draw::{draw_indexed, shade, DrawError, DrawParams, DrawStats, ShadedMesh, Shading};
 pub use mesh::{Mesh, MeshSource, SourceVertex, VertexIndex};
 pub use target::{
