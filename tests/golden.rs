@@ -187,3 +187,48 @@ fn bunny_cut_over_the_peer_orbit() {
 fn bunny_cut_in_depth_colours() {
     check("bunny_cut_depth", &lod_frames(&[12], true)[0]);
 }
+
+/// The bunny's cut drawn the way a device draws it: 320x16 bands of Rgb565 with 16-bit depth,
+/// through `vdlod::draw_bands`, stitched.
+#[test]
+fn bunny_cut_in_bands_rgb565_u16_depth() {
+    use vdlod::prelude::*;
+    use vdlod_demo::camera::peer_orbit;
+    let mesh = bunny();
+    let (_, bytes, _) =
+        vdlod_demo::hierarchy::build_with_progress(&mesh, &Default::default(), false).unwrap();
+    let h = HierarchyView::parse(&bytes).unwrap();
+    let mut cut = Cut::<2508, 5000, 313>::boxed();
+    cut.reset(&h).unwrap();
+    cut.set_geomorph_frames(4);
+    let orbit = peer_orbit(&mesh.bounds(), 36, W, H);
+    let budget = Budget {
+        max_triangles: 5000,
+        ..Budget::default()
+    };
+    let mut scratch = vec![ShadedVertex::default(); 2508];
+    let (mut color, mut depth) = (vec![Rgb565(0); W * 16], vec![0u16; W * 16]);
+    let mut pixels = Vec::with_capacity(W * H);
+    for i in 0..=7 {
+        let camera = orbit.camera(i);
+        vdlod::adapt(&mut cut, &h, &camera, &QRefine::new(1.0), &budget).unwrap();
+        if i < 7 {
+            continue;
+        }
+        let bands = Bands {
+            color: &mut color,
+            depth: &mut depth,
+            rows: 16,
+            background: Rgb565::from_rgb(24, 26, 32),
+        };
+        let style = vdlod_demo::render::style(Shading::Gouraud, false);
+        vdlod::draw_bands(bands, &cut, &h, &camera, &style, &mut scratch, |band| {
+            pixels.extend(band.color().iter().map(|p| {
+                let [r, g, b] = p.to_rgb();
+                Rgba8([r, g, b, 255])
+            }))
+        })
+        .unwrap();
+    }
+    check("bunny_cut_bands_rgb565_u16", &pixels);
+}
