@@ -60,6 +60,10 @@ fn whole<D: Depth>(mesh: &Mesh<'_>, params: &DrawParams) -> (Vec<Rgba8>, Vec<D>,
     (color, depth, stats)
 }
 
+fn whole_stats(mesh: &Mesh<'_>, params: &DrawParams) -> DrawStats {
+    whole::<u32>(mesh, params).2
+}
+
 /// Draws the frame window by window through one buffer of `stride * rows` entries (with padding
 /// columns that must stay untouched), shading once, and stitches the windows.
 fn windowed<D: Depth>(
@@ -67,9 +71,14 @@ fn windowed<D: Depth>(
     params: &DrawParams,
     windows: &[Window],
     stride: usize,
+    binned: bool,
 ) -> (Vec<Rgba8>, Vec<D>) {
     let mut scratch = vec![ShadedVertex::default(); mesh.positions.len()];
-    let shaded = shade(mesh, params, W, H, &mut scratch).unwrap();
+    let mut rows = vec![[0u16; 2]; mesh.triangles.len()];
+    let mut shaded = shade(mesh, params, W, H, &mut scratch).unwrap();
+    if binned {
+        shaded = shaded.bin(&mut rows).unwrap();
+    }
     let rows = windows.iter().map(|w| w.height).max().unwrap();
     let (mut color, mut depth) = (vec![BG; W * H], vec![D::CLEAR; W * H]);
     let sentinel = Rgba8([1, 2, 3, 4]);
@@ -85,6 +94,7 @@ fn windowed<D: Depth>(
         let s = shaded.draw(&mut target).unwrap();
         // Every window reports the whole frame's statistics.
         assert_eq!(*stats.get_or_insert(s), s, "window {w:?}");
+        assert_eq!(s, whole_stats(mesh, params), "window {w:?}");
         for y in 0..w.height {
             for x in 0..stride {
                 let (src, dst) = (y * stride + x, (w.y + y) * W + w.x + x);
@@ -112,9 +122,12 @@ fn bands_stitch_to_the_whole_frame() {
         for rows in [1, 7, 16, 40, H] {
             let bands: Vec<Window> = Window::bands(W, H, rows).collect();
             for stride in [W, W + 3] {
-                let (c, d) = windowed::<u32>(&mesh, &p, &bands, stride);
-                assert!(c == color, "rows {rows}, stride {stride}, wireframe {wire}");
-                assert!(d == depth, "rows {rows}, stride {stride}, wireframe {wire}");
+                for binned in [false, true] {
+                    let (c, d) = windowed::<u32>(&mesh, &p, &bands, stride, binned);
+                    let case = format!("rows {rows}, stride {stride}, wire {wire}, bins {binned}");
+                    assert!(c == color, "{case}");
+                    assert!(d == depth, "{case}");
+                }
             }
         }
     }
@@ -137,8 +150,10 @@ fn tiles_stitch_to_the_whole_frame_with_16_bit_depth() {
             });
         }
     }
-    let (c, d) = windowed::<u16>(&mesh, &p, &tiles, 50);
-    assert!(c == color && d == depth);
+    for binned in [false, true] {
+        let (c, d) = windowed::<u16>(&mesh, &p, &tiles, 50, binned);
+        assert!(c == color && d == depth);
+    }
 }
 
 #[test]
@@ -186,6 +201,15 @@ fn bad_windows_and_frames_are_typed_errors() {
     assert_eq!(
         shade(&mesh, &p, 0, H, &mut scratch).err(),
         Some(DrawError::Frame(TargetError::ZeroSize))
+    );
+    let mut rows = vec![[0u16; 2]; mesh.triangles.len() - 1];
+    let shaded = shade(&mesh, &p, W, H, &mut scratch).unwrap();
+    assert_eq!(
+        shaded.bin(&mut rows).err(),
+        Some(DrawError::BinsTooSmall {
+            needed: mesh.triangles.len(),
+            available: mesh.triangles.len() - 1
+        })
     );
     let shaded = shade(&mesh, &p, W, H, &mut scratch).unwrap();
     let mut c = vec![Rgba8::default(); W * 16];

@@ -209,6 +209,7 @@ fn bunny_cut_in_bands_rgb565_u16_depth() {
     let mut scratch = vec![ShadedVertex::default(); 2508];
     let (mut color, mut depth) = (vec![Rgb565(0); W * 16], vec![0u16; W * 16]);
     let mut pixels = Vec::with_capacity(W * H);
+    let mut bins = vec![[0u16; 2]; 5000];
     for i in 0..=7 {
         let camera = orbit.camera(i);
         vdlod::adapt(&mut cut, &h, &camera, &QRefine::new(1.0), &budget).unwrap();
@@ -220,6 +221,7 @@ fn bunny_cut_in_bands_rgb565_u16_depth() {
             depth: &mut depth,
             rows: 16,
             background: Rgb565::from_rgb(24, 26, 32),
+            bins: Some(&mut bins),
         };
         let style = vdlod_demo::render::style(Shading::Gouraud, false);
         vdlod::draw_bands(bands, &cut, &h, &camera, &style, &mut scratch, |band| {

@@ -17,7 +17,7 @@ use glam::{Mat3, Mat4, Vec3};
 use crate::clip::{self, clip_triangle, ClipVertex};
 use crate::edge::{
     fill_triangle, pixel_bounds, scan, signed_area2, signed_area2_xy, Coverage, Facing, Fragment,
-    ScreenVertex,
+    ScreenVertex, SUBPIXEL_BITS,
 };
 use crate::mesh::{MeshSource, VertexIndex};
 use crate::target::{check_frame, Depth, Pixel, Target, TargetError};
@@ -126,6 +126,13 @@ pub enum DrawError {
     MissingNormals,
     /// The frame size given to [`shade`] is zero or too large.
     Frame(TargetError),
+    /// The row bins of [`ShadedMesh::bin`] are fewer than the triangles.
+    BinsTooSmall {
+        /// Triangles in the mesh.
+        needed: usize,
+        /// Length of the bins slice.
+        available: usize,
+    },
     /// The target is for a frame of another size than the one the mesh was shaded for.
     FrameMismatch {
         /// The frame [`shade`] was given.
@@ -157,6 +164,10 @@ impl fmt::Display for DrawError {
             } => write!(f, "{attribute} has {actual} entries, expected {expected}"),
             DrawError::MissingNormals => write!(f, "Gouraud shading needs vertex normals"),
             DrawError::Frame(e) => write!(f, "{e}"),
+            DrawError::BinsTooSmall { needed, available } => write!(
+                f,
+                "row bins hold {available} triangles, the mesh has {needed}"
+            ),
             DrawError::FrameMismatch { shaded, target } => write!(
                 f,
                 "the mesh was shaded for a {}x{} frame, the target is part of a {}x{} frame",
@@ -242,6 +253,7 @@ pub struct ShadedMesh<'a, M: MeshSource> {
     lighting: Option<PreparedLighting>,
     viewport: Viewport,
     frame: (usize, usize),
+    bins: Option<(&'a [[u16; 2]], DrawStats)>,
 }
 
 /// Runs the vertex stage of `mesh` for a `width` by `height` frame into `scratch` (at least one
@@ -302,10 +314,84 @@ pub fn shade<'a, M: MeshSource>(
         lighting: prepared,
         viewport,
         frame: (width, height),
+        bins: None,
     })
 }
 
-impl<M: MeshSource> ShadedMesh<'_, M> {
+impl<'a, M: MeshSource> ShadedMesh<'a, M> {
+    /// Bins the triangles by pixel row once, so that each band of a frame drawn in bands skips
+    /// the triangles that miss it after reading four bytes, instead of three shaded vertices.
+    /// `rows` needs one entry per triangle (4 bytes each) and holds each triangle's first and
+    /// last row. The statistics of the whole frame are counted here, and every draw returns them.
+    pub fn bin(self, rows: &'a mut [[u16; 2]]) -> Result<ShadedMesh<'a, M>, DrawError> {
+        let triangles = self.mesh.triangles();
+        if rows.len() < triangles.len() {
+            return Err(DrawError::BinsTooSmall {
+                needed: triangles.len(),
+                available: rows.len(),
+            });
+        }
+        let (params, scratch) = (self.params, self.vertices);
+        let cull = params.cull_back_faces;
+        let last = self.frame.1 as i32 - 1;
+        const EMPTY: [u16; 2] = [1, 0];
+        let mut stats = DrawStats {
+            submitted: triangles.len() as u32,
+            ..DrawStats::default()
+        };
+        for (tri, row) in triangles.iter().zip(rows.iter_mut()) {
+            let tri = &tri.map(VertexIndex::to_u32);
+            let v = tri.map(|i| &scratch[i as usize]);
+            let union = v[0].outcode | v[1].outcode | v[2].outcode;
+            *row = EMPTY;
+            if union == 0 {
+                let area = signed_area2_xy(v.map(|v| [v.x, v.y]));
+                if area == 0 || (area > 0 && cull) {
+                    stats.culled += 1;
+                    if cull {
+                        continue; // neither filled nor outlined
+                    }
+                } else {
+                    stats.rasterized += 1;
+                }
+                // Whole pixel rows: they hold the pixel centres filled and the wireframe's pixels.
+                let ys = v.map(|v| v.y >> SUBPIXEL_BITS);
+                let first = ys[0].min(ys[1]).min(ys[2]).max(0);
+                let end = ys[0].max(ys[1]).max(ys[2]).min(last);
+                if first <= end {
+                    *row = [first as u16, end as u16];
+                }
+            } else if union & clip::INVALID != 0 {
+                stats.invalid += 1;
+            } else if v[0].outcode & v[1].outcode & v[2].outcode != 0 {
+                stats.outside += 1;
+            } else {
+                stats.clipped += 1;
+                for_each_clipped(
+                    &self.viewport,
+                    params,
+                    self.mesh,
+                    tri,
+                    [[0.0; 3]; 3],
+                    union,
+                    |s| {
+                        let area = signed_area2(s);
+                        if area < 0 || (area > 0 && !cull) {
+                            stats.rasterized += 1;
+                        } else {
+                            stats.culled += 1;
+                        }
+                    },
+                );
+                *row = [0, last as u16];
+            }
+        }
+        Ok(ShadedMesh {
+            bins: Some((rows, stats)),
+            ..self
+        })
+    }
+
     /// Draws the triangles into `target`, which must be (a window of) the frame the mesh was
     /// shaded for. The statistics are those of the whole frame, whatever the window.
     pub fn draw<P: Pixel, D: Depth>(
@@ -338,7 +424,18 @@ impl<M: MeshSource> ShadedMesh<'_, M> {
                     Coverage::Culled => stats.culled += 1,
                 }
             };
+        let (top, bottom) = (target.window.y, target.window.y + target.window.height - 1);
+        let misses = |t: usize| match self.bins {
+            Some((rows, _)) => {
+                let [first, last] = rows[t].map(usize::from);
+                last < top || first > bottom
+            }
+            None => false,
+        };
         for (t, tri) in mesh.triangles().iter().enumerate() {
+            if misses(t) {
+                continue;
+            }
             let tri = &tri.map(VertexIndex::to_u32);
             // References, not copies: a culled triangle reads only positions and outcodes.
             let v = tri.map(|i| &scratch[i as usize]);
@@ -381,7 +478,10 @@ impl<M: MeshSource> ShadedMesh<'_, M> {
 
         if let Some(wire) = params.wireframe {
             let color = P::from_rgb(wire[0], wire[1], wire[2]);
-            for tri in mesh.triangles() {
+            for (t, tri) in mesh.triangles().iter().enumerate() {
+                if misses(t) {
+                    continue;
+                }
                 let tri = &tri.map(VertexIndex::to_u32);
                 let v = tri.map(|i| scratch[i as usize]);
                 let union = v[0].outcode | v[1].outcode | v[2].outcode;
@@ -405,7 +505,7 @@ impl<M: MeshSource> ShadedMesh<'_, M> {
                 }
             }
         }
-        Ok(stats)
+        Ok(self.bins.map_or(stats, |(_, whole)| whole))
     }
 }
 
