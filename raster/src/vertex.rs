@@ -86,6 +86,15 @@ pub struct ShadedVertex {
 }
 
 impl ShadedVertex {
+    /// All zeros, for `static` scratch arrays (`Default::default` is not `const`).
+    pub const ZERO: ShadedVertex = ShadedVertex {
+        x: 0,
+        y: 0,
+        z: 0.0,
+        rgb: [0; 3],
+        outcode: 0,
+    };
+
     /// The vertex as the edge stage takes it.
     #[inline(always)]
     pub fn screen(&self) -> ScreenVertex {
