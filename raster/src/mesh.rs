@@ -52,6 +52,15 @@ pub trait MeshSource {
     fn triangles(&self) -> &[[Self::Index; 3]];
     /// Vertex `i` (below [`MeshSource::vertex_count`]).
     fn vertex(&self, i: usize) -> SourceVertex;
+    /// Vertices `first..first + out.len()` (all below [`MeshSource::vertex_count`]) into `out`:
+    /// how the vertex stage reads them, eight at a time; override when a batch is cheaper than
+    /// its vertices one by one.
+    #[inline(always)]
+    fn batch(&self, first: usize, out: &mut [SourceVertex]) {
+        for (k, o) in out.iter_mut().enumerate() {
+            *o = self.vertex(first + k);
+        }
+    }
     /// The position of vertex `i`; override when it is cheaper than the whole vertex.
     #[inline(always)]
     fn position(&self, i: usize) -> [f32; 3] {
@@ -131,6 +140,25 @@ impl<I: VertexIndex> MeshSource for Mesh<'_, I> {
             position: self.positions[i],
             normal: self.normals.map_or([0.0; 3], |n| n[i]),
             color: self.colors.map_or([0; 3], |c| c[i]),
+        }
+    }
+
+    #[inline(always)]
+    fn batch(&self, first: usize, out: &mut [SourceVertex]) {
+        // Slices checked once per batch, attributes copied array by array.
+        let end = first + out.len();
+        for (o, p) in out.iter_mut().zip(&self.positions[first..end]) {
+            o.position = *p;
+        }
+        if let Some(normals) = self.normals {
+            for (o, n) in out.iter_mut().zip(&normals[first..end]) {
+                o.normal = *n;
+            }
+        }
+        if let Some(colors) = self.colors {
+            for (o, c) in out.iter_mut().zip(&colors[first..end]) {
+                o.color = *c;
+            }
         }
     }
 

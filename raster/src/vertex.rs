@@ -9,7 +9,7 @@ use glam::{Mat3, Mat4, Vec3, Vec4};
 
 use crate::clip::{self, GUARD_BAND};
 use crate::edge::{ScreenVertex, DEPTH_MAX, SUBPIXEL_ONE};
-use crate::mesh::MeshSource;
+use crate::mesh::{MeshSource, SourceVertex};
 
 /// One directional light plus an ambient term.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -259,12 +259,23 @@ pub fn shade_vertices<M: MeshSource>(
         let mut p = [[0.0f32; LANES]; 3];
         let mut n = [[0.0f32; LANES]; 3];
         let mut rgb = [[0.0f32; LANES]; 3];
-        for k in 0..len {
-            let v = mesh.vertex(first + k);
+        let mut batch = [SourceVertex::default(); LANES];
+        mesh.batch(first, &mut batch[..len]);
+        for (k, v) in batch[..len].iter().enumerate() {
             for a in 0..3 {
                 p[a][k] = v.position[a];
                 n[a][k] = v.normal[a];
-                rgb[a][k] = if colors { v.color[a] as f32 } else { base[a] };
+            }
+        }
+        if colors {
+            for (k, v) in batch[..len].iter().enumerate() {
+                for (channel, c) in rgb.iter_mut().zip(v.color) {
+                    channel[k] = c as f32;
+                }
+            }
+        } else {
+            for (channel, b) in rgb.iter_mut().zip(base) {
+                *channel = [b; LANES];
             }
         }
 
