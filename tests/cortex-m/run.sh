@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
-# vdlod frames on an emulated Cortex-M7 (qemu mps2-an500) against the host twin of the same
-# source: builds the bunny hierarchy, the firmware and the host twin, runs both, compares the
-# per-frame hashes (exit 1 on any mismatch or missing frame) and reports RAM, flash and
-# instruction counts.
+# vdlod frames on an emulated Cortex-M7 (qemu mps2-an500) against the twin of the same source on
+# the host and on aarch64 (qemu-user): builds the bunny hierarchy, the firmware and the twins,
+# runs all three, compares the per-frame hashes (exit 1 on any mismatch or missing frame) and
+# reports RAM, flash and instruction counts.
 #
-# Needs rustup and cargo; installs qemu-system-arm (apt-get), the thumbv7em-none-eabihf target
-# and the llvm-tools component when missing.
+# Needs rustup and cargo; installs qemu-system-arm, qemu-user and gcc-aarch64-linux-gnu
+# (apt-get), the thumbv7em-none-eabihf and aarch64-unknown-linux-gnu targets and the llvm-tools
+# component when missing.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 export CARGO_TERM_COLOR=never
@@ -16,17 +17,24 @@ MANIFEST=tests/cortex-m/Cargo.toml
 FW_TARGET_DIR=tests/cortex-m/target
 ELF="$FW_TARGET_DIR/$TARGET/release/vdlod-firmware"
 HOST_BIN="$FW_TARGET_DIR/release/vdlod-firmware"
+ARM64=aarch64-unknown-linux-gnu
+ARM64_BIN="$FW_TARGET_DIR/$ARM64/release/vdlod-firmware"
 OUT=target/cortex-m
 mkdir -p "$OUT"
 
 # --- tools ---------------------------------------------------------------------------------
-if ! command -v qemu-system-arm >/dev/null 2>&1; then
+missing=()
+command -v qemu-system-arm >/dev/null 2>&1 || missing+=(qemu-system-arm)
+command -v qemu-aarch64 >/dev/null 2>&1 || missing+=(qemu-user)
+command -v aarch64-linux-gnu-gcc >/dev/null 2>&1 || missing+=(gcc-aarch64-linux-gnu)
+if [ "${#missing[@]}" -gt 0 ]; then
     SUDO=""
     if [ "$(id -u)" -ne 0 ]; then SUDO=sudo; fi
     $SUDO apt-get update
-    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y --no-install-recommends qemu-system-arm
+    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y --no-install-recommends "${missing[@]}"
 fi
-rustup target add "$TARGET"
+rustup target add "$TARGET" "$ARM64"
+export CARGO_TARGET_AARCH64_UNKNOWN_LINUX_GNU_LINKER=aarch64-linux-gnu-gcc
 rustup component add llvm-tools
 HOST_TRIPLE=$(rustc -vV | sed -n 's/^host: //p')
 LLVM_BIN="$(rustc --print sysroot)/lib/rustlib/$HOST_TRIPLE/bin"
@@ -46,6 +54,7 @@ export VDLOD_HIERARCHY="$PWD/$OUT/bunny.vdh"
 # --- build both ----------------------------------------------------------------------------
 cargo build --release --manifest-path "$MANIFEST" --target-dir "$FW_TARGET_DIR" --target "$TARGET"
 cargo build --release --manifest-path "$MANIFEST" --target-dir "$FW_TARGET_DIR"
+cargo build --release --manifest-path "$MANIFEST" --target-dir "$FW_TARGET_DIR" --target "$ARM64"
 
 # --- run both ------------------------------------------------------------------------------
 status=0
@@ -54,19 +63,25 @@ timeout 600 qemu-system-arm -M mps2-an500 -nographic \
     -kernel "$ELF" </dev/null >"$OUT/device.txt" || status=$?
 host_status=0
 "$HOST_BIN" >"$OUT/host.txt" || host_status=$?
+arm64_status=0
+qemu-aarch64 -L /usr/aarch64-linux-gnu "$ARM64_BIN" >"$OUT/arm64.txt" || arm64_status=$?
 
 echo "== device (qemu mps2-an500, Cortex-M7, exit $status)"
 cat "$OUT/device.txt"
 echo "== host twin ($HOST_TRIPLE, exit $host_status)"
 cat "$OUT/host.txt"
+echo "== twin on aarch64 (qemu-user, exit $arm64_status)"
+grep -E '^frame=' "$OUT/arm64.txt" || true
 
 # --- compare -------------------------------------------------------------------------------
 fail=0
 if [ "$status" -ne 0 ]; then echo "FAIL: qemu exited with $status"; fail=1; fi
 if [ "$host_status" -ne 0 ]; then echo "FAIL: the host twin exited with $host_status"; fail=1; fi
+if [ "$arm64_status" -ne 0 ]; then echo "FAIL: the aarch64 twin exited with $arm64_status"; fail=1; fi
 grep -E '^frame=[0-9]+ hash=' "$OUT/device.txt" | tr -d '\r' >"$OUT/device.hashes" || true
 grep -E '^frame=[0-9]+ hash=' "$OUT/host.txt" >"$OUT/host.hashes" || true
-for f in device host; do
+grep -E '^frame=[0-9]+ hash=' "$OUT/arm64.txt" >"$OUT/arm64.hashes" || true
+for f in device host arm64; do
     n=$(wc -l <"$OUT/$f.hashes")
     if [ "$n" -ne "$FRAMES" ]; then
         echo "FAIL: $f printed $n of $FRAMES frame hashes"
@@ -75,6 +90,10 @@ for f in device host; do
 done
 if ! diff -u "$OUT/host.hashes" "$OUT/device.hashes"; then
     echo "FAIL: device and host hashes differ"
+    fail=1
+fi
+if ! diff -u "$OUT/host.hashes" "$OUT/arm64.hashes"; then
+    echo "FAIL: aarch64 and host hashes differ"
     fail=1
 fi
 
@@ -112,6 +131,7 @@ echo "statics of 1 KiB and more (bytes, symbol):"
         }
     }'
 echo "ram_bytes=$ram flash_bytes=$flash"
+echo "goals: ram <= 262144 ($([ "$ram" -le 262144 ] && echo met || echo NOT met)), flash <= 1500000 ($([ "$flash" -le 1500000 ] && echo met || echo NOT met))"
 
 # --- instructions --------------------------------------------------------------------------
 echo "== instructions (qemu -icount shift=0, SysTick at 25 MHz: ticks x 40)"
@@ -121,4 +141,4 @@ if [ "$fail" -ne 0 ]; then
     echo "cortex-m: FAILED"
     exit 1
 fi
-echo "cortex-m: OK ($FRAMES frames, device and host hashes identical)"
+echo "cortex-m: OK ($FRAMES frames, hashes identical on the Cortex-M7, $HOST_TRIPLE and aarch64)"
