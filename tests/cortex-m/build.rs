@@ -1,4 +1,7 @@
-//! Links the firmware for the emulated board and makes the hierarchy file a build input.
+//! Links the firmware for the emulated board, makes the hierarchy file a build input, and writes
+//! the frame's configuration (`VDLOD_FW_BUDGET` triangles, default 5,000, and a
+//! `VDLOD_FW_WIDTH` x `VDLOD_FW_HEIGHT` frame, default 320x240) as constants, so that
+//! `tests/cortex-m/table.sh` can link and run other sizes.
 //!
 //! On `target_os = "none"` (thumbv7em-none-eabihf) it puts `memory.x` where cortex-m-rt's
 //! `link.x` includes it from and passes `-Tlink.x` to the binary's link; a host build of the same
@@ -21,8 +24,43 @@ fn main() {
         ),
     }
 
+    let out = PathBuf::from(env::var_os("OUT_DIR").expect("cargo sets OUT_DIR"));
+    let number = |name: &str, default: usize| -> usize {
+        println!("cargo:rerun-if-env-changed={name}");
+        match env::var(name) {
+            Ok(v) => v
+                .parse()
+                .unwrap_or_else(|_| panic!("{name}={v} is not a positive number")),
+            Err(_) => default,
+        }
+    };
+    let budget = number("VDLOD_FW_BUDGET", 5000).max(16);
+    let (width, height) = (
+        number("VDLOD_FW_WIDTH", 320),
+        number("VDLOD_FW_HEIGHT", 240),
+    );
+    // The capacities of the README's table: half a vertex slot per triangle plus eight, and a
+    // queue of an eighth of the vertex slots.
+    let vertices = budget / 2 + 8;
+    fs::write(
+        out.join("config.rs"),
+        format!(
+            "/// Triangle slots of the cut (and the budget).\n\
+             pub const TRIANGLES: usize = {budget};\n\
+             /// Vertex slots of the cut.\n\
+             pub const VERTICES: usize = {vertices};\n\
+             /// Entries of each work queue of the cut.\n\
+             pub const QUEUE: usize = {};\n\
+             /// Frame width in pixels.\n\
+             pub const WIDTH: usize = {width};\n\
+             /// Frame height in pixels.\n\
+             pub const HEIGHT: usize = {height};\n",
+            vertices / 8
+        ),
+    )
+    .expect("write config.rs");
+
     if env::var("CARGO_CFG_TARGET_OS").as_deref() == Ok("none") {
-        let out = PathBuf::from(env::var_os("OUT_DIR").expect("cargo sets OUT_DIR"));
         fs::copy("memory.x", out.join("memory.x")).expect("copy memory.x to OUT_DIR");
         println!("cargo:rustc-link-search={}", out.display());
         println!("cargo:rustc-link-arg-bins=-Tlink.x");

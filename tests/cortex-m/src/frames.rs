@@ -1,5 +1,5 @@
 //! The work of one run, identical on the device and on the host: parse the hierarchy in place,
-//! fly eight frames of the peer orbit with a 5,000-triangle cut, hash each frame.
+//! fly eight frames of the peer orbit with a cut for a triangle budget (5,000 by default), hash each frame.
 //!
 //! Each frame is adapted and drawn through the facade (`vdlod::adapt`, `vdlod::draw_bands`): 320x240
 //! in bands of 16 rows, byte-swapped Rgb565 as an SPI panel takes it, 16-bit depth, triangles binned
@@ -21,18 +21,11 @@ use crate::clock::Span;
 pub const FRAMES: u32 = 8;
 /// Frames per revolution of the orbit (frame `i` is at azimuth `2 pi i / 36`).
 pub const ORBIT_STEPS: u32 = 36;
-/// Vertex slots of the cut.
-pub const VERTICES: usize = 2508;
-/// Triangle slots of the cut (and the budget).
-pub const TRIANGLES: usize = 5000;
-/// Entries of each work queue of the cut.
-pub const QUEUE: usize = 313;
+// TRIANGLES, VERTICES, QUEUE, WIDTH and HEIGHT, from build.rs (5,000 triangles at 320x240 unless
+// the build says otherwise).
+include!(concat!(env!("OUT_DIR"), "/config.rs"));
 /// Geomorph length in frames.
 pub const GEOMORPH_FRAMES: u16 = 4;
-/// Frame width in pixels.
-pub const WIDTH: usize = 320;
-/// Frame height in pixels.
-pub const HEIGHT: usize = 240;
 /// Rows per band.
 pub const BAND_ROWS: usize = 16;
 
