@@ -17,7 +17,7 @@ for size in 160x120 320x240 480x320; do
         stack=$(sed -n 's/^ram: .*stack_peak=\([0-9]*\).*/\1/p' "$log")
         ram=$(sed -n 's/^ram_bytes=\([0-9]*\) flash_bytes=.*/\1/p' "$log")
         flash=$(sed -n 's/^ram_bytes=[0-9]* flash_bytes=\([0-9]*\)/\1/p' "$log")
-        range() { grep -E '^cost frame=[1-7] ' "$log" | sed -n "s/.*$1_instructions=\([0-9]*\).*/\1/p" | sort -n | sed -n '1p;$p' | awk '{ printf "%s%.1fM", NR > 1 ? "-" : "", $1 / 1e6 }'; }
+        range() { grep -E '^cost frame=[1-7] ' "$log" | sed -n "s/.*$1_instructions=\([0-9]*\).*/\1/p" | sort -n | sed -n '1p;$p' | awk '{ printf "%s%.1fM", (NR > 1 ? "-" : ""), $1 / 1e6 }'; }
         echo "| $size | $budget | $(sym CUT) | $(sym SCRATCH) | $(sym BINS) | $band | $stack | $ram | $flash | $(range adapt) | $(range draw) |"
     done
 done
