@@ -22,8 +22,15 @@ use vdlod_raster::{shade, MeshSource};
 
 const W: usize = 320;
 const H: usize = 240;
-const ROUNDS: usize = 300;
+/// Rounds of the five draws; `VDLOD_BENCH_ROUNDS` overrides it (1 under callgrind).
+fn rounds() -> usize {
+    std::env::var("VDLOD_BENCH_ROUNDS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(300)
+}
 
+#[inline(never)]
 fn whole<M: MeshSource>(mesh: &M, params: &vdlod_raster::DrawParams, buf: &mut Buffers) -> u32 {
     let shaded = shade(mesh, params, W, H, &mut buf.scratch).expect("shades");
     let mut t = Target::new(&mut buf.color, &mut buf.depth, W, H).expect("target");
@@ -31,6 +38,19 @@ fn whole<M: MeshSource>(mesh: &M, params: &vdlod_raster::DrawParams, buf: &mut B
     shaded.draw(&mut t).expect("draws").rasterized
 }
 
+/// Bands without bins (a function of its own, so that profiles tell the two apart).
+#[inline(never)]
+fn plain<M: MeshSource>(m: &M, p: &vdlod_raster::DrawParams, b: &mut Buffers, rows: usize) -> u32 {
+    banded(m, p, b, rows, false)
+}
+
+/// Bands with row bins.
+#[inline(never)]
+fn binned<M: MeshSource>(m: &M, p: &vdlod_raster::DrawParams, b: &mut Buffers, rows: usize) -> u32 {
+    banded(m, p, b, rows, true)
+}
+
+#[inline(always)]
 fn banded<M: MeshSource>(
     mesh: &M,
     params: &vdlod_raster::DrawParams,
@@ -72,15 +92,15 @@ fn run<M: MeshSource>(name: &str, mesh: &M, params: &vdlod_raster::DrawParams) {
         bins: vec![[0; 2]; mesh.triangles().len()],
     };
     let mut times = [Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new()];
-    for _ in 0..ROUNDS {
+    for _ in 0..rounds() {
         for (k, t) in times.iter_mut().enumerate() {
             let start = Instant::now();
             black_box(match k {
                 0 => whole(mesh, params, &mut buf),
-                1 => banded(mesh, params, &mut buf, 16, false),
-                2 => banded(mesh, params, &mut buf, 40, false),
-                3 => banded(mesh, params, &mut buf, 16, true),
-                _ => banded(mesh, params, &mut buf, 40, true),
+                1 => plain(mesh, params, &mut buf, 16),
+                2 => plain(mesh, params, &mut buf, 40),
+                3 => binned(mesh, params, &mut buf, 16),
+                _ => binned(mesh, params, &mut buf, 40),
             });
             t.push(start.elapsed().as_secs_f64() * 1e6);
         }
@@ -127,6 +147,9 @@ fn main() {
         &cut_mesh,
         &params,
     );
+    if std::env::var_os("VDLOD_BENCH_CUT_ONLY").is_some() {
+        return;
+    }
     run(
         &format!("full bunny, {} triangles", mesh.triangles.len()),
         &mesh.as_raster_mesh(),

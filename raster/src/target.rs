@@ -372,10 +372,22 @@ impl<'a, P: Pixel, D: Depth> Target<'a, P, D> {
         })
     }
 
-    /// Fills the colour buffer with `background` and the depth buffer with [`Depth::CLEAR`].
+    /// Fills the window's pixels with `background` and their depths with [`Depth::CLEAR`]
+    /// (the padding after each row, and whatever the slices hold past the window, are left as
+    /// they are).
     pub fn clear(&mut self, background: P) {
-        self.color.fill(background);
-        self.depth.fill(D::CLEAR);
+        let (width, rows, stride) = (self.window.width, self.window.height, self.stride);
+        if stride == width {
+            let len = width * rows;
+            self.color[..len].fill(background);
+            self.depth[..len].fill(D::CLEAR);
+        } else {
+            for y in 0..rows {
+                let row = y * stride..y * stride + width;
+                self.color[row.clone()].fill(background);
+                self.depth[row].fill(D::CLEAR);
+            }
+        }
     }
 
     /// Frame width in pixels.
