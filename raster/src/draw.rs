@@ -404,6 +404,23 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
                 target: (target.width, target.height),
             });
         }
+        // Two copies of the loop, so that the whole-frame draw pays nothing for the bins.
+        Ok(match self.bins {
+            Some((rows, whole)) => {
+                self.draw_triangles::<P, D, true>(target, rows);
+                whole
+            }
+            None => self.draw_triangles::<P, D, false>(target, &[]),
+        })
+    }
+
+    /// The triangle loop and the wireframe pass; with `BINNED`, triangles whose `rows` miss the
+    /// target's window are skipped.
+    fn draw_triangles<P: Pixel, D: Depth, const BINNED: bool>(
+        &self,
+        target: &mut Target<'_, P, D>,
+        rows: &[[u16; 2]],
+    ) -> DrawStats {
         let (mesh, params, scratch) = (self.mesh, self.params, self.vertices);
         let viewport = &self.viewport;
         let prepared = self.lighting.as_ref();
@@ -425,12 +442,11 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
                 }
             };
         let (top, bottom) = (target.window.y, target.window.y + target.window.height - 1);
-        let misses = |t: usize| match self.bins {
-            Some((rows, _)) => {
+        let misses = |t: usize| {
+            BINNED && {
                 let [first, last] = rows[t].map(usize::from);
                 last < top || first > bottom
             }
-            None => false,
         };
         for (t, tri) in mesh.triangles().iter().enumerate() {
             if misses(t) {
@@ -505,7 +521,7 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
                 }
             }
         }
-        Ok(self.bins.map_or(stats, |(_, whole)| whole))
+        stats
     }
 }
 
