@@ -58,15 +58,17 @@ fn banded<M: MeshSource>(
     rows: usize,
     binned: bool,
 ) -> u32 {
-    let mut shaded = shade(mesh, params, W, H, &mut buf.scratch).expect("shades");
-    if binned {
-        shaded = shaded.bin(&mut buf.bins).expect("bins");
-    }
+    let shaded = shade(mesh, params, W, H, &mut buf.scratch).expect("shades");
+    let binned = binned.then(|| shaded.bin(&mut buf.bins).expect("bins"));
     let mut n = 0;
     for band in Window::bands(W, H, rows) {
         let mut t = Target::window(&mut buf.color, &mut buf.depth, W, H, band, W).expect("band");
         t.clear(Rgb565(0));
-        n = shaded.draw(&mut t).expect("draws").rasterized;
+        let stats = match &binned {
+            Some(b) => b.draw(&mut t),
+            None => shaded.draw(&mut t),
+        };
+        n = stats.expect("draws").rasterized;
         black_box(t.color());
     }
     n

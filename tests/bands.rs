@@ -75,10 +75,8 @@ fn windowed<D: Depth>(
 ) -> (Vec<Rgba8>, Vec<D>) {
     let mut scratch = vec![ShadedVertex::default(); mesh.positions.len()];
     let mut rows = vec![[0u16; 2]; mesh.triangles.len()];
-    let mut shaded = shade(mesh, params, W, H, &mut scratch).unwrap();
-    if binned {
-        shaded = shaded.bin(&mut rows).unwrap();
-    }
+    let shaded = shade(mesh, params, W, H, &mut scratch).unwrap();
+    let binned = binned.then(|| shaded.bin(&mut rows).unwrap());
     let rows = windows.iter().map(|w| w.height).max().unwrap();
     let (mut color, mut depth) = (vec![BG; W * H], vec![D::CLEAR; W * H]);
     let sentinel = Rgba8([1, 2, 3, 4]);
@@ -91,7 +89,10 @@ fn windowed<D: Depth>(
             c[y * stride..y * stride + w.width].fill(BG);
         }
         let mut target = Target::window(&mut c[..len], &mut d[..len], W, H, w, stride).unwrap();
-        let s = shaded.draw(&mut target).unwrap();
+        let s = match &binned {
+            Some(b) => b.draw(&mut target).unwrap(),
+            None => shaded.draw(&mut target).unwrap(),
+        };
         // Every window reports the whole frame's statistics.
         assert_eq!(*stats.get_or_insert(s), s, "window {w:?}");
         assert_eq!(s, whole_stats(mesh, params), "window {w:?}");

@@ -221,7 +221,7 @@ fn bunny_cut_in_bands_rgb565_u16_depth() {
             depth: &mut depth,
             rows: 16,
             background: Rgb565::from_rgb(24, 26, 32),
-            bins: Some(&mut bins),
+            bins: &mut bins,
         };
         let style = vdlod_demo::render::style(Shading::Gouraud, false);
         vdlod::draw_bands(bands, &cut, &h, &camera, &style, &mut scratch, |band| {

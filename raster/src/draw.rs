@@ -245,7 +245,7 @@ pub fn draw_indexed<P: Pixel, D: Depth, M: MeshSource>(
 
 /// A mesh after the vertex stage of one frame, ready to be drawn into the whole frame or into any
 /// window of it, as often as needed (once per band), without shading its vertices again.
-#[derive(Clone, Copy, Debug)]
+#[derive(Debug)]
 pub struct ShadedMesh<'a, M: MeshSource> {
     mesh: &'a M,
     params: &'a DrawParams,
@@ -253,7 +253,46 @@ pub struct ShadedMesh<'a, M: MeshSource> {
     lighting: Option<PreparedLighting>,
     viewport: Viewport,
     frame: (usize, usize),
-    bins: Option<(&'a [[u16; 2]], DrawStats)>,
+}
+
+/// A [`ShadedMesh`] with its triangles binned by pixel row ([`ShadedMesh::bin`]), for a frame
+/// drawn in bands: each band skips the triangles that miss it after reading four bytes.
+#[derive(Debug)]
+pub struct BinnedMesh<'a, M: MeshSource> {
+    shaded: ShadedMesh<'a, M>,
+    rows: &'a [[u16; 2]],
+    stats: DrawStats,
+}
+
+// By hand: a derive would ask `M: Copy`, and both hold only references and plain values.
+impl<M: MeshSource> Clone for ShadedMesh<'_, M> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<M: MeshSource> Copy for ShadedMesh<'_, M> {}
+
+impl<M: MeshSource> Clone for BinnedMesh<'_, M> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<M: MeshSource> Copy for BinnedMesh<'_, M> {}
+
+impl<M: MeshSource> BinnedMesh<'_, M> {
+    /// Draws the triangles that meet `target`'s window, which must be (a window of) the frame
+    /// the mesh was shaded for; returns the statistics of the whole frame, counted by
+    /// [`ShadedMesh::bin`].
+    pub fn draw<P: Pixel, D: Depth>(
+        &self,
+        target: &mut Target<'_, P, D>,
+    ) -> Result<DrawStats, DrawError> {
+        self.shaded.check_frame(target)?;
+        self.shaded.draw_triangles::<P, D, true>(target, self.rows);
+        Ok(self.stats)
+    }
 }
 
 /// Runs the vertex stage of `mesh` for a `width` by `height` frame into `scratch` (at least one
@@ -314,7 +353,6 @@ pub fn shade<'a, M: MeshSource>(
         lighting: prepared,
         viewport,
         frame: (width, height),
-        bins: None,
     })
 }
 
@@ -323,7 +361,7 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
     /// the triangles that miss it after reading four bytes, instead of three shaded vertices.
     /// `rows` needs one entry per triangle (4 bytes each) and holds each triangle's first and
     /// last row. The statistics of the whole frame are counted here, and every draw returns them.
-    pub fn bin(self, rows: &'a mut [[u16; 2]]) -> Result<ShadedMesh<'a, M>, DrawError> {
+    pub fn bin(self, rows: &'a mut [[u16; 2]]) -> Result<BinnedMesh<'a, M>, DrawError> {
         let triangles = self.mesh.triangles();
         if rows.len() < triangles.len() {
             return Err(DrawError::BinsTooSmall {
@@ -386,9 +424,10 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
                 *row = [0, last as u16];
             }
         }
-        Ok(ShadedMesh {
-            bins: Some((rows, stats)),
-            ..self
+        Ok(BinnedMesh {
+            shaded: self,
+            rows,
+            stats,
         })
     }
 
@@ -398,24 +437,24 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
         &self,
         target: &mut Target<'_, P, D>,
     ) -> Result<DrawStats, DrawError> {
-        if (target.width, target.height) != self.frame {
-            return Err(DrawError::FrameMismatch {
+        self.check_frame(target)?;
+        Ok(self.draw_triangles::<P, D, false>(target, &[]))
+    }
+
+    fn check_frame<P: Pixel, D: Depth>(&self, target: &Target<'_, P, D>) -> Result<(), DrawError> {
+        if (target.width, target.height) == self.frame {
+            Ok(())
+        } else {
+            Err(DrawError::FrameMismatch {
                 shaded: self.frame,
                 target: (target.width, target.height),
-            });
+            })
         }
-        // Two copies of the loop, so that the whole-frame draw pays nothing for the bins.
-        Ok(match self.bins {
-            Some((rows, whole)) => {
-                self.draw_triangles::<P, D, true>(target, rows);
-                whole
-            }
-            None => self.draw_triangles::<P, D, false>(target, &[]),
-        })
     }
 
     /// The triangle loop and the wireframe pass; with `BINNED`, triangles whose `rows` miss the
-    /// target's window are skipped.
+    /// target's window are skipped (two copies of the loop, so that a whole-frame draw pays
+    /// nothing for the bins, and a device that always bins carries one).
     fn draw_triangles<P: Pixel, D: Depth, const BINNED: bool>(
         &self,
         target: &mut Target<'_, P, D>,

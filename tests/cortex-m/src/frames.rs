@@ -243,7 +243,7 @@ pub fn run_frames(bytes: &[u8], report: &mut impl FnMut(Report)) -> Result<(), R
             depth: &mut draw.depth[..],
             rows: BAND_ROWS,
             background: Rgb565::from_rgb(24, 26, 32).into(),
-            bins: Some(&mut draw.bins[..]),
+            bins: &mut draw.bins[..],
         };
         // Hashing a band is part of the flush: a device would send it to its panel here.
         let mut hashing = 0u64;
