@@ -250,11 +250,13 @@ pub(crate) fn scan<P: Pixel, D: Depth, F>(
     ];
     let attrs = Attrs::new(v, area);
     let (x0, x1) = (x0 as usize, x1 as usize);
+    let (span, stride) = (x1 - x0, target.stride);
+    let mut first = target.index(x0, y0 as usize);
     let mut row = [e[0].start, e[1].start, e[2].start];
-    for y in y0 as usize..=y1 as usize {
-        let (first, last) = (target.index(x0, y), target.index(x1, y));
-        let crow = &mut target.color[first..=last];
-        let drow = &mut target.depth[first..=last];
+    for _ in y0..=y1 {
+        let crow = &mut target.color[first..=first + span];
+        let drow = &mut target.depth[first..=first + span];
+        first += stride;
         let [mut e0, mut e1, mut e2] = row;
         let mut entered = false;
         for (c, d) in crow.iter_mut().zip(drow.iter_mut()) {

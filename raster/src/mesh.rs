@@ -40,6 +40,21 @@ pub struct SourceVertex {
     pub color: [u8; 3],
 }
 
+/// Vertices per [`VertexBatch`]: two AVX or four SSE/NEON registers per attribute.
+pub const BATCH: usize = 8;
+
+/// Up to [`BATCH`] vertices attribute by attribute (structure of arrays), as the vertex stage
+/// transforms them: `positions[axis][lane]`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct VertexBatch {
+    /// Object-space positions.
+    pub positions: [[f32; BATCH]; 3],
+    /// Object-space normals.
+    pub normals: [[f32; BATCH]; 3],
+    /// Colour channels in `0.0..=255.0`.
+    pub colors: [[f32; BATCH]; 3],
+}
+
 /// A triangle mesh the rasterizer can draw: triangles over vertices it reads by index.
 ///
 /// Implementations must be consistent: the same index gives the same vertex for the whole draw.
@@ -52,13 +67,19 @@ pub trait MeshSource {
     fn triangles(&self) -> &[[Self::Index; 3]];
     /// Vertex `i` (below [`MeshSource::vertex_count`]).
     fn vertex(&self, i: usize) -> SourceVertex;
-    /// Vertices `first..first + out.len()` (all below [`MeshSource::vertex_count`]) into `out`:
-    /// how the vertex stage reads them, eight at a time; override when a batch is cheaper than
-    /// its vertices one by one.
+    /// Vertices `first..first + len` (`len` at most [`BATCH`], all below
+    /// [`MeshSource::vertex_count`]) into the first `len` lanes of `out`, which arrives zeroed:
+    /// how the vertex stage reads a mesh; override when a batch is cheaper than its vertices one
+    /// by one. The colours are used only when [`MeshSource::has_colors`].
     #[inline(always)]
-    fn batch(&self, first: usize, out: &mut [SourceVertex]) {
-        for (k, o) in out.iter_mut().enumerate() {
-            *o = self.vertex(first + k);
+    fn batch(&self, first: usize, len: usize, out: &mut VertexBatch) {
+        for k in 0..len.min(BATCH) {
+            let v = self.vertex(first + k);
+            for a in 0..3 {
+                out.positions[a][k] = v.position[a];
+                out.normals[a][k] = v.normal[a];
+                out.colors[a][k] = v.color[a] as f32;
+            }
         }
     }
     /// The position of vertex `i`; override when it is cheaper than the whole vertex.
@@ -144,20 +165,26 @@ impl<I: VertexIndex> MeshSource for Mesh<'_, I> {
     }
 
     #[inline(always)]
-    fn batch(&self, first: usize, out: &mut [SourceVertex]) {
+    fn batch(&self, first: usize, len: usize, out: &mut VertexBatch) {
         // Slices checked once per batch, attributes copied array by array.
-        let end = first + out.len();
-        for (o, p) in out.iter_mut().zip(&self.positions[first..end]) {
-            o.position = *p;
+        let end = first + len.min(BATCH);
+        for (k, q) in self.positions[first..end].iter().enumerate() {
+            for a in 0..3 {
+                out.positions[a][k] = q[a];
+            }
         }
         if let Some(normals) = self.normals {
-            for (o, n) in out.iter_mut().zip(&normals[first..end]) {
-                o.normal = *n;
+            for (k, q) in normals[first..end].iter().enumerate() {
+                for a in 0..3 {
+                    out.normals[a][k] = q[a];
+                }
             }
         }
         if let Some(colors) = self.colors {
-            for (o, c) in out.iter_mut().zip(&colors[first..end]) {
-                o.color = *c;
+            for (k, c) in colors[first..end].iter().enumerate() {
+                for a in 0..3 {
+                    out.colors[a][k] = c[a] as f32;
+                }
             }
         }
     }

@@ -9,7 +9,7 @@ use glam::{Mat3, Mat4, Vec3, Vec4};
 
 use crate::clip::{self, GUARD_BAND};
 use crate::edge::{ScreenVertex, DEPTH_MAX, SUBPIXEL_ONE};
-use crate::mesh::{MeshSource, SourceVertex};
+use crate::mesh::{MeshSource, VertexBatch, BATCH};
 
 /// One directional light plus an ambient term.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -230,8 +230,8 @@ impl PreparedLighting {
     }
 }
 
-/// Vertices per batch of [`shade_vertices`]: two AVX or four SSE/NEON registers per attribute.
-const LANES: usize = 8;
+/// Vertices per batch of [`shade_vertices`].
+const LANES: usize = BATCH;
 
 /// Runs the vertex stage over a whole mesh.
 ///
@@ -243,6 +243,7 @@ const LANES: usize = 8;
 /// vertices take the mesh's colours, or `base` when it has none.
 ///
 /// `out` must hold exactly the mesh's vertices ([`crate::shade`] checks this).
+#[inline(never)] // one stage, one profile entry; inlining it gains nothing
 pub fn shade_vertices<M: MeshSource>(
     mvp: &Mat4,
     viewport: &Viewport,
@@ -256,24 +257,14 @@ pub fn shade_vertices<M: MeshSource>(
     for (first, out) in (0..).step_by(LANES).zip(out.chunks_mut(LANES)) {
         let len = out.len();
         // Gather the batch; lanes past the end of the mesh hold zeros and are not stored.
-        let mut p = [[0.0f32; LANES]; 3];
-        let mut n = [[0.0f32; LANES]; 3];
-        let mut rgb = [[0.0f32; LANES]; 3];
-        let mut batch = [SourceVertex::default(); LANES];
-        mesh.batch(first, &mut batch[..len]);
-        for (k, v) in batch[..len].iter().enumerate() {
-            for a in 0..3 {
-                p[a][k] = v.position[a];
-                n[a][k] = v.normal[a];
-            }
-        }
-        if colors {
-            for (k, v) in batch[..len].iter().enumerate() {
-                for (channel, c) in rgb.iter_mut().zip(v.color) {
-                    channel[k] = c as f32;
-                }
-            }
-        } else {
+        let mut batch = VertexBatch::default();
+        mesh.batch(first, len, &mut batch);
+        let VertexBatch {
+            positions: p,
+            normals: n,
+            colors: mut rgb,
+        } = batch;
+        if !colors {
             for (channel, b) in rgb.iter_mut().zip(base) {
                 *channel = [b; LANES];
             }
