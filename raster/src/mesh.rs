@@ -142,6 +142,16 @@ fn check_len(attribute: &'static str, expected: usize, actual: usize) -> Result<
     }
 }
 
+/// Copies up to [`BATCH`] triples into lanes: `lanes[axis][k] = f(triples[k][axis])`.
+#[inline(always)]
+fn transpose<T: Copy>(triples: &[[T; 3]], lanes: &mut [[f32; BATCH]; 3], f: impl Fn(T) -> f32) {
+    for (k, t) in triples.iter().enumerate().take(BATCH) {
+        for (lane, &c) in lanes.iter_mut().zip(t) {
+            lane[k] = f(c);
+        }
+    }
+}
+
 impl<I: VertexIndex> MeshSource for Mesh<'_, I> {
     type Index = I;
 
@@ -168,24 +178,12 @@ impl<I: VertexIndex> MeshSource for Mesh<'_, I> {
     fn batch(&self, first: usize, len: usize, out: &mut VertexBatch) {
         // Slices checked once per batch, attributes copied array by array.
         let end = first + len.min(BATCH);
-        for (k, q) in self.positions[first..end].iter().enumerate() {
-            for a in 0..3 {
-                out.positions[a][k] = q[a];
-            }
-        }
+        transpose(&self.positions[first..end], &mut out.positions, |c| c);
         if let Some(normals) = self.normals {
-            for (k, q) in normals[first..end].iter().enumerate() {
-                for a in 0..3 {
-                    out.normals[a][k] = q[a];
-                }
-            }
+            transpose(&normals[first..end], &mut out.normals, |c| c);
         }
         if let Some(colors) = self.colors {
-            for (k, c) in colors[first..end].iter().enumerate() {
-                for a in 0..3 {
-                    out.colors[a][k] = c[a] as f32;
-                }
-            }
+            transpose(&colors[first..end], &mut out.colors, |c| c as f32);
         }
     }
 
