@@ -93,18 +93,8 @@ impl From<Rgb888> for Rgba8 {
     }
 }
 
-impl Pixel for EgRgb565 {
-    /// Exactly [`Rgb565::from_rgb`].
-    #[inline(always)]
-    fn from_rgb(r: u8, g: u8, b: u8) -> Self {
-        Rgb565::from_rgb(r, g, b).into()
-    }
-    /// Exactly [`Rgb565::to_rgb`].
-    #[inline(always)]
-    fn to_rgb(self) -> [u8; 3] {
-        Rgb565::from(self).to_rgb()
-    }
-}
+// Exactly [`Rgb565::from_rgb`] and [`Rgb565::to_rgb`].
+crate::target::pixel_via_rgb565!(EgRgb565);
 
 impl Pixel for Bgr565 {
     /// The channels of [`Rgb565::from_rgb`], blue in the high bits.

@@ -399,12 +399,7 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
                 if first <= end {
                     *row = [first as u16, end as u16];
                 }
-            } else if union & clip::INVALID != 0 {
-                stats.invalid += 1;
-            } else if v[0].outcode & v[1].outcode & v[2].outcode != 0 {
-                stats.outside += 1;
-            } else {
-                stats.clipped += 1;
+            } else if needs_clipping(&v, union, &mut stats) {
                 for_each_clipped(
                     &self.viewport,
                     params,
@@ -518,12 +513,7 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
                     rgb: colors[k],
                 });
                 scan(target, &s, area.abs(), bounds, depth_test::<P, D>);
-            } else if union & clip::INVALID != 0 {
-                stats.invalid += 1;
-            } else if v[0].outcode & v[1].outcode & v[2].outcode != 0 {
-                stats.outside += 1;
-            } else {
-                stats.clipped += 1;
+            } else if needs_clipping(&v, union, &mut stats) {
                 let colors = triangle_colors(mesh, params, prepared, t, tri, &v);
                 for_each_clipped(viewport, params, mesh, tri, colors, union, |s| {
                     fill(target, &mut stats, s)
@@ -561,6 +551,23 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
             }
         }
         stats
+    }
+}
+
+/// Whether a triangle with a vertex outside the clipping volume (outcodes' union `union`, not 0)
+/// is to be clipped; if not, it is counted as dropped for a non-finite vertex or as entirely
+/// outside one plane.
+#[inline(always)]
+fn needs_clipping(v: &[&ShadedVertex; 3], union: u8, stats: &mut DrawStats) -> bool {
+    if union & clip::INVALID != 0 {
+        stats.invalid += 1;
+        false
+    } else if v[0].outcode & v[1].outcode & v[2].outcode != 0 {
+        stats.outside += 1;
+        false
+    } else {
+        stats.clipped += 1;
+        true
     }
 }
 

@@ -134,16 +134,25 @@ impl From<Rgb565Be> for Rgb565 {
     }
 }
 
-impl Pixel for Rgb565Be {
-    #[inline(always)]
-    fn from_rgb(r: u8, g: u8, b: u8) -> Self {
-        Rgb565::from_rgb(r, g, b).into()
-    }
-    #[inline(always)]
-    fn to_rgb(self) -> [u8; 3] {
-        Rgb565::from(self).to_rgb()
-    }
+/// Implements [`Pixel`] for a 16-bit 5:6:5 type through its conversions to and from [`Rgb565`],
+/// so that every such format packs and unpacks exactly as [`Rgb565`] does.
+macro_rules! pixel_via_rgb565 {
+    ($t:ty) => {
+        impl $crate::target::Pixel for $t {
+            #[inline(always)]
+            fn from_rgb(r: u8, g: u8, b: u8) -> Self {
+                $crate::target::Rgb565::from_rgb(r, g, b).into()
+            }
+            #[inline(always)]
+            fn to_rgb(self) -> [u8; 3] {
+                $crate::target::Rgb565::from(self).to_rgb()
+            }
+        }
+    };
 }
+pub(crate) use pixel_via_rgb565;
+
+pixel_via_rgb565!(Rgb565Be);
 
 /// A rectangle of a frame, in pixels: the part of it a [`Target`]'s buffers hold.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
