@@ -243,7 +243,7 @@ const LANES: usize = BATCH;
 /// vertices take the mesh's colours, or `base` when it has none.
 ///
 /// `out` must hold exactly the mesh's vertices ([`crate::shade`] checks this).
-#[inline(never)] // one stage, one profile entry; inlining it gains nothing
+#[inline]
 pub fn shade_vertices<M: MeshSource>(
     mvp: &Mat4,
     viewport: &Viewport,
