@@ -10,6 +10,25 @@ use glam::{Mat4, Vec3};
 use vdlod_core::policy::View;
 
 /// A perspective camera looking at a point, with the size of the frame it draws.
+///
+/// ```
+/// use vdlod::{glam::Vec3, Camera};
+/// let camera = Camera {
+///     eye: Vec3::new(0.0, 1.0, 4.0),
+///     target: Vec3::ZERO,
+///     up: Vec3::Y,
+///     fov_y: 1.0,
+///     near: 0.5,
+///     far: 10.0,
+///     width: 320,
+///     height: 240,
+/// };
+/// camera.check().unwrap();
+/// let view = camera.view(); // for the refinement policy
+/// let mvp = camera.view_projection(); // for the rasterizer
+/// assert!((mvp * camera.target.extend(1.0)).w > 0.0);
+/// # let _ = view;
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {
     /// Eye position.

@@ -181,6 +181,30 @@ pub fn adapt<const V: usize, const F: usize, const Q: usize, I: SlotIndex, P: Po
 
 /// Draws `cut` as `camera` sees it into `target`, a whole frame of the camera's size (or a window
 /// of one). `scratch` needs one entry per vertex slot of the cut that is in use.
+///
+/// ```
+/// use vdlod::prelude::*;
+/// # fn main() -> Result<(), Box<dyn std::error::Error>> {
+/// # use vdlod::core::build::{build, InputMesh};
+/// # let positions = [[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]];
+/// # let triangles = [[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]];
+/// # let input = InputMesh { positions: &positions, colors: None, triangles: &triangles };
+/// # let bytes = build(&input, &Default::default(), &mut |_| {})?.to_bytes(false);
+/// let h = HierarchyView::parse(&bytes)?;
+/// let mut cut = Cut::<64, 128, 8>::boxed();
+/// cut.reset(&h)?;
+/// let (center, radius) = h.bounding_sphere();
+/// let camera = Orbit::merge_tree(center.into(), radius, 8).viewport(40, 30).camera(1);
+/// vdlod::adapt(&mut cut, &h, &camera, &QRefine::new(1.0), &Budget::default())?;
+/// let (mut color, mut depth) = (vec![Rgba8([0, 0, 0, 255]); 40 * 30], vec![0u32; 40 * 30]);
+/// let mut target = Target::new(&mut color, &mut depth, 40, 30)?;
+/// target.clear(Rgba8([0, 0, 0, 255]));
+/// let mut scratch = vec![ShadedVertex::default(); cut.vertex_count()];
+/// let stats = vdlod::draw(&mut target, &cut, &h, &camera, &Style::default(), &mut scratch)?;
+/// assert!(stats.rasterized > 0);
+/// # Ok(())
+/// # }
+/// ```
 #[allow(clippy::too_many_arguments)]
 pub fn draw<P: Pixel, D: Depth, const V: usize, const F: usize, const Q: usize, I>(
     target: &mut Target<'_, P, D>,
