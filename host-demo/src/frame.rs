@@ -5,9 +5,9 @@
 
 use std::path::Path;
 
-use vdlod::core::cut::{Cut, SlotIndex};
-use vdlod::core::format::HierarchyView;
 use vdlod::{Camera, Style};
+use vdlod_core::cut::{Cut, SlotIndex};
+use vdlod_core::format::HierarchyView;
 use vdlod_raster::{
     draw_indexed, DrawParams, DrawStats, MeshSource, Rgba8, ShadedVertex, Target, VertexIndex,
 };
@@ -43,6 +43,16 @@ impl std::fmt::Display for FrameError {
 }
 
 impl std::error::Error for FrameError {}
+
+impl From<vdlod::FrameError> for FrameError {
+    fn from(e: vdlod::FrameError) -> Self {
+        match e {
+            vdlod::FrameError::Camera(e) => FrameError::Camera(e),
+            vdlod::FrameError::Target(e) => FrameError::Target(e),
+            vdlod::FrameError::Draw(e) => FrameError::Draw(e),
+        }
+    }
+}
 
 /// An RGBA8 frame with its depth buffer and vertex scratch.
 pub struct Frame {
@@ -130,11 +140,7 @@ impl Frame {
         let result = {
             let mut target = self.target()?;
             target.clear(BACKGROUND);
-            vdlod::draw(&mut target, cut, h, camera, style, &mut scratch).map_err(|e| match e {
-                vdlod::FrameError::Camera(e) => FrameError::Camera(e),
-                vdlod::FrameError::Target(e) => FrameError::Target(e),
-                vdlod::FrameError::Draw(e) => FrameError::Draw(e),
-            })
+            vdlod::draw(&mut target, cut, h, camera, style, &mut scratch).map_err(FrameError::from)
         };
         self.scratch = scratch;
         result

@@ -6,6 +6,7 @@ use std::io::Write as _;
 use std::path::Path;
 use std::time::Instant;
 
+use vdlod::Style;
 use vdlod_core::adapt::{Budget, FrameStats};
 use vdlod_core::cut::{Coloring, Cut, SlotIndex};
 use vdlod_core::format::HierarchyView;
@@ -20,7 +21,6 @@ use crate::frame::{encode_png, Frame, FrameError};
 use crate::label;
 use crate::mesh::{vertex_normals, Bounds, IndexedMesh};
 use crate::render::style;
-use vdlod::Style;
 
 /// Calls `$body` with `$cut` bound to a new boxed cut of the smallest capacity class that holds
 /// `$vertices` vertices and `$triangles` triangles: 16-bit cuts up to 32,767 vertices and 65,534

@@ -6,9 +6,11 @@
 //! target's window, and fills it with a strict-less depth test. The wireframe overlay, when asked
 //! for, is drawn afterwards over the filled window. [`draw_indexed`] does both for a whole frame.
 //!
-//! A frame drawn in bands shades once and draws once per band: each band re-reads every
-//! triangle's three shaded vertices and its bounding box (a few nanoseconds per triangle on a
-//! desktop, no per-frame memory), and clips again the few triangles that need it.
+//! A frame drawn in bands shades once and draws once per band. [`ShadedMesh::draw`] re-reads every
+//! triangle's three shaded vertices in every band; [`ShadedMesh::bin`] records each triangle's rows
+//! once (4 bytes per triangle) so that [`BinnedMesh::draw`] skips the triangles that miss a band.
+//! Triangles that span several bands are set up once per band, and the few that need clipping are
+//! clipped again in each.
 
 use core::fmt;
 
@@ -370,7 +372,7 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
             });
         }
         let (params, scratch) = (self.params, self.vertices);
-        let cull = params.cull_back_faces;
+        let facing = Facing::culling(params.cull_back_faces);
         let last = self.frame.1 as i32 - 1;
         const EMPTY: [u16; 2] = [1, 0];
         let mut stats = DrawStats {
@@ -384,13 +386,13 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
             *row = EMPTY;
             if union == 0 {
                 let area = signed_area2_xy(v.map(|v| [v.x, v.y]));
-                if area == 0 || (area > 0 && cull) {
+                if facing.draws(area) {
+                    stats.rasterized += 1;
+                } else {
                     stats.culled += 1;
-                    if cull {
+                    if facing == Facing::Front {
                         continue; // neither filled nor outlined
                     }
-                } else {
-                    stats.rasterized += 1;
                 }
                 // Whole pixel rows: they hold the pixel centres filled and the wireframe's pixels.
                 let ys = v.map(|v| v.y >> SUBPIXEL_BITS);
@@ -408,8 +410,7 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
                     [[0.0; 3]; 3],
                     union,
                     |s| {
-                        let area = signed_area2(s);
-                        if area < 0 || (area > 0 && !cull) {
+                        if facing.draws(signed_area2(s)) {
                             stats.rasterized += 1;
                         } else {
                             stats.culled += 1;
@@ -458,11 +459,7 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
         let (mesh, params, scratch) = (self.mesh, self.params, self.vertices);
         let viewport = &self.viewport;
         let prepared = self.lighting.as_ref();
-        let facing = if params.cull_back_faces {
-            Facing::Front
-        } else {
-            Facing::Both
-        };
+        let facing = Facing::culling(params.cull_back_faces);
         let mut stats = DrawStats {
             submitted: mesh.triangles().len() as u32,
             ..DrawStats::default()
@@ -494,7 +491,7 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
                 // Cull before any colour work: half the triangles of a closed mesh face away.
                 let xy = v.map(|v| [v.x, v.y]);
                 let area = signed_area2_xy(xy);
-                if area == 0 || (area > 0 && params.cull_back_faces) {
+                if !facing.draws(area) {
                     stats.culled += 1;
                     continue;
                 }

@@ -73,6 +73,25 @@ pub enum Facing {
     Both,
 }
 
+impl Facing {
+    /// Whether a triangle of [`signed_area2`] `area` is drawn: front-facing ones (negative area)
+    /// always, back-facing ones with [`Facing::Both`], zero-area ones never.
+    #[inline(always)]
+    pub fn draws(self, area: i64) -> bool {
+        area < 0 || (area > 0 && self == Facing::Both)
+    }
+
+    /// [`Facing::Front`] when back faces are culled, else [`Facing::Both`].
+    #[inline(always)]
+    pub fn culling(cull_back_faces: bool) -> Facing {
+        if cull_back_faces {
+            Facing::Front
+        } else {
+            Facing::Both
+        }
+    }
+}
+
 /// What happened to a triangle handed to [`fill_triangle`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Coverage {
@@ -215,12 +234,13 @@ where
     F: FnMut(&mut P, &mut D, Fragment<'_>),
 {
     let area = signed_area2(tri);
+    if !facing.draws(area) {
+        return Coverage::Culled;
+    }
     let v = if area < 0 {
         [tri[0], tri[2], tri[1]]
-    } else if area > 0 && facing == Facing::Both {
-        *tri
     } else {
-        return Coverage::Culled;
+        *tri
     };
     if let Some(bounds) = pixel_bounds(v.map(|v| [v.x, v.y]), &target.window) {
         scan(target, &v, area.abs(), bounds, plot);

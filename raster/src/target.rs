@@ -150,6 +150,7 @@ macro_rules! pixel_via_rgb565 {
         }
     };
 }
+#[cfg(feature = "embedded-graphics")]
 pub(crate) use pixel_via_rgb565;
 
 pixel_via_rgb565!(Rgb565Be);

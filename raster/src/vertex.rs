@@ -230,9 +230,6 @@ impl PreparedLighting {
     }
 }
 
-/// Vertices per batch of [`shade_vertices`].
-const LANES: usize = BATCH;
-
 /// Runs the vertex stage over a whole mesh.
 ///
 /// Vertices go through in batches of eight, attribute by attribute (structure of arrays), so that
@@ -254,7 +251,7 @@ pub fn shade_vertices<M: MeshSource>(
 ) {
     let m = mvp.to_cols_array_2d();
     let colors = mesh.has_colors();
-    for (first, out) in (0..).step_by(LANES).zip(out.chunks_mut(LANES)) {
+    for (first, out) in (0..).step_by(BATCH).zip(out.chunks_mut(BATCH)) {
         let len = out.len();
         // Gather the batch; lanes past the end of the mesh hold zeros and are not stored.
         let mut batch = VertexBatch::default();
@@ -266,34 +263,34 @@ pub fn shade_vertices<M: MeshSource>(
         } = batch;
         if !colors {
             for (channel, b) in rgb.iter_mut().zip(base) {
-                *channel = [b; LANES];
+                *channel = [b; BATCH];
             }
         }
 
         // Clip space, in the order of `to_clip`: x, y, z columns, then the translation.
-        let mut clip = [[0.0f32; LANES]; 4];
+        let mut clip = [[0.0f32; BATCH]; 4];
         for (r, row) in clip.iter_mut().enumerate() {
-            for k in 0..LANES {
+            for k in 0..BATCH {
                 row[k] = m[0][r] * p[0][k] + m[1][r] * p[1][k] + m[2][r] * p[2][k] + m[3][r];
             }
         }
-        let mut light = [1.0f32; LANES];
+        let mut light = [1.0f32; BATCH];
         if let Some(p) = lighting {
             for (k, l) in light.iter_mut().enumerate() {
                 *l = p.intensity(Vec3::new(n[0][k], n[1][k], n[2][k]));
             }
         }
-        let mut screen = [(0, 0, 0.0f32); LANES];
+        let mut screen = [(0, 0, 0.0f32); BATCH];
         for (k, s) in screen.iter_mut().enumerate() {
             *s = viewport.project_xyz(clip[0][k], clip[1][k], clip[2][k], clip[3][k]);
         }
-        let mut lit = [[0u8; LANES]; 3];
+        let mut lit = [[0u8; BATCH]; 3];
         for a in 0..3 {
-            for k in 0..LANES {
+            for k in 0..BATCH {
                 lit[a][k] = saturate_u8(rgb[a][k] * light[k]);
             }
         }
-        let mut code = [0u8; LANES];
+        let mut code = [0u8; BATCH];
         for (k, code) in code.iter_mut().enumerate() {
             *code = clip::outcode(Vec4::new(clip[0][k], clip[1][k], clip[2][k], clip[3][k]));
         }

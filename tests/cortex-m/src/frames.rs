@@ -1,9 +1,10 @@
 //! The work of one run, identical on the device and on the host: parse the hierarchy in place,
-//! fly eight frames of the peer orbit with a cut for a triangle budget (5,000 by default), hash each frame.
+//! fly eight frames of the peer orbit with a cut for a triangle budget (5,000 by default), hash
+//! each frame.
 //!
-//! Each frame is adapted and drawn through the facade (`vdlod::adapt`, `vdlod::draw_bands`): 320x240
-//! in bands of 16 rows, byte-swapped Rgb565 as an SPI panel takes it, 16-bit depth, triangles binned
-//! by row once per frame. Everything large is a `static` (the cut, the raster scratch, the bins and
+//! Each frame is adapted and drawn through the facade (`vdlod::adapt`, `vdlod::draw_bands`):
+//! 320x240 by default, in bands of 16 rows, byte-swapped Rgb565 as an SPI panel takes it, 16-bit
+//! depth, triangles binned by row once per frame. Everything large is a `static` (the cut, the raster scratch, the bins and
 //! one band), so it lands in `.bss` and the symbol table shows what each costs; nothing big ever
 //! passes through the stack, and the vertices are read from the hierarchy in flash, never copied.
 
