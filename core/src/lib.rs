@@ -19,3 +19,4 @@ pub mod cut;
 pub mod format;
 mod nodemap;
 pub mod policy;
+pub mod wavelet;

@@ -1,0 +1,718 @@
+//! Writing semi-regular files: the base mesh's topology, the positions of every level, and
+//! per wavelet the bounds the run-time tests read (Azuma et al. §3.3).
+//!
+//! For each wavelet, over the image of its support (its one-ring at its own level):
+//!
+//! - the radius of the sphere around its vertex holding every finest vertex of the support
+//!   (the view-frustum test, §3.3.1);
+//! - the cone of normals around its vertex normal holding every finest triangle's normal (the
+//!   back-face and silhouette tests, §3.3.2);
+//! - the error spheroid of equation 3, aligned with the normal: at each finest vertex `q` of the
+//!   support, the error `rho(q) - rho_t(q)` when the wavelet is left out. The paper computes it
+//!   with every coarser wavelet in and every sibling out, and notes that a sibling coming in can
+//!   raise the error. Here the bound holds for every set the cut can be in: the wavelet and its
+//!   descendants are out, its ancestors are in, and every other wavelet whose hat is not zero at
+//!   `q` may be in or out. Along the normal the extremes of those sums are exact; across it the
+//!   lengths add. The ratio `a / b` is that of the largest along and across parts (equation 3),
+//!   and the spheroid is then scaled to hold every vertex's worst case.
+//!
+//! Bounds are then made monotonic down the dependency graph (a parent's sphere holds its
+//! children's, its cone theirs, its `a` and `b` are at least theirs), so that a wavelet the tests
+//! want has parents the tests want too.
+
+use alloc::vec;
+use alloc::vec::Vec;
+use core::fmt;
+
+use super::format::{
+    Counts, SemiRegularView, CRC_OFFSET, FACE_SIZE, FLAG_COLORS, HEADER_SIZE, MAGIC, MAX_LEVELS,
+    NONE, VERSION, VERTEX_SIZE,
+};
+use super::lattice::{hex_len, Point};
+use crate::format::{crc32, encode_length, oct_decode, oct_encode, POSITION_STEPS};
+
+/// Why a semi-regular mesh cannot be made.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum SemiRegularBuildError {
+    /// No base face, or a base face names a vertex that is not there or names one twice.
+    BadFace(u32),
+    /// A base edge is run the same way twice or shared by more than two faces.
+    NotManifold {
+        /// One end.
+        a: u32,
+        /// The other end.
+        b: u32,
+    },
+    /// Levels outside `1..=12`, or more vertices than a file holds.
+    TooLarge,
+    /// A position is not finite.
+    NotFinite(u32),
+    /// The positions or colours do not match the vertex count.
+    Count {
+        /// What was given.
+        given: usize,
+        /// What the levels and base mesh need.
+        needed: usize,
+    },
+}
+
+impl fmt::Display for SemiRegularBuildError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::BadFace(face) => write!(f, "base face {face} is degenerate or out of range"),
+            Self::NotManifold { a, b } => {
+                write!(
+                    f,
+                    "base edge {a}-{b} is not manifold (or faces disagree on orientation)"
+                )
+            }
+            Self::TooLarge => write!(f, "levels must be 1 to 12 and the mesh below 2^31 vertices"),
+            Self::NotFinite(v) => write!(f, "vertex {v}'s position is not finite"),
+            Self::Count { given, needed } => write!(f, "{given} values given, {needed} needed"),
+        }
+    }
+}
+
+impl core::error::Error for SemiRegularBuildError {}
+
+/// A semi-regular mesh in memory: a base mesh, its levels, and every vertex's position (and
+/// colour) in the file's vertex order.
+#[derive(Clone, Debug)]
+pub struct SemiRegular {
+    /// The file's bytes with every record zero but positions (a view for the lattice walks).
+    skeleton: Vec<u8>,
+    /// Positions of every vertex, in file order.
+    pub positions: Vec<[f32; 3]>,
+    /// Colours of every vertex, if any.
+    pub colors: Option<Vec<[u8; 3]>>,
+}
+
+/// The file's face and edge sections for a base mesh: corners, edge ids in the order sides
+/// first name them, across links; and the edge count.
+fn topology(
+    vertices: u32,
+    faces: &[[u32; 3]],
+) -> Result<(Vec<u8>, Vec<u8>, u32), SemiRegularBuildError> {
+    use alloc::collections::BTreeMap;
+    if faces.is_empty() || faces.len() >= 1 << 29 {
+        return Err(SemiRegularBuildError::BadFace(0));
+    }
+    // Directed edge -> face side.
+    let mut sides: BTreeMap<(u32, u32), (u32, usize)> = BTreeMap::new();
+    for (f, c) in faces.iter().enumerate() {
+        if c.iter().any(|&v| v >= vertices) || c[0] == c[1] || c[1] == c[2] || c[0] == c[2] {
+            return Err(SemiRegularBuildError::BadFace(f as u32));
+        }
+        for k in 0..3 {
+            let (a, b) = (c[k], c[(k + 1) % 3]);
+            if sides.insert((a, b), (f as u32, k)).is_some() {
+                return Err(SemiRegularBuildError::NotManifold { a, b });
+            }
+        }
+    }
+    let mut edge_of = vec![[NONE; 3]; faces.len()];
+    let mut face_bytes = Vec::with_capacity(faces.len() * FACE_SIZE);
+    let mut owners: Vec<u32> = Vec::new();
+    for (f, c) in faces.iter().enumerate() {
+        for k in 0..3 {
+            let across = sides.get(&(c[(k + 1) % 3], c[k])).copied();
+            match across {
+                Some((g, kk)) if (g as usize, kk) < (f, k) => {
+                    edge_of[f][k] = edge_of[g as usize][kk]
+                }
+                _ => {
+                    edge_of[f][k] = owners.len() as u32;
+                    owners.push(((f as u32) << 2) | k as u32);
+                }
+            }
+        }
+    }
+    for (f, c) in faces.iter().enumerate() {
+        for v in c {
+            face_bytes.extend_from_slice(&v.to_le_bytes());
+        }
+        for e in edge_of[f] {
+            face_bytes.extend_from_slice(&e.to_le_bytes());
+        }
+        for k in 0..3 {
+            let a = match sides.get(&(c[(k + 1) % 3], c[k])) {
+                Some(&(g, kk)) => (g << 2) | kk as u32,
+                None => NONE,
+            };
+            face_bytes.extend_from_slice(&a.to_le_bytes());
+        }
+    }
+    let edges = owners.len() as u32;
+    let edge_bytes = owners.iter().flat_map(|o| o.to_le_bytes()).collect();
+    Ok((face_bytes, edge_bytes, edges))
+}
+
+/// Bytes of a file: header, faces, edges, vertex records, colours; the checksum filled in.
+#[allow(clippy::too_many_arguments)]
+fn file_bytes(
+    counts: Counts,
+    faces: &[u8],
+    edges: &[u8],
+    records: &[[u8; VERTEX_SIZE]],
+    colors: Option<&[[u8; 3]]>,
+    origin: [f32; 3],
+    extent: [f32; 3],
+    unit: f32,
+) -> Vec<u8> {
+    let mut out = vec![0u8; HEADER_SIZE];
+    out[0..4].copy_from_slice(&MAGIC);
+    out[4..6].copy_from_slice(&VERSION.to_le_bytes());
+    let flags = if colors.is_some() { FLAG_COLORS } else { 0 };
+    out[6..8].copy_from_slice(&flags.to_le_bytes());
+    for (k, v) in [
+        counts.levels,
+        counts.base_vertices,
+        counts.base_faces,
+        counts.base_edges,
+    ]
+    .iter()
+    .enumerate()
+    {
+        out[8 + 4 * k..12 + 4 * k].copy_from_slice(&v.to_le_bytes());
+    }
+    for (k, v) in origin.iter().chain(&extent).chain([&unit]).enumerate() {
+        let o = super::format::BOX_OFFSET + 4 * k;
+        out[o..o + 4].copy_from_slice(&v.to_le_bytes());
+    }
+    out.extend_from_slice(faces);
+    out.extend_from_slice(edges);
+    for r in records {
+        out.extend_from_slice(r);
+    }
+    if let Some(c) = colors {
+        for x in c {
+            out.extend_from_slice(x);
+        }
+    }
+    let crc = crc32(&out[HEADER_SIZE..]);
+    out[CRC_OFFSET..CRC_OFFSET + 4].copy_from_slice(&crc.to_le_bytes());
+    out
+}
+
+/// The box of `positions`, its 16-bit quantizer and the length unit (the diagonal).
+fn frame(positions: &[[f32; 3]]) -> ([f32; 3], [f32; 3], f32) {
+    let mut lo = [f32::MAX; 3];
+    let mut hi = [f32::MIN; 3];
+    for p in positions {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    let extent = [0, 1, 2].map(|k| (hi[k] - lo[k]).max(0.0));
+    let d = libm::sqrtf(extent.iter().map(|e| e * e).sum::<f32>());
+    let unit = if d.is_finite() && d > 0.0 { d } else { 1.0 };
+    (lo, extent, unit)
+}
+
+fn quantize(p: [f32; 3], origin: [f32; 3], extent: [f32; 3]) -> [u16; 3] {
+    [0, 1, 2].map(|k| {
+        let step = extent[k] / POSITION_STEPS;
+        if step > 0.0 {
+            libm::roundf((p[k] - origin[k]) / step).clamp(0.0, POSITION_STEPS) as u16
+        } else {
+            0
+        }
+    })
+}
+
+impl SemiRegular {
+    /// A semi-regular mesh over the base mesh `faces` (counter-clockwise, a manifold with or
+    /// without border, `base.len()` vertices) with `levels` subdivisions, where the vertex at
+    /// weights `w` (units of `1/2^levels`, see [`Point`]) of base face `f` is at `place(f, w)`
+    /// (base vertices are at `base`).
+    pub fn from_fn(
+        base: &[[f32; 3]],
+        faces: &[[u32; 3]],
+        levels: u32,
+        mut place: impl FnMut(u32, [i32; 3]) -> [f32; 3],
+    ) -> Result<SemiRegular, SemiRegularBuildError> {
+        if levels == 0 || levels > MAX_LEVELS || base.len() >= 1 << 30 {
+            return Err(SemiRegularBuildError::TooLarge);
+        }
+        let (face_bytes, edge_bytes, edges) = topology(base.len() as u32, faces)?;
+        let counts = Counts {
+            levels,
+            base_vertices: base.len() as u32,
+            base_faces: faces.len() as u32,
+            base_edges: edges,
+        };
+        if counts.vertices() >= 1 << 31 {
+            return Err(SemiRegularBuildError::TooLarge);
+        }
+        let n = counts.vertices() as usize;
+        let records = vec![[0u8; VERTEX_SIZE]; n];
+        let skeleton = file_bytes(
+            counts,
+            &face_bytes,
+            &edge_bytes,
+            &records,
+            None,
+            [0.0; 3],
+            [1.0; 3],
+            1.0,
+        );
+        let view =
+            SemiRegularView::parse(&skeleton).map_err(|_| SemiRegularBuildError::TooLarge)?;
+        let mut positions = Vec::with_capacity(n);
+        positions.extend_from_slice(base);
+        for v in base.len() as u32..n as u32 {
+            let p = view.point(v).ok_or(SemiRegularBuildError::TooLarge)?;
+            positions.push(place(p.face, p.w));
+        }
+        if let Some(v) = positions
+            .iter()
+            .position(|p| !p.iter().all(|c| c.is_finite()))
+        {
+            return Err(SemiRegularBuildError::NotFinite(v as u32));
+        }
+        Ok(SemiRegular {
+            skeleton,
+            positions,
+            colors: None,
+        })
+    }
+
+    /// The unit sphere as an octahedron subdivided `levels` times, each new vertex pushed out
+    /// to the sphere: `8 * 4^levels` faces (8,192 at 5 levels, the paper's Fig. 11 sphere).
+    pub fn sphere(levels: u32) -> Result<SemiRegular, SemiRegularBuildError> {
+        let base = [
+            [1.0, 0.0, 0.0],
+            [-1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, -1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [0.0, 0.0, -1.0],
+        ];
+        let faces = [
+            [0, 2, 4],
+            [2, 1, 4],
+            [1, 3, 4],
+            [3, 0, 4],
+            [2, 0, 5],
+            [1, 2, 5],
+            [3, 1, 5],
+            [0, 3, 5],
+        ];
+        let n = (1u32 << levels.min(MAX_LEVELS)) as f32;
+        SemiRegular::from_fn(&base, &faces, levels, |f, w| {
+            let c = faces[f as usize].map(|v| base[v as usize]);
+            let p: [f32; 3] =
+                core::array::from_fn(|k| (0..3).map(|i| c[i][k] * w[i] as f32 / n).sum());
+            let l = libm::sqrtf(p.iter().map(|x| x * x).sum());
+            p.map(|x| x / l)
+        })
+    }
+
+    /// The lattice of this mesh (every record zero).
+    fn view(&self) -> SemiRegularView<'_> {
+        // `from_fn` parsed these bytes already.
+        SemiRegularView::parse(&self.skeleton).expect("the skeleton was validated when made")
+    }
+
+    /// The header's counts.
+    #[must_use]
+    pub fn counts(&self) -> Counts {
+        self.view().counts()
+    }
+
+    /// The finest level as a triangle mesh over [`SemiRegular::positions`] (counter-clockwise).
+    #[must_use]
+    pub fn finest_triangles(&self) -> Vec<[u32; 3]> {
+        let view = self.view();
+        let mut out = Vec::with_capacity(view.counts().finest_faces() as usize);
+        for_finest_triangles(&view, |_, t| out.push(t));
+        out
+    }
+
+    /// The file: positions quantized over the bounding box, normals, and every wavelet's bounds
+    /// (see the module documentation).
+    pub fn to_bytes(&self) -> Result<Vec<u8>, SemiRegularBuildError> {
+        let view = self.view();
+        let counts = view.counts();
+        let n = counts.vertices() as usize;
+        if self.positions.len() != n {
+            return Err(SemiRegularBuildError::Count {
+                given: self.positions.len(),
+                needed: n,
+            });
+        }
+        if let Some(c) = &self.colors {
+            if c.len() != n {
+                return Err(SemiRegularBuildError::Count {
+                    given: c.len(),
+                    needed: n,
+                });
+            }
+        }
+        let (origin, extent, unit) = frame(&self.positions);
+        let faces_at = HEADER_SIZE;
+        let edges_at = faces_at + counts.base_faces as usize * FACE_SIZE;
+        let records_at = edges_at + counts.base_edges as usize * super::format::EDGE_SIZE;
+        let face_bytes = &self.skeleton[faces_at..edges_at];
+        let edge_bytes = &self.skeleton[edges_at..records_at];
+        // Quantized positions first: every bound is measured on what the file will hold.
+        let mut records: Vec<[u8; VERTEX_SIZE]> = self
+            .positions
+            .iter()
+            .map(|&p| {
+                let q = quantize(p, origin, extent);
+                let mut r = [0u8; VERTEX_SIZE];
+                for k in 0..3 {
+                    r[2 * k..2 * k + 2].copy_from_slice(&q[k].to_le_bytes());
+                }
+                r
+            })
+            .collect();
+        let staged = file_bytes(
+            counts, face_bytes, edge_bytes, &records, None, origin, extent, unit,
+        );
+        let staged =
+            SemiRegularView::parse(&staged).map_err(|_| SemiRegularBuildError::TooLarge)?;
+        let positions: Vec<[f32; 3]> = (0..n as u32).map(|v| staged.position(v)).collect();
+        let normals = vertex_normals(&staged, &positions);
+        for (r, nrm) in records.iter_mut().zip(&normals) {
+            let (x, y) = oct_encode(*nrm);
+            r[6] = x as u8;
+            r[7] = y as u8;
+        }
+        let axes: Vec<[f32; 3]> = records
+            .iter()
+            .map(|r| oct_decode(r[6] as i8, r[7] as i8))
+            .collect();
+        let mut bounds = wavelet_bounds(&staged, &positions, &axes);
+        monotonic(&staged, &positions, &axes, &mut bounds);
+        let base = counts.base_vertices as usize;
+        for (k, b) in bounds.iter().enumerate() {
+            let r = &mut records[base + k];
+            r[8] = encode_length(b.radius / unit);
+            r[9] = encode_length(b.a / unit);
+            r[10] = encode_length(b.b / unit);
+            r[11] = if b.cone >= core::f32::consts::FRAC_PI_2 {
+                255
+            } else {
+                libm::ceilf(libm::sinf(b.cone) * 255.0).clamp(0.0, 255.0) as u8
+            };
+        }
+        Ok(file_bytes(
+            counts,
+            face_bytes,
+            edge_bytes,
+            &records,
+            self.colors.as_deref(),
+            origin,
+            extent,
+            unit,
+        ))
+    }
+}
+
+/// Calls `f(face, triangle)` for every triangle of `K^J` (vertex ids, counter-clockwise), face
+/// by face, rows of increasing `j`.
+fn for_finest_triangles(view: &SemiRegularView<'_>, mut f: impl FnMut(u32, [u32; 3])) {
+    let n = view.steps();
+    for face in 0..view.counts().base_faces {
+        let id = |i: i32, j: i32| {
+            view.vertex_id(Point {
+                face,
+                w: [n - i - j, i, j],
+            })
+            .unwrap_or(0)
+        };
+        for j in 0..n {
+            for i in 0..n - j {
+                f(face, [id(i, j), id(i + 1, j), id(i, j + 1)]);
+                if i + j + 2 <= n {
+                    f(face, [id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]);
+                }
+            }
+        }
+    }
+}
+
+fn sub(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn cross(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn dot(a: [f32; 3], b: [f32; 3]) -> f32 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn norm(a: [f32; 3]) -> f32 {
+    libm::sqrtf(dot(a, a))
+}
+
+fn unit(a: [f32; 3]) -> [f32; 3] {
+    let l = norm(a);
+    if l > 0.0 && l.is_finite() {
+        a.map(|x| x / l)
+    } else {
+        [0.0, 0.0, 1.0]
+    }
+}
+
+/// Area-weighted vertex normals of the finest level.
+fn vertex_normals(view: &SemiRegularView<'_>, positions: &[[f32; 3]]) -> Vec<[f32; 3]> {
+    let mut acc = vec![[0.0f32; 3]; positions.len()];
+    for_finest_triangles(view, |_, t| {
+        let [a, b, c] = t.map(|v| positions[v as usize]);
+        let n = cross(sub(b, a), sub(c, a));
+        for v in t {
+            for k in 0..3 {
+                acc[v as usize][k] += n[k];
+            }
+        }
+    });
+    acc.into_iter().map(unit).collect()
+}
+
+/// One wavelet's bounds before encoding.
+#[derive(Clone, Copy, Debug, Default)]
+struct WaveletBounds {
+    radius: f32,
+    a: f32,
+    b: f32,
+    /// Cone half-angle in radians.
+    cone: f32,
+}
+
+/// How a wavelet relates to the one being bounded.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Kin {
+    /// It, or a descendant: out when it is out.
+    Out,
+    /// An ancestor: in whenever it is tested.
+    In,
+    /// Anything else: in or out.
+    Either,
+}
+
+/// The bounds of every wavelet (index = vertex id - base vertices).
+fn wavelet_bounds(
+    view: &SemiRegularView<'_>,
+    positions: &[[f32; 3]],
+    axes: &[[f32; 3]],
+) -> Vec<WaveletBounds> {
+    let c = view.counts();
+    let base = c.base_vertices;
+    // Coefficients: a wavelet's position minus its parent edge's midpoint.
+    let coefficient: Vec<[f32; 3]> = (base..view.vertices())
+        .map(|v| {
+            let p = view.point(v).unwrap_or(Point { face: 0, w: [0; 3] });
+            let [x, y] = view.parent_edge(p, view.level(p));
+            let pos = |q: Point| {
+                view.vertex_id(q)
+                    .map_or([0.0; 3], |id| positions[id as usize])
+            };
+            let (px, py) = (pos(x), pos(y));
+            let m = [0, 1, 2].map(|k| (px[k] + py[k]) * 0.5);
+            sub(positions[v as usize], m)
+        })
+        .collect();
+    let levels = c.levels;
+    (base..view.vertices())
+        .map(|v| {
+            let Some(m) = view.point(v) else {
+                return WaveletBounds::default();
+            };
+            let level = view.level(m);
+            let s = view.step_of(level);
+            let center = positions[v as usize];
+            let axis = axes[v as usize];
+            let mut out = WaveletBounds::default();
+            let mut worst: Vec<(f32, f32)> = Vec::new();
+            // Every finest triangle of the support (by its lower-left lattice point), for the
+            // cone of normals.
+            for dj in -s - 1..=s {
+                for di in -s - 1..=s {
+                    let q = m.offset([-1, 1, 0], di).offset([-1, 0, 1], dj);
+                    let right = q.offset([-1, 1, 0], 1);
+                    let up = q.offset([-1, 0, 1], 1);
+                    for t in [[q, right, up], [right, right.offset([-1, 0, 1], 1), up]] {
+                        if t.iter().any(|&x| hex_len(m.to(x)) > s) {
+                            continue;
+                        }
+                        let ids = t.map(|x| view.canonical(x).and_then(|x| view.vertex_id(x)));
+                        let [Some(a), Some(b), Some(cc)] = ids else {
+                            continue;
+                        };
+                        let [a, b, cc] = [a, b, cc].map(|k| positions[k as usize]);
+                        let nrm = unit(cross(sub(b, a), sub(cc, a)));
+                        let cos = dot(nrm, axis).clamp(-1.0, 1.0);
+                        out.cone = out.cone.max(libm::acosf(cos));
+                    }
+                }
+            }
+            // Every finest point of the support, in the wavelet's frame.
+            for dj in -s..=s {
+                for di in -s..=s {
+                    if hex_len([-di - dj, di, dj]) > s {
+                        continue;
+                    }
+                    let q = m.offset([-1, 1, 0], di).offset([-1, 0, 1], dj);
+                    let Some(qc) = view.canonical(q) else {
+                        continue;
+                    };
+                    let Some(qid) = view.vertex_id(qc) else {
+                        continue;
+                    };
+                    let pq = positions[qid as usize];
+                    out.radius = out.radius.max(norm(sub(pq, center)));
+                    // The error at q: what the wavelet and its descendants carry, plus what
+                    // the others may or may not.
+                    let mut out_part = [0.0f32; 3];
+                    let (mut lo, mut hi, mut across) = (0.0f32, 0.0f32, 0.0f32);
+                    for l in 1..=levels {
+                        let sl = view.step_of(l);
+                        for (corner, weight) in containing(q, sl) {
+                            let Some(cc) = view.canonical(corner) else {
+                                continue;
+                            };
+                            if view.level(cc) != l || weight == 0 {
+                                continue;
+                            }
+                            let Some(id) = view.vertex_id(cc) else {
+                                continue;
+                            };
+                            let contrib = coefficient[(id - base) as usize]
+                                .map(|x| x * weight as f32 / sl as f32);
+                            let kin = if id == v || (l > level && hex_len(m.to(corner)) + sl <= s) {
+                                Kin::Out
+                            } else if l < level && hex_len(corner.to(m)) + s <= sl {
+                                Kin::In
+                            } else {
+                                Kin::Either
+                            };
+                            match kin {
+                                Kin::Out => {
+                                    for k in 0..3 {
+                                        out_part[k] += contrib[k];
+                                    }
+                                }
+                                Kin::In => {}
+                                Kin::Either => {
+                                    let along = dot(contrib, axis);
+                                    lo += along.min(0.0);
+                                    hi += along.max(0.0);
+                                    across += norm(cross(contrib, axis));
+                                }
+                            }
+                        }
+                    }
+                    let along = dot(out_part, axis);
+                    let a_q = (along + lo).abs().max((along + hi).abs());
+                    let b_q = norm(cross(out_part, axis)) + across;
+                    worst.push((a_q, b_q));
+                }
+            }
+            let max_a = worst.iter().fold(0.0f32, |m, w| m.max(w.0));
+            let max_b = worst.iter().fold(0.0f32, |m, w| m.max(w.1));
+            if max_b <= 0.0 {
+                out.a = max_a;
+            } else if max_a <= 0.0 {
+                out.b = max_b;
+            } else {
+                // Equation 3's ratio, then scaled so that every worst case is inside.
+                let ratio = max_a / max_b;
+                out.b = worst.iter().fold(0.0f32, |m, &(a, b)| {
+                    m.max(libm::sqrtf((a / ratio) * (a / ratio) + b * b))
+                });
+                out.a = ratio * out.b;
+            }
+            out
+        })
+        .collect()
+}
+
+/// The corners of the lattice triangle of step `s` holding `q` (same frame), each with `q`'s
+/// weight on it in units of `1/s` (the three sum to `s`).
+fn containing(q: Point, s: i32) -> [(Point, i32); 3] {
+    let (i, j) = (q.w[1], q.w[2]);
+    let (ci, cj) = (i.div_euclid(s), j.div_euclid(s));
+    let (fi, fj) = (i - ci * s, j - cj * s);
+    let at = |a: i32, b: i32| Point {
+        face: q.face,
+        w: [q.w[0] + i + j - a * s - b * s, a * s, b * s],
+    };
+    if fi + fj <= s {
+        [
+            (at(ci, cj), s - fi - fj),
+            (at(ci + 1, cj), fi),
+            (at(ci, cj + 1), fj),
+        ]
+    } else {
+        [
+            (at(ci + 1, cj + 1), fi + fj - s),
+            (at(ci, cj + 1), s - fi),
+            (at(ci + 1, cj), s - fj),
+        ]
+    }
+}
+
+/// Makes bounds monotonic down the dependency graph, finest level first.
+fn monotonic(
+    view: &SemiRegularView<'_>,
+    positions: &[[f32; 3]],
+    axes: &[[f32; 3]],
+    bounds: &mut [WaveletBounds],
+) {
+    let base = view.counts().base_vertices;
+    let mut order: Vec<(u32, u32)> = (base..view.vertices())
+        .filter_map(|v| view.point(v).map(|p| (view.level(p), v)))
+        .collect();
+    order.sort_unstable_by(|a, b| b.cmp(a));
+    for (level, v) in order {
+        let Some(p) = view.point(v) else { continue };
+        let child = bounds[(v - base) as usize];
+        for q in view.parents(p, level) {
+            if q == NONE {
+                continue;
+            }
+            let gap = norm(sub(positions[v as usize], positions[q as usize]));
+            let turn = libm::acosf(dot(axes[v as usize], axes[q as usize]).clamp(-1.0, 1.0));
+            let parent = &mut bounds[(q - base) as usize];
+            parent.radius = parent.radius.max(gap + child.radius);
+            parent.a = parent.a.max(child.a);
+            parent.b = parent.b.max(child.b);
+            parent.cone = parent.cone.max(turn + child.cone);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::wavelet::lattice::Site;
+
+    #[test]
+    fn vertex_ids_and_points_round_trip() {
+        let s = SemiRegular::sphere(3).unwrap();
+        let view = s.view();
+        assert_eq!(view.vertices(), 6 + 12 * 7 + 8 * 21);
+        for v in 6..view.vertices() {
+            let p = view.point(v).unwrap();
+            assert_eq!(view.vertex_id(p), Some(v), "{p:?}");
+            assert!(matches!(view.site(p), Site::Edge(..) | Site::Inner));
+        }
+    }
+
+    #[test]
+    fn the_sphere_has_the_papers_face_count() {
+        let s = SemiRegular::sphere(5).unwrap();
+        assert_eq!(s.finest_triangles().len(), 8192);
+        assert_eq!(s.counts().finest_faces(), 8192);
+    }
+}

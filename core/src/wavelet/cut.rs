@@ -1,0 +1,783 @@
+//! The wavelet engine's cut: which wavelets are in this frame's mesh, and the crack-free
+//! triangles they make.
+//!
+//! The state is the paper's `U_t` (Azuma et al. §3.4) as one bit per wavelet, nothing per
+//! wavelet else. [`WaveletCut::adapt`] moves it incrementally: a wavelet in `U_t` none of whose
+//! children is in it leaves when the policy no longer wants it, and a wavelet both of whose
+//! parents are in `U_t` joins when the policy wants it, largest error first, so `U_t` always
+//! meets the closure condition (every ancestor of a member is a member). A frame's work is one
+//! pass over the members and their children, and a split or removal for each change.
+//!
+//! The triangles are then emitted as §3.6 describes: every base triangle is subdivided
+//! recursively while one of its edge midpoints is in `U_t`; a triangle that is not, but whose
+//! neighbour across an edge is, is cut at that edge's midpoint, and each half is tested again, so
+//! no T-vertex is left and the mesh has no crack: for a closed input every edge is shared by two
+//! triangles run opposite ways ([`WaveletCut::check`], tested after every frame of long camera
+//! paths). A vertex that is not in `U_t` (a T-vertex, or the corner of a subdivided triangle whose
+//! own wavelet is out) sits at the midpoint of its parent edge, where `rho_t` puts it.
+//!
+//! The triangle count is kept exactly as wavelets come and go, without emitting: every vertex of
+//! the emitted mesh that is not a base vertex adds two triangles (one on a border), and a vertex
+//! is in the mesh when one of the two triangles around its parent edge is subdivided. So the
+//! budget is hard: a wavelet joins only when the triangles it brings fit
+//! [`Budget::max_triangles`] and the arenas.
+//!
+//! Memory (`Self::BYTES`): the bits (`4 WORDS`), 16 B per vertex slot (id and position), 6 B
+//! (`u16`) per triangle slot, 2 B per triangle slot of vertex map, 8 B per queue entry. With
+//! `V = T / 2` (a closed mesh has about half as many vertices as triangles) and `Q = T / 8`, that is
+//! 17 B per triangle of capacity plus the bits.
+
+use crate::adapt::{Budget, FrameStats};
+use crate::cut::slot::{Arena, SlotIndex};
+use crate::cut::NIL;
+use crate::nodemap::NodeMap;
+use crate::policy::{Policy, View};
+
+use super::format::SemiRegularView;
+use super::lattice::Point;
+
+/// Why a cut cannot hold a semi-regular mesh.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum WaveletCutError {
+    /// The bit set has fewer bits than the mesh has wavelets.
+    Bits {
+        /// Wavelets of the mesh.
+        wavelets: u32,
+        /// Bits of the cut.
+        bits: u32,
+    },
+    /// The base mesh alone does not fit the arenas.
+    Capacity {
+        /// Base vertices.
+        vertices: u32,
+        /// Base triangles.
+        triangles: u32,
+    },
+}
+
+impl core::fmt::Display for WaveletCutError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match *self {
+            Self::Bits { wavelets, bits } => write!(
+                f,
+                "the mesh has {wavelets} wavelets, the cut holds {bits} bits (raise WORDS)"
+            ),
+            Self::Capacity {
+                vertices,
+                triangles,
+            } => write!(
+                f,
+                "the base mesh ({vertices} vertices, {triangles} triangles) does not fit the cut"
+            ),
+        }
+    }
+}
+
+impl core::error::Error for WaveletCutError {}
+
+/// What [`WaveletCut::check`] found wrong.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct WaveletDefect(pub &'static str);
+
+impl core::fmt::Display for WaveletDefect {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(self.0)
+    }
+}
+
+/// An arena filled up while emitting.
+#[derive(Debug)]
+struct Full;
+
+/// The level given to a piece's edges inside its leaf triangle (never tested for a neighbour).
+const INSIDE: u32 = u32::MAX;
+
+/// Whether wavelet vertex `id` is in the set `bits` of a mesh with `base` base vertices and
+/// `wavelets` wavelets.
+#[inline]
+fn has(bits: &[u32], base: u32, wavelets: u32, id: u32) -> bool {
+    let w = id.wrapping_sub(base);
+    w < wavelets
+        && bits
+            .get((w / 32) as usize)
+            .is_some_and(|b| b >> (w % 32) & 1 == 1)
+}
+
+/// The wavelets in a frame's mesh as bits, and the triangles they make, in fixed arenas: up to
+/// `32 WORDS` wavelets, `T` triangles, `V` vertices and `Q` candidates waiting to join,
+/// indices stored as `I`.
+pub struct WaveletCut<
+    const WORDS: usize,
+    const T: usize,
+    const V: usize,
+    const Q: usize,
+    I: SlotIndex = u16,
+> {
+    included: [u32; WORDS],
+    base_vertices: u32,
+    base_faces: u32,
+    wavelets: u32,
+    levels: u32,
+    /// The emitted mesh's counts, kept as wavelets come and go.
+    triangles: u32,
+    vertices: u32,
+    ids: Arena<u32, V>,
+    positions: [[f32; 3]; V],
+    tris: Arena<[I; 3], T>,
+    map: NodeMap<T, I>,
+    heap: Arena<(u32, u32), Q>,
+    threshold: f32,
+}
+
+impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: SlotIndex> Default
+    for WaveletCut<WORDS, T, V, Q, I>
+{
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: SlotIndex>
+    core::fmt::Debug for WaveletCut<WORDS, T, V, Q, I>
+{
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("WaveletCut")
+            .field("triangles", &self.triangles)
+            .field("vertices", &self.vertices)
+            .field("capacity", &(WORDS * 32, T, V, Q))
+            .field("bytes", &Self::BYTES)
+            .finish()
+    }
+}
+
+impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: SlotIndex>
+    WaveletCut<WORDS, T, V, Q, I>
+{
+    /// Bytes of memory the cut occupies (it allocates nothing).
+    pub const BYTES: usize = core::mem::size_of::<Self>();
+
+    const CAPACITY_FITS: () = assert!(
+        V < I::LIMIT && T < I::LIMIT,
+        "a cut's vertex and triangle capacities must be below 65,535 with u16 indices"
+    );
+
+    /// An empty cut, all zeros (a `static` lands in `.bss`); [`WaveletCut::reset`] loads a
+    /// mesh's base.
+    #[must_use]
+    pub const fn new() -> Self {
+        let () = Self::CAPACITY_FITS;
+        WaveletCut {
+            included: [0; WORDS],
+            base_vertices: 0,
+            base_faces: 0,
+            wavelets: 0,
+            levels: 0,
+            triangles: 0,
+            vertices: 0,
+            ids: Arena::new(0),
+            positions: [[0.0; 3]; V],
+            tris: Arena::new([I::ZERO; 3]),
+            map: NodeMap::new(),
+            heap: Arena::new((0, 0)),
+            threshold: 0.0,
+        }
+    }
+
+    /// A cut on the heap, built in place (never on the stack).
+    #[cfg(feature = "build")]
+    #[must_use]
+    pub fn boxed() -> alloc::boxed::Box<Self> {
+        // All-zero bytes are `new()` (its fields are integers, floats and arrays of them).
+        let layout = core::alloc::Layout::new::<Self>();
+        if layout.size() == 0 {
+            return alloc::boxed::Box::new(Self::new());
+        }
+        // SAFETY: the layout has a non-zero size, the memory is zeroed (which is a valid
+        // `Self`, the state `new` returns), and `Box` takes it with the same layout.
+        #[allow(unsafe_code)]
+        unsafe {
+            let p = alloc::alloc::alloc_zeroed(layout) as *mut Self;
+            if p.is_null() {
+                alloc::alloc::handle_alloc_error(layout);
+            }
+            alloc::boxed::Box::from_raw(p)
+        }
+    }
+
+    /// Replaces the cut by `s`'s base mesh (no wavelet in).
+    pub fn reset(&mut self, s: &SemiRegularView<'_>) -> Result<(), WaveletCutError> {
+        let c = s.counts();
+        let bits = (WORDS * 32).min(u32::MAX as usize) as u32;
+        if s.wavelets() > bits {
+            return Err(WaveletCutError::Bits {
+                wavelets: s.wavelets(),
+                bits,
+            });
+        }
+        if c.base_faces as usize > T || c.base_vertices as usize > V.min(self.map.capacity()) {
+            return Err(WaveletCutError::Capacity {
+                vertices: c.base_vertices,
+                triangles: c.base_faces,
+            });
+        }
+        self.included.iter_mut().for_each(|w| *w = 0);
+        self.base_vertices = c.base_vertices;
+        self.base_faces = c.base_faces;
+        self.wavelets = s.wavelets();
+        self.levels = c.levels;
+        self.triangles = c.base_faces;
+        self.vertices = c.base_vertices;
+        self.threshold = 1.0;
+        // The base mesh fits, so emitting it cannot fail.
+        let _complete = self.emit(s);
+        debug_assert!(_complete);
+        Ok(())
+    }
+
+    /// Whether wavelet vertex `id` is in this frame's mesh.
+    #[inline]
+    #[must_use]
+    pub fn includes(&self, id: u32) -> bool {
+        has(&self.included, self.base_vertices, self.wavelets, id)
+    }
+
+    /// Wavelets in this frame's mesh.
+    #[must_use]
+    pub fn included(&self) -> u32 {
+        self.included.iter().map(|w| w.count_ones()).sum()
+    }
+
+    /// The regulated error threshold (1 after [`WaveletCut::reset`]).
+    #[must_use]
+    pub fn threshold(&self) -> f32 {
+        self.threshold
+    }
+
+    /// The emitted triangles, as vertex slots.
+    #[must_use]
+    pub fn triangles(&self) -> &[[I; 3]] {
+        self.tris.as_slice()
+    }
+
+    /// Emitted vertices.
+    #[must_use]
+    pub fn vertex_count(&self) -> usize {
+        self.ids.len()
+    }
+
+    /// The mesh vertex id of vertex slot `i` (see [`super::format`]; `u32::MAX` out of range).
+    #[must_use]
+    pub fn vertex_id(&self, i: usize) -> u32 {
+        self.ids.as_slice().get(i).copied().unwrap_or(NIL)
+    }
+
+    /// The position of vertex slot `i` in this frame: its own for a base vertex or a wavelet in
+    /// the mesh, the midpoint of its parent edge for any other.
+    #[must_use]
+    pub fn position(&self, i: usize) -> [f32; 3] {
+        self.positions.get(i).copied().unwrap_or([0.0; 3])
+    }
+
+    /// The policy's verdict on wavelet vertex `id` at threshold `t`: wanted, and how much.
+    #[inline]
+    fn wants<P: Policy>(
+        s: &SemiRegularView<'_>,
+        id: u32,
+        view: &View,
+        policy: &P,
+        t: f32,
+    ) -> Option<f32> {
+        let d = policy.demand(&s.bounds(id), view);
+        (d.visible && d.error > t).then_some(d.error)
+    }
+
+    #[inline]
+    fn flip(&mut self, id: u32) {
+        let w = id.wrapping_sub(self.base_vertices) as usize;
+        if let Some(word) = self.included.get_mut(w / 32) {
+            *word ^= 1 << (w % 32);
+        }
+    }
+
+    /// Vertices and triangles that canonical point `v` (at level `level`) adds to the emitted
+    /// mesh: none when neither triangle around its parent edge is subdivided, else one vertex
+    /// and a triangle per side (two inside, one on a border).
+    fn presence(&self, s: &SemiRegularView<'_>, v: Point, level: u32) -> (u32, u32) {
+        let [x, y] = s.parent_edge(v, level);
+        let inc = |id| has(&self.included, self.base_vertices, self.wavelets, id);
+        let mut sides = 0;
+        let mut split = false;
+        for (a, b, c) in [(x, y, x.left_of(y)), (y, x, x.right_of(y))] {
+            if s.canonical(c).is_some() {
+                sides += 1;
+                split |= s.subdivided(a, b, c, inc);
+            }
+        }
+        if split {
+            (1, sides)
+        } else {
+            (0, 0)
+        }
+    }
+
+    /// The points whose presence can change when wavelet `p` (at `level`) comes or goes: the
+    /// edge midpoints of the two triangles around its parent edge (`p` among them), each once.
+    fn neighbourhood(
+        s: &SemiRegularView<'_>,
+        p: Point,
+        level: u32,
+    ) -> ([Option<(u32, Point)>; 5], usize) {
+        let [x, y] = s.parent_edge(p, level);
+        let (l, r) = (x.left_of(y), x.right_of(y));
+        let mut out = [None; 5];
+        let mut n = 0;
+        for m in [p, y.mid(l), l.mid(x), x.mid(r), r.mid(y)] {
+            let Some(q) = s.canonical(m) else { continue };
+            let Some(id) = s.vertex_id(q) else { continue };
+            if out[..n].iter().all(|o| o.is_none_or(|(k, _)| k != id)) {
+                out[n] = Some((id, q));
+                n += 1;
+            }
+        }
+        (out, n)
+    }
+
+    /// Adds or removes wavelet `p` (vertex `id`, at `level`) and updates the counts.
+    fn toggle(&mut self, s: &SemiRegularView<'_>, id: u32, p: Point, level: u32) {
+        let (around, n) = Self::neighbourhood(s, p, level);
+        let count = |cut: &Self| {
+            around[..n]
+                .iter()
+                .flatten()
+                .fold((0u32, 0u32), |(v, t), &(_, q)| {
+                    let (dv, dt) = cut.presence(s, q, s.level(q));
+                    (v + dv, t + dt)
+                })
+        };
+        let before = count(self);
+        self.flip(id);
+        let after = count(self);
+        self.vertices = (self.vertices + after.0).saturating_sub(before.0);
+        self.triangles = (self.triangles + after.1).saturating_sub(before.1);
+    }
+
+    /// Whether any child of wavelet `p` (at `level`) is in the mesh.
+    fn any_child_in(&self, s: &SemiRegularView<'_>, p: Point, level: u32) -> bool {
+        s.children(p, level)
+            .iter()
+            .flatten()
+            .any(|&c| s.vertex_id(c).is_some_and(|id| self.includes(id)))
+    }
+
+    /// Whether every parent of wavelet `p` (at `level`) is in the mesh, and `from` (when not
+    /// [`NIL`]) is the one with the smallest id (so that a sweep over the members looks at a
+    /// wavelet with two parents once).
+    fn joinable_from(&self, s: &SemiRegularView<'_>, p: Point, level: u32, from: u32) -> bool {
+        let parents = s.parents(p, level);
+        let mut first = NIL;
+        for q in parents {
+            if q != NIL {
+                if !self.includes(q) {
+                    return false;
+                }
+                first = first.min(q);
+            }
+        }
+        from == NIL || first == from
+    }
+
+    /// Moves the cut for one frame seen from `view`: wavelets the policy no longer wants leave
+    /// (finest first, as their children leave), then wanted wavelets whose parents are in join,
+    /// largest error first, while [`Budget::max_triangles`], [`Budget::max_ops`] and the arenas
+    /// allow; then the triangles are emitted.
+    pub fn adapt<P: Policy>(
+        &mut self,
+        s: &SemiRegularView<'_>,
+        view: &View,
+        policy: &P,
+        budget: &Budget,
+    ) -> FrameStats {
+        let mut stats = FrameStats::default();
+        if self.wavelets != s.wavelets() || self.base_faces != s.counts().base_faces {
+            // Not reset with this mesh: nothing to do safely.
+            stats.capacity_limited = true;
+            return stats;
+        }
+        let t = self.threshold;
+        let max_triangles = budget.max_triangles.min(T as u32);
+        let max_vertices = (V.min(self.map.capacity()) as u32).max(self.base_vertices);
+        let mut ops = 0u32;
+        let words = (self.wavelets as usize).div_ceil(32).min(WORDS);
+
+        // Coarsen: a member with no member child leaves when unwanted; its parents may follow
+        // in the next pass.
+        'coarsen: loop {
+            let mut removed = false;
+            for word in 0..words {
+                let mut bits = self.included[word];
+                while bits != 0 {
+                    let id = self.base_vertices + (word as u32) * 32 + bits.trailing_zeros();
+                    bits &= bits - 1;
+                    let Some(p) = s.point(id) else { continue };
+                    let level = s.level(p);
+                    if self.any_child_in(s, p, level)
+                        || Self::wants(s, id, view, policy, t).is_some()
+                    {
+                        continue;
+                    }
+                    if ops >= budget.max_ops {
+                        stats.ops_limited = true;
+                        break 'coarsen;
+                    }
+                    self.toggle(s, id, p, level);
+                    ops += 1;
+                    stats.ecols += 1;
+                    removed = true;
+                }
+            }
+            if !removed {
+                break;
+            }
+        }
+
+        if self.triangles > max_triangles || self.vertices > max_vertices {
+            self.enforce_max(s, view, policy, max_triangles, max_vertices, &mut stats);
+        }
+
+        // Refine: candidates are the level-1 wavelets and the children of members whose
+        // parents are all in; the heap hands out the largest error first.
+        self.heap.clear();
+        let n = s.steps() as u32;
+        for e in 0..s.counts().base_edges {
+            let id = self.base_vertices + e * (n - 1) + n / 2 - 1;
+            if !self.includes(id) {
+                self.offer(s, id, view, policy, t, &mut stats);
+            }
+        }
+        for word in 0..words {
+            let mut bits = self.included[word];
+            while bits != 0 {
+                let id = self.base_vertices + (word as u32) * 32 + bits.trailing_zeros();
+                bits &= bits - 1;
+                self.offer_children(s, id, true, view, policy, t, &mut stats);
+            }
+        }
+        while let Some((_, id)) = self.heap.heap_pop() {
+            if self.includes(id) {
+                continue;
+            }
+            if ops >= budget.max_ops {
+                stats.ops_limited = true;
+                break;
+            }
+            let Some(p) = s.point(id) else { continue };
+            let level = s.level(p);
+            let before = (self.vertices, self.triangles);
+            self.toggle(s, id, p, level);
+            let (over_t, over_v) = (self.triangles > max_triangles, self.vertices > max_vertices);
+            if over_t || over_v {
+                self.flip(id);
+                (self.vertices, self.triangles) = before;
+                if over_t && !over_v && max_triangles == budget.max_triangles {
+                    stats.budget_limited = true;
+                } else {
+                    stats.capacity_limited = true;
+                }
+                break;
+            }
+            ops += 1;
+            stats.vsplits += 1;
+            self.offer_children(s, id, false, view, policy, t, &mut stats);
+        }
+        self.heap.clear();
+
+        if !self.emit(s) {
+            stats.capacity_limited = true;
+        }
+        self.threshold = budget.regulate(self.threshold, self.triangles);
+        stats.triangles = self.tris.len() as u32;
+        stats.vertices = self.ids.len() as u32;
+        stats.threshold = t;
+        stats.over_budget = stats.triangles > budget.max_triangles;
+        stats
+    }
+
+    /// Removes members with no member child, smallest error first, until the mesh fits
+    /// `max_triangles` and `max_vertices` (a lowered budget; the hard limit wins over
+    /// [`Budget::max_ops`]).
+    fn enforce_max<P: Policy>(
+        &mut self,
+        s: &SemiRegularView<'_>,
+        view: &View,
+        policy: &P,
+        max_triangles: u32,
+        max_vertices: u32,
+        stats: &mut FrameStats,
+    ) {
+        let priority = |id: u32| {
+            let d = policy.demand(&s.bounds(id), view);
+            !(if d.visible { d.error.max(0.0) } else { 0.0 }).to_bits()
+        };
+        self.heap.clear();
+        let words = (self.wavelets as usize).div_ceil(32).min(WORDS);
+        for word in 0..words {
+            let mut bits = self.included[word];
+            while bits != 0 {
+                let id = self.base_vertices + (word as u32) * 32 + bits.trailing_zeros();
+                bits &= bits - 1;
+                let Some(p) = s.point(id) else { continue };
+                if !self.any_child_in(s, p, s.level(p))
+                    && self.heap.heap_push((priority(id), id)).is_err()
+                {
+                    stats.queue_overflow = true;
+                }
+            }
+        }
+        while self.triangles > max_triangles || self.vertices > max_vertices {
+            let Some((_, id)) = self.heap.heap_pop() else {
+                break;
+            };
+            let Some(p) = s.point(id) else { continue };
+            let level = s.level(p);
+            if !self.includes(id) || self.any_child_in(s, p, level) {
+                continue;
+            }
+            self.toggle(s, id, p, level);
+            stats.ecols += 1;
+            stats.budget_ecols += 1;
+            for q in s.parents(p, level) {
+                let Some(pq) = s.point(q) else { continue };
+                if self.includes(q)
+                    && !self.any_child_in(s, pq, s.level(pq))
+                    && self.heap.heap_push((priority(q), q)).is_err()
+                {
+                    stats.queue_overflow = true;
+                }
+            }
+        }
+        self.heap.clear();
+    }
+
+    /// Puts wavelet `id` on the heap if the policy wants it.
+    fn offer<P: Policy>(
+        &mut self,
+        s: &SemiRegularView<'_>,
+        id: u32,
+        view: &View,
+        policy: &P,
+        t: f32,
+        stats: &mut FrameStats,
+    ) {
+        if let Some(error) = Self::wants(s, id, view, policy, t) {
+            if self.heap.heap_push((error.to_bits(), id)).is_err() {
+                stats.queue_overflow = true;
+            }
+        }
+    }
+
+    /// Offers the children of member `id` that may join now (in a `sweep` over the members,
+    /// only those whose first parent is `id`).
+    #[allow(clippy::too_many_arguments)]
+    fn offer_children<P: Policy>(
+        &mut self,
+        s: &SemiRegularView<'_>,
+        id: u32,
+        sweep: bool,
+        view: &View,
+        policy: &P,
+        t: f32,
+        stats: &mut FrameStats,
+    ) {
+        let Some(p) = s.point(id) else { return };
+        let level = s.level(p);
+        for c in s.children(p, level).into_iter().flatten() {
+            let Some(cid) = s.vertex_id(c) else { continue };
+            let from = if sweep { id } else { NIL };
+            if !self.includes(cid) && self.joinable_from(s, c, level + 1, from) {
+                self.offer(s, cid, view, policy, t, stats);
+            }
+        }
+    }
+
+    /// Emits the triangles of the current set; `false` when an arena filled up (the mesh is
+    /// then incomplete, which the budget's admission prevents).
+    fn emit(&mut self, s: &SemiRegularView<'_>) -> bool {
+        self.ids.clear();
+        self.tris.clear();
+        self.map
+            .reset(NodeMap::<T, I>::span_for(self.vertices as usize));
+        let n = s.steps();
+        for f in 0..self.base_faces {
+            let p = [[n, 0, 0], [0, n, 0], [0, 0, n]].map(|w| Point { face: f, w });
+            let mut v = [0u32; 3];
+            for k in 0..3 {
+                match self.slot(s, p[k], [NIL; 2]) {
+                    Ok(x) => v[k] = x,
+                    Err(Full) => return false,
+                }
+            }
+            if self.emit_triangle(s, p, v, 0).is_err() {
+                return false;
+            }
+        }
+        true
+    }
+
+    /// The vertex slot of point `p`, added if new: at its own position when it is a base vertex
+    /// or a member, else at the midpoint of the slots `ends` (its parent edge).
+    fn slot(&mut self, s: &SemiRegularView<'_>, p: Point, ends: [u32; 2]) -> Result<u32, Full> {
+        let id = s.canonical(p).and_then(|q| s.vertex_id(q)).ok_or(Full)?;
+        if let Some(slot) = self.map.get(id, self.ids.as_slice()) {
+            return Ok(slot);
+        }
+        let position = if id < self.base_vertices || self.includes(id) {
+            s.position(id)
+        } else {
+            let a = self.position(ends[0] as usize);
+            let b = self.position(ends[1] as usize);
+            [0, 1, 2].map(|k| (a[k] + b[k]) * 0.5)
+        };
+        let slot = self.ids.push(id).map_err(|_| Full)?;
+        self.positions[slot as usize] = position;
+        if !self.map.insert(slot, self.ids.as_slice()) {
+            return Err(Full);
+        }
+        Ok(slot)
+    }
+
+    /// Emits the triangle `p` (vertex slots `v`) of level `level`: its four children when it
+    /// is subdivided, else itself, cut where its neighbours are finer.
+    fn emit_triangle(
+        &mut self,
+        s: &SemiRegularView<'_>,
+        p: [Point; 3],
+        v: [u32; 3],
+        level: u32,
+    ) -> Result<(), Full> {
+        let inc = |id| has(&self.included, self.base_vertices, self.wavelets, id);
+        if level >= self.levels || !s.subdivided(p[0], p[1], p[2], inc) {
+            return self.emit_piece(s, p, v, [level; 3]);
+        }
+        let m = [p[0].mid(p[1]), p[1].mid(p[2]), p[2].mid(p[0])];
+        let mv = [
+            self.slot(s, m[0], [v[0], v[1]])?,
+            self.slot(s, m[1], [v[1], v[2]])?,
+            self.slot(s, m[2], [v[2], v[0]])?,
+        ];
+        let next = level + 1;
+        self.emit_triangle(s, [p[0], m[0], m[2]], [v[0], mv[0], mv[2]], next)?;
+        self.emit_triangle(s, [m[0], p[1], m[1]], [mv[0], v[1], mv[1]], next)?;
+        self.emit_triangle(s, [m[2], m[1], p[2]], [mv[2], mv[1], v[2]], next)?;
+        self.emit_triangle(s, [m[0], m[1], m[2]], mv, next)
+    }
+
+    /// Emits a piece of a leaf triangle whose edges are at `levels` (edge `k` from corner `k`;
+    /// [`INSIDE`] for a cut inside the leaf): halved at the midpoint of the first edge whose
+    /// neighbour across is subdivided (the paper's T-vertex removal, Fig. 7), else as it is.
+    fn emit_piece(
+        &mut self,
+        s: &SemiRegularView<'_>,
+        p: [Point; 3],
+        v: [u32; 3],
+        levels: [u32; 3],
+    ) -> Result<(), Full> {
+        for i in 0..3 {
+            let (j, k) = ((i + 1) % 3, (i + 2) % 3);
+            if levels[i] >= self.levels {
+                continue;
+            }
+            let (a, b) = (p[i], p[j]);
+            let inc = |id| has(&self.included, self.base_vertices, self.wavelets, id);
+            if !s.subdivided(b, a, a.right_of(b), inc) {
+                continue;
+            }
+            let m = a.mid(b);
+            let mv = self.slot(s, m, [v[i], v[j]])?;
+            let finer = levels[i] + 1;
+            self.emit_piece(
+                s,
+                [a, m, p[k]],
+                [v[i], mv, v[k]],
+                [finer, INSIDE, levels[k]],
+            )?;
+            return self.emit_piece(
+                s,
+                [m, b, p[k]],
+                [mv, v[j], v[k]],
+                [finer, levels[j], INSIDE],
+            );
+        }
+        self.tris
+            .push([I::store(v[0]), I::store(v[1]), I::store(v[2])])
+            .map_err(|_| Full)?;
+        Ok(())
+    }
+
+    /// Checks the invariants: every member's parents are members, the kept counts are the
+    /// emitted ones, no triangle repeats a vertex, no edge is run the same way twice or shared
+    /// by more than two triangles, and on a mesh without border (`closed`) every edge is shared
+    /// by exactly two. `scratch` needs three entries per triangle.
+    pub fn check(
+        &self,
+        s: &SemiRegularView<'_>,
+        closed: bool,
+        scratch: &mut [[u32; 2]],
+    ) -> Result<(), WaveletDefect> {
+        let words = (self.wavelets as usize).div_ceil(32).min(WORDS);
+        for word in 0..words {
+            let mut bits = self.included[word];
+            while bits != 0 {
+                let id = self.base_vertices + (word as u32) * 32 + bits.trailing_zeros();
+                bits &= bits - 1;
+                let p = s
+                    .point(id)
+                    .ok_or(WaveletDefect("a member is not a wavelet"))?;
+                let parents = s.parents(p, s.level(p));
+                if parents.iter().any(|&q| q != NIL && !self.includes(q)) {
+                    return Err(WaveletDefect("a member's parent is not a member"));
+                }
+            }
+        }
+        if self.tris.len() as u32 != self.triangles || self.ids.len() as u32 != self.vertices {
+            return Err(WaveletDefect("the kept counts are not the emitted mesh's"));
+        }
+        let tris = self.tris.as_slice();
+        let edges = scratch
+            .get_mut(..3 * tris.len())
+            .ok_or(WaveletDefect("scratch too small"))?;
+        for (t, e) in tris.iter().zip(edges.chunks_exact_mut(3)) {
+            let v = t.map(|x| x.load());
+            if v[0] == v[1] || v[1] == v[2] || v[0] == v[2] {
+                return Err(WaveletDefect("a triangle repeats a vertex"));
+            }
+            for k in 0..3 {
+                e[k] = [v[k], v[(k + 1) % 3]];
+            }
+        }
+        // Sorted by (smaller, larger) end: an edge's runs are next to each other.
+        edges.sort_unstable_by_key(|&[a, b]| (a.min(b), a.max(b), a));
+        let mut i = 0;
+        while i < edges.len() {
+            let key = |e: [u32; 2]| (e[0].min(e[1]), e[0].max(e[1]));
+            let mut j = i + 1;
+            while j < edges.len() && key(edges[j]) == key(edges[i]) {
+                j += 1;
+            }
+            match j - i {
+                1 if closed => return Err(WaveletDefect("an edge of a closed mesh has one side")),
+                1 => {}
+                2 if edges[i][0] == edges[i + 1][0] => {
+                    return Err(WaveletDefect("two triangles run an edge the same way"))
+                }
+                2 => {}
+                _ => {
+                    return Err(WaveletDefect(
+                        "an edge is shared by more than two triangles",
+                    ))
+                }
+            }
+            i = j;
+        }
+        Ok(())
+    }
+}

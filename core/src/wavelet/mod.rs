@@ -1,0 +1,29 @@
+//! The wavelet engine: view-dependent refinement of meshes with subdivision connectivity.
+//!
+//! Azuma, Wood, Curless, Duchamp, Salesin and Stuetzle, "View-dependent refinement of
+//! multiresolution meshes with subdivision connectivity" (2003). A semi-regular mesh (a base mesh
+//! and `J` levels of 4-to-1 subdivision) is a sum of lazy wavelets, one per vertex that a
+//! subdivision adds; each frame the cut keeps the wavelets the camera needs and emits the
+//! crack-free triangles they make. It is the second engine beside the vertex forest of
+//! [`crate::cut`]: the same [`crate::policy`] tests (a wavelet's bounds are a
+//! [`crate::policy::Bounds`]), the same [`crate::adapt::Budget`] and
+//! [`crate::adapt::FrameStats`], and triangles as vertex slots with positions, which the
+//! rasterizer draws as it draws the vertex forest's cut.
+//!
+//! - [`format`]: the file, read in place and validated (one 12-byte record per vertex).
+//! - [`lattice`]: every level's connectivity, computed from the base mesh.
+//! - [`cut`]: the set of wavelets as bits, its incremental adaptation and the emitted mesh.
+//! - `build` (feature `build`): sources of semi-regular meshes and the per-wavelet bounds.
+
+#[cfg(feature = "build")]
+pub mod build;
+pub mod cut;
+pub mod format;
+pub mod lattice;
+
+pub use cut::{WaveletCut, WaveletCutError, WaveletDefect};
+pub use format::{SemiRegularError, SemiRegularView};
+pub use lattice::Point;
+
+#[cfg(all(test, feature = "build"))]
+mod tests;

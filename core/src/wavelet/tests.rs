@@ -1,0 +1,156 @@
+//! The wavelet cut on generated meshes: closure, exact counts and a crack-free mesh after every
+//! frame of random camera paths, full refinement giving the finest level, and convergence.
+
+use alloc::vec;
+use alloc::vec::Vec;
+
+use super::build::SemiRegular;
+use super::{SemiRegularView, WaveletCut};
+use crate::adapt::Budget;
+use crate::policy::{QRefine, ScreenError, View};
+
+type Cut = WaveletCut<1024, 16_384, 8_192, 4_096>;
+
+fn sphere(levels: u32) -> Vec<u8> {
+    SemiRegular::sphere(levels).unwrap().to_bytes().unwrap()
+}
+
+/// A xorshift stream in `[0, 1)`.
+struct Rng(u32);
+impl Rng {
+    fn next(&mut self) -> f32 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 17;
+        self.0 ^= self.0 << 5;
+        (self.0 >> 8) as f32 / (1u32 << 24) as f32
+    }
+}
+
+fn random_view(rng: &mut Rng) -> View {
+    let d = 1.3 + 6.0 * rng.next();
+    let (a, b) = (core::f32::consts::TAU * rng.next(), 3.0 * rng.next() - 1.5);
+    let eye = [
+        d * libm::cosf(a) * libm::cosf(b),
+        d * libm::sinf(b),
+        d * libm::sinf(a) * libm::cosf(b),
+    ];
+    let target = [
+        0.6 * rng.next() - 0.3,
+        0.6 * rng.next() - 0.3,
+        0.6 * rng.next() - 0.3,
+    ];
+    View::look_at(eye, target, [0.0, 1.0, 0.0], 0.9, 4.0 / 3.0, 480.0)
+}
+
+#[test]
+fn random_camera_paths_keep_the_mesh_closed_and_the_counts_exact() {
+    let bytes = sphere(4);
+    let s = SemiRegularView::parse(&bytes).unwrap();
+    let mut cut = Cut::boxed();
+    cut.reset(&s).unwrap();
+    let mut scratch = vec![[0u32; 2]; 3 * 16_384];
+    cut.check(&s, true, &mut scratch).unwrap();
+    let mut rng = Rng(0x9E37_79B9);
+    let mut seen = (u32::MAX, 0);
+    for frame in 0..300 {
+        let view = random_view(&mut rng);
+        let tol = 0.25 + 4.0 * rng.next();
+        let policy = QRefine {
+            error: ScreenError {
+                silhouette: tol,
+                interior: tol * 7.0,
+            },
+        };
+        let budget = if frame % 3 == 0 {
+            Budget {
+                max_triangles: 300 + (rng.next() * 2000.0) as u32,
+                ..Budget::default()
+            }
+        } else {
+            Budget::default()
+        };
+        let stats = cut.adapt(&s, &view, &policy, &budget);
+        cut.check(&s, true, &mut scratch)
+            .unwrap_or_else(|d| panic!("frame {frame}: {d}"));
+        assert!(stats.triangles <= budget.max_triangles, "frame {frame}");
+        assert_eq!(stats.triangles as usize, cut.triangles().len());
+        seen = (seen.0.min(stats.triangles), seen.1.max(stats.triangles));
+    }
+    // The paths went from coarse to fine.
+    assert!(seen.0 < 400 && seen.1 > 1000, "{seen:?}");
+}
+
+#[test]
+fn full_refinement_is_the_finest_level() {
+    let mesh = SemiRegular::sphere(3).unwrap();
+    let bytes = mesh.to_bytes().unwrap();
+    let s = SemiRegularView::parse(&bytes).unwrap();
+    let mut cut = Cut::boxed();
+    cut.reset(&s).unwrap();
+    let view = View::look_at([0.0, 0.0, 3.0], [0.0; 3], [0.0, 1.0, 0.0], 0.9, 1.0, 480.0);
+    let stats = cut.adapt(&s, &view, &ScreenError::new(1e-9), &Budget::default());
+    assert_eq!(cut.included(), s.wavelets());
+    assert_eq!(stats.triangles, 8 * 64);
+    let mut scratch = vec![[0u32; 2]; 3 * 512];
+    cut.check(&s, true, &mut scratch).unwrap();
+    // The same triangles as the finest level, vertex for vertex.
+    let mut want: Vec<[u32; 3]> = mesh
+        .finest_triangles()
+        .iter()
+        .map(|&t| rotate_min(t))
+        .collect();
+    let mut got: Vec<[u32; 3]> = cut
+        .triangles()
+        .iter()
+        .map(|t| rotate_min(t.map(|x| cut.vertex_id(x as usize))))
+        .collect();
+    want.sort_unstable();
+    got.sort_unstable();
+    assert_eq!(got, want);
+    for i in 0..cut.vertex_count() {
+        assert_eq!(cut.position(i), s.position(cut.vertex_id(i)));
+    }
+}
+
+fn rotate_min(t: [u32; 3]) -> [u32; 3] {
+    let k = (0..3).min_by_key(|&k| t[k]).unwrap();
+    [t[k], t[(k + 1) % 3], t[(k + 2) % 3]]
+}
+
+#[test]
+fn a_second_call_with_the_same_view_does_nothing() {
+    let bytes = sphere(5);
+    let s = SemiRegularView::parse(&bytes).unwrap();
+    let mut cut = Cut::boxed();
+    cut.reset(&s).unwrap();
+    let mut rng = Rng(7);
+    for _ in 0..20 {
+        let view = random_view(&mut rng);
+        let policy = QRefine::new(0.5 + 2.0 * rng.next());
+        cut.adapt(&s, &view, &policy, &Budget::default());
+        let again = cut.adapt(&s, &view, &policy, &Budget::default());
+        assert_eq!((again.vsplits, again.ecols), (0, 0));
+    }
+}
+
+#[test]
+fn the_budget_keeps_the_largest_errors() {
+    let bytes = sphere(5);
+    let s = SemiRegularView::parse(&bytes).unwrap();
+    let mut cut = Cut::boxed();
+    cut.reset(&s).unwrap();
+    let view = View::look_at([0.0, 0.0, 2.5], [0.0; 3], [0.0, 1.0, 0.0], 0.9, 1.0, 480.0);
+    let free = cut.adapt(&s, &view, &QRefine::new(0.5), &Budget::default());
+    cut.reset(&s).unwrap();
+    let budget = Budget {
+        max_triangles: free.triangles / 3,
+        ..Budget::default()
+    };
+    let capped = cut.adapt(&s, &view, &QRefine::new(0.5), &budget);
+    assert!(capped.budget_limited);
+    assert!(capped.triangles <= budget.max_triangles);
+    assert!(
+        capped.triangles + 8 >= budget.max_triangles / 2,
+        "{capped:?}"
+    );
+}
