@@ -217,10 +217,27 @@ pub fn draw<P: Pixel, D: Depth, const V: usize, const F: usize, const Q: usize, 
 where
     I: SlotIndex + VertexIndex,
 {
+    draw_mesh(
+        target,
+        &CutMesh::new(cut, h, style.vertex_colors),
+        camera,
+        style,
+        scratch,
+    )
+}
+
+/// Draws any engine's mesh (a [`CutMesh`], a [`WaveletMesh`], or any [`MeshSource`]) as
+/// `camera` sees it into `target`: [`draw`] for whichever engine made the mesh.
+pub fn draw_mesh<P: Pixel, D: Depth, M: MeshSource>(
+    target: &mut Target<'_, P, D>,
+    mesh: &M,
+    camera: &Camera,
+    style: &Style,
+    scratch: &mut [ShadedVertex],
+) -> Result<DrawStats, FrameError> {
     camera.check()?;
-    let mesh = CutMesh::new(cut, h, style.vertex_colors);
     let params = style.params(camera);
-    let shaded = shade(&mesh, &params, camera.width, camera.height, scratch)?;
+    let shaded = shade(mesh, &params, camera.width, camera.height, scratch)?;
     Ok(shaded.draw(target)?)
 }
 
@@ -288,14 +305,26 @@ pub fn draw_bands<P: Pixel, D: Depth, const V: usize, const F: usize, const Q: u
     camera: &Camera,
     style: &Style,
     scratch: &mut [ShadedVertex],
-    mut flush: impl FnMut(&Target<'_, P, D>),
+    flush: impl FnMut(&Target<'_, P, D>),
 ) -> Result<DrawStats, FrameError>
 where
     I: SlotIndex + VertexIndex,
 {
+    let mesh = CutMesh::new(cut, h, style.vertex_colors);
+    draw_mesh_bands(bands, &mesh, camera, style, scratch, flush)
+}
+
+/// [`draw_bands`] for any engine's mesh (see [`draw_mesh`]).
+pub fn draw_mesh_bands<P: Pixel, D: Depth, M: MeshSource>(
+    bands: Bands<'_, P, D>,
+    mesh: &M,
+    camera: &Camera,
+    style: &Style,
+    scratch: &mut [ShadedVertex],
+    mut flush: impl FnMut(&Target<'_, P, D>),
+) -> Result<DrawStats, FrameError> {
     camera.check()?;
     let (width, height) = (camera.width, camera.height);
-    let mesh = CutMesh::new(cut, h, style.vertex_colors);
     let params = style.params(camera);
     let Bands {
         color,
@@ -307,7 +336,7 @@ where
     if rows == 0 {
         return Err(TargetError::ZeroSize.into());
     }
-    let binned = shade(&mesh, &params, width, height, scratch)?.bin(bins)?;
+    let binned = shade(mesh, &params, width, height, scratch)?.bin(bins)?;
     let mut stats = DrawStats::default();
     for band in Window::bands(width, height, rows) {
         let mut target = Target::window(color, depth, width, height, band, width)?;

@@ -146,6 +146,25 @@ impl Frame {
         result
     }
 
+    /// Clears to [`BACKGROUND`] and draws any engine's `mesh` as `camera` sees it (see
+    /// [`vdlod::draw_mesh`]).
+    pub fn draw_styled<M: MeshSource>(
+        &mut self,
+        mesh: &M,
+        camera: &Camera,
+        style: &Style,
+    ) -> Result<DrawStats, FrameError> {
+        let mut scratch = self.take_scratch(mesh.vertex_count());
+        let result = {
+            let mut target = self.target()?;
+            target.clear(BACKGROUND);
+            vdlod::draw_mesh(&mut target, mesh, camera, style, &mut scratch)
+                .map_err(FrameError::from)
+        };
+        self.scratch = scratch;
+        result
+    }
+
     /// The vertex scratch, at least `n` long, taken out of the frame while its target is borrowed.
     fn take_scratch(&mut self, n: usize) -> Vec<ShadedVertex> {
         if self.scratch.len() < n {

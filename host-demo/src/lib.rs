@@ -10,3 +10,4 @@ pub mod label;
 pub mod lod;
 pub mod mesh;
 pub mod render;
+pub mod wavelet;

@@ -10,10 +10,13 @@ use clap::{Parser, Subcommand, ValueEnum};
 use vdlod_core::adapt::Budget;
 use vdlod_core::build::{BuildOptions, Cost};
 use vdlod_core::format::HierarchyView;
+use vdlod_core::wavelet::build::SemiRegular;
+use vdlod_core::wavelet::SemiRegularView;
 use vdlod_demo::hierarchy;
 use vdlod_demo::lod::{self, OrbitOptions, PolicyChoice};
 use vdlod_demo::mesh::{load_obj, load_obj_bytes, IndexedMesh, MeshError, BUNNY_NAME, BUNNY_OBJ};
 use vdlod_demo::render::{render_orbit, RenderOptions};
+use vdlod_demo::wavelet;
 use vdlod_raster::Shading;
 
 #[derive(Parser)]
@@ -36,11 +39,47 @@ enum Command {
     Render(RenderArgs),
     /// Build a mesh's vertex hierarchy and write it as a .vdh file.
     Build(BuildArgs),
-    /// Validate a .vdh file and print its figures.
+    /// Validate a .vdh hierarchy or .vdw semi-regular file and print its figures.
     Info {
-        /// The hierarchy file.
+        /// The file.
         file: PathBuf,
     },
+    /// Write the unit sphere as a semi-regular mesh for the wavelet engine: an octahedron
+    /// subdivided LEVELS times (8,192 faces at 5 levels).
+    Sphere(SphereArgs),
+    /// Run one of the papers' experiments: pictures and CSV into OUT/NAME/, one `key=value`
+    /// summary line per engine or setting.
+    Reproduce(ReproduceArgs),
+}
+
+#[derive(clap::Args)]
+struct SphereArgs {
+    /// Subdivision levels.
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=8))]
+    levels: u32,
+    /// Output file (.vdw).
+    #[arg(long, short)]
+    out: PathBuf,
+    /// Also write the finest level as an OBJ file.
+    #[arg(long)]
+    obj: Option<PathBuf>,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum Experiment {
+    /// The wavelet paper (Azuma et al. 2003), Fig. 11: the 8,192-face sphere at 0.5 px
+    /// silhouette / 3.5 px interior tolerance (paper: 732 faces), both engines.
+    Fig11,
+}
+
+#[derive(clap::Args)]
+struct ReproduceArgs {
+    /// The experiment.
+    #[arg(value_enum)]
+    name: Experiment,
+    /// Parent directory of the experiment's folder.
+    #[arg(long, short, default_value = "out")]
+    out: PathBuf,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -395,11 +434,41 @@ fn build_command(args: BuildArgs) -> Result<(), String> {
 }
 
 fn info(file: PathBuf) -> Result<(), String> {
+    let raw = std::fs::read(&file).map_err(|e| format!("{}: cannot read: {e}", file.display()))?;
+    if raw.starts_with(&vdlod_core::wavelet::format::MAGIC) {
+        let s = SemiRegularView::parse(&raw).map_err(|e| format!("{}: {e}", file.display()))?;
+        println!("{}: {}", file.display(), wavelet::summarize(&s));
+        return Ok(());
+    }
     let bytes = hierarchy::read(&file)?;
     let view = HierarchyView::parse(&bytes).map_err(|e| format!("{}: {e}", file.display()))?;
     // What `orbit` would reject, `info` rejects: refine it fully and check the mesh.
     lod::full_detail(&view).map_err(|e| format!("{}: {e}", file.display()))?;
     println!("{}: {}", file.display(), hierarchy::summarize(&view));
+    Ok(())
+}
+
+fn sphere(args: SphereArgs) -> Result<(), String> {
+    let mesh = SemiRegular::sphere(args.levels).map_err(|e| e.to_string())?;
+    let bytes = mesh.to_bytes().map_err(|e| e.to_string())?;
+    let s = SemiRegularView::parse(&bytes).map_err(|e| format!("{}: {e}", args.out.display()))?;
+    wavelet::write_file(&args.out, &bytes)?;
+    println!("{}: {}", args.out.display(), wavelet::summarize(&s));
+    if let Some(obj) = args.obj {
+        wavelet::write_obj(&mesh, &obj)?;
+        println!("{}: the finest level as OBJ", obj.display());
+    }
+    Ok(())
+}
+
+fn reproduce(args: ReproduceArgs) -> Result<(), String> {
+    let (name, lines) = match args.name {
+        Experiment::Fig11 => ("fig11", wavelet::fig11(&args.out.join("fig11"))?),
+    };
+    for line in lines {
+        println!("{line}");
+    }
+    println!("wrote {}", args.out.join(name).display());
     Ok(())
 }
 
@@ -410,6 +479,8 @@ fn main() -> ExitCode {
         Some(Command::Render(args)) => render(args),
         Some(Command::Build(args)) => build_command(args),
         Some(Command::Info { file }) => info(file),
+        Some(Command::Sphere(args)) => sphere(args),
+        Some(Command::Reproduce(args)) => reproduce(args),
         None => orbit_command(OrbitArgs::default()),
     };
     match result {

@@ -591,7 +591,7 @@ fn wavelet_bounds(
                                 .map(|x| x * weight as f32 / sl as f32);
                             let kin = if id == v || (l > level && hex_len(m.to(corner)) + sl <= s) {
                                 Kin::Out
-                            } else if l < level && hex_len(corner.to(m)) + s <= sl {
+                            } else if l < level {
                                 Kin::In
                             } else {
                                 Kin::Either

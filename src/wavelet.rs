@@ -1,0 +1,101 @@
+//! The wavelet engine in the frame loop: [`adapt_wavelets`] moves a
+//! [`WaveletCut`](vdlod_core::wavelet::WaveletCut) to a [`Camera`], and [`WaveletMesh`] is its
+//! mesh as the rasterizer reads it, so [`crate::draw_mesh`] and [`crate::draw_mesh_bands`] draw
+//! it exactly as they draw the vertex forest's [`crate::CutMesh`].
+
+use vdlod_core::adapt::{Budget, FrameStats};
+use vdlod_core::cut::SlotIndex;
+use vdlod_core::policy::Policy;
+use vdlod_core::wavelet::{SemiRegularView, WaveletCut};
+use vdlod_raster::{MeshSource, SourceVertex, VertexIndex};
+
+use crate::camera::Camera;
+use crate::frame::FrameError;
+
+/// A wavelet cut as a mesh the rasterizer draws as is: its triangles, each vertex at its
+/// position this frame (a vertex whose wavelet is out sits on its parent edge), with the
+/// normal and colour the file gives it.
+#[derive(Clone, Copy, Debug)]
+pub struct WaveletMesh<
+    'a,
+    's,
+    const W: usize,
+    const T: usize,
+    const V: usize,
+    const Q: usize,
+    I: SlotIndex,
+> {
+    cut: &'a WaveletCut<W, T, V, Q, I>,
+    s: &'a SemiRegularView<'s>,
+    colors: bool,
+}
+
+impl<'a, 's, const W: usize, const T: usize, const V: usize, const Q: usize, I: SlotIndex>
+    WaveletMesh<'a, 's, W, T, V, Q, I>
+{
+    /// The mesh of `cut` over `s`; with `colors`, in the file's vertex colours.
+    pub fn new(
+        cut: &'a WaveletCut<W, T, V, Q, I>,
+        s: &'a SemiRegularView<'s>,
+        colors: bool,
+    ) -> Self {
+        WaveletMesh { cut, s, colors }
+    }
+}
+
+impl<
+        const W: usize,
+        const T: usize,
+        const V: usize,
+        const Q: usize,
+        I: SlotIndex + VertexIndex,
+    > MeshSource for WaveletMesh<'_, '_, W, T, V, Q, I>
+{
+    type Index = I;
+
+    fn vertex_count(&self) -> usize {
+        self.cut.vertex_count()
+    }
+
+    fn triangles(&self) -> &[[I; 3]] {
+        self.cut.triangles()
+    }
+
+    #[inline]
+    fn vertex(&self, i: usize) -> SourceVertex {
+        let id = self.cut.vertex_id(i);
+        SourceVertex {
+            position: self.cut.position(i),
+            normal: self.s.normal(id),
+            color: self.s.color(id),
+        }
+    }
+
+    fn has_normals(&self) -> bool {
+        true
+    }
+
+    fn has_colors(&self) -> bool {
+        self.colors
+    }
+}
+
+/// Adapts a wavelet cut to `camera` (see [`WaveletCut::adapt`]); a camera that cannot be used
+/// changes nothing.
+pub fn adapt_wavelets<
+    const W: usize,
+    const T: usize,
+    const V: usize,
+    const Q: usize,
+    I: SlotIndex,
+    P: Policy,
+>(
+    cut: &mut WaveletCut<W, T, V, Q, I>,
+    s: &SemiRegularView<'_>,
+    camera: &Camera,
+    policy: &P,
+    budget: &Budget,
+) -> Result<FrameStats, FrameError> {
+    camera.check()?;
+    Ok(cut.adapt(s, &camera.view(), policy, budget))
+}
