@@ -10,11 +10,14 @@
 //! - the error spheroid of equation 3, aligned with the normal: at each finest vertex `q` of the
 //!   support, the error `rho(q) - rho_t(q)` when the wavelet is left out. The paper computes it
 //!   with every coarser wavelet in and every sibling out, and notes that a sibling coming in can
-//!   raise the error. Here the bound holds for every set the cut can be in: the wavelet and its
-//!   descendants are out, its ancestors are in, and every other wavelet whose hat is not zero at
-//!   `q` may be in or out. Along the normal the extremes of those sums are exact; across it the
-//!   lengths add. The ratio `a / b` is that of the largest along and across parts (equation 3),
-//!   and the spheroid is then scaled to hold every vertex's worst case.
+//!   raise the error. Here coarser wavelets are in, as the paper assumes (the closure condition
+//!   puts the ancestors in, and the monotonic bounds below make the coarser neighbours wanted
+//!   wherever the wavelet is); the wavelet and its descendants are out; and every other
+//!   wavelet of its level or finer whose hat is not zero at `q` (the four siblings and their
+//!   descendants) may be in or out: the bound holds for all of those sets. Along the normal the
+//!   extremes of the sums are exact; across it the lengths add. The ratio `a / b` is that of
+//!   the largest along and across parts (equation 3), and the spheroid is then scaled to hold
+//!   every vertex's worst case.
 //!
 //! Bounds are then made monotonic down the dependency graph (a parent's sphere holds its
 //! children's, its cone theirs, its `a` and `b` are at least theirs), so that a wavelet the tests
