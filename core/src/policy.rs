@@ -154,6 +154,16 @@ fn normalize(a: [f32; 3]) -> Option<[f32; 3]> {
 }
 
 impl View {
+    /// All zeros: a placeholder for "no view yet" in an all-zero (`.bss`) state.
+    pub(crate) const ZERO: View = View {
+        eye: [0.0; 3],
+        forward: [0.0; 3],
+        lanes: [[0.0; 8]; 4],
+        fov_y: 0.0,
+        tan_fov: 0.0,
+        pixels_per_unit: 0.0,
+    };
+
     /// The view from `eye` towards `target` with `up` roughly up, a vertical field of view of
     /// `fov_y` radians, width / height `aspect`, on a viewport `height` pixels tall. Degenerate
     /// input (eye on the target, `up` along the view) falls back to looking down `-z` with `+y` up.

@@ -127,6 +127,36 @@ pub struct WaveletCut<
     map: NodeMap<T, I>,
     heap: Arena<(u32, u32), Q>,
     threshold: f32,
+    /// Running geomorphs, sorted by wavelet vertex id, and their wavelets as bits.
+    morphs: Arena<Morph, Q>,
+    morphing: [u32; WORDS],
+    /// Whether a vertex slot sits elsewhere than its own position because a geomorph moves it or
+    /// an end of its parent edge.
+    moved: [bool; V],
+    geomorph_frames: u16,
+    /// The previous frame's view (valid with `has_previous`).
+    previous: View,
+    has_previous: bool,
+}
+
+/// One running geomorph (Azuma et al. §3.5, equation 6): the wavelet's coefficient is scaled by
+/// `weight`, which moves by `step` each frame, up to 1 for a wavelet joining and down to 0 for
+/// one leaving (which then leaves, once no child of it is left).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Morph {
+    id: u32,
+    weight: f32,
+    step: f32,
+    leaving: bool,
+}
+
+impl Morph {
+    const ZERO: Morph = Morph {
+        id: 0,
+        weight: 0.0,
+        step: 0.0,
+        leaving: false,
+    };
 }
 
 impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: SlotIndex> Default
@@ -180,6 +210,12 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
             map: NodeMap::new(),
             heap: Arena::new((0, 0)),
             threshold: 0.0,
+            morphs: Arena::new(Morph::ZERO),
+            morphing: [0; WORDS],
+            moved: [false; V],
+            geomorph_frames: 0,
+            previous: View::ZERO,
+            has_previous: false,
         }
     }
 
@@ -221,6 +257,9 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
             });
         }
         self.included.iter_mut().for_each(|w| *w = 0);
+        self.morphing.iter_mut().for_each(|w| *w = 0);
+        self.morphs.clear();
+        self.has_previous = false;
         self.base_vertices = c.base_vertices;
         self.base_faces = c.base_faces;
         self.wavelets = s.wavelets();
@@ -232,6 +271,11 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         let _complete = self.emit(s);
         debug_assert!(_complete);
         Ok(())
+    }
+
+    #[inline]
+    fn morphing_bit(&self, id: u32) -> bool {
+        has(&self.morphing, self.base_vertices, self.wavelets, id)
     }
 
     /// Whether wavelet vertex `id` is in this frame's mesh.
@@ -361,23 +405,24 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         self.triangles = (self.triangles + after.1).saturating_sub(before.1);
     }
 
-    /// Whether any child of wavelet `p` (at `level`) is in the mesh.
-    fn any_child_in(&self, s: &SemiRegularView<'_>, p: Point, level: u32) -> bool {
-        s.children(p, level)
-            .iter()
-            .flatten()
-            .any(|&c| s.vertex_id(c).is_some_and(|id| self.includes(id)))
+    /// Whether any child of wavelet `p` (at `level`) is in the mesh (with `staying`, only
+    /// children that are not leaving count).
+    fn any_child_in(&self, s: &SemiRegularView<'_>, p: Point, level: u32, staying: bool) -> bool {
+        s.children(p, level).iter().flatten().any(|&c| {
+            s.vertex_id(c)
+                .is_some_and(|id| self.includes(id) && !(staying && self.leaving(id)))
+        })
     }
 
-    /// Whether every parent of wavelet `p` (at `level`) is in the mesh, and `from` (when not
-    /// [`NIL`]) is the one with the smallest id (so that a sweep over the members looks at a
-    /// wavelet with two parents once).
+    /// Whether every parent of wavelet `p` (at `level`) is in the mesh and not leaving, and
+    /// `from` (when not [`NIL`]) is the one with the smallest id (so that a sweep over the
+    /// members looks at a wavelet with two parents once).
     fn joinable_from(&self, s: &SemiRegularView<'_>, p: Point, level: u32, from: u32) -> bool {
         let parents = s.parents(p, level);
         let mut first = NIL;
         for q in parents {
             if q != NIL {
-                if !self.includes(q) {
+                if !self.includes(q) || self.leaving(q) {
                     return false;
                 }
                 first = first.min(q);
@@ -386,10 +431,158 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         from == NIL || first == from
     }
 
-    /// Moves the cut for one frame seen from `view`: wavelets the policy no longer wants leave
-    /// (finest first, as their children leave), then wanted wavelets whose parents are in join,
-    /// largest error first, while [`Budget::max_triangles`], [`Budget::max_ops`] and the arenas
-    /// allow; then the triangles are emitted.
+    /// Geomorphs last `frames` frames (0, the default: none). Wavelets that join or leave
+    /// because of the frustum or back-face tests never blend.
+    pub fn set_geomorph_frames(&mut self, frames: u16) {
+        self.geomorph_frames = frames;
+    }
+
+    /// Wavelets in a running geomorph.
+    #[must_use]
+    pub fn blending(&self) -> u32 {
+        self.morphs.len() as u32
+    }
+
+    /// Where wavelet `id`'s geomorph is in the sorted arena (`Err`: where it would go).
+    fn morph_at(&self, id: u32) -> Result<usize, usize> {
+        if !has(&self.morphing, self.base_vertices, self.wavelets, id) {
+            return Err(0);
+        }
+        self.morphs.as_slice().binary_search_by_key(&id, |m| m.id)
+    }
+
+    /// The weight of wavelet `id`'s coefficient: 1 unless it is in a geomorph.
+    #[inline]
+    fn weight(&self, id: u32) -> f32 {
+        match self.morph_at(id) {
+            Ok(i) => self.morphs.as_slice()[i].weight,
+            Err(_) => 1.0,
+        }
+    }
+
+    /// Whether wavelet `id` is leaving in a geomorph.
+    #[inline]
+    fn leaving(&self, id: u32) -> bool {
+        self.morph_at(id)
+            .is_ok_and(|i| self.morphs.as_slice()[i].leaving)
+    }
+
+    fn set_morphing(&mut self, id: u32, on: bool) {
+        let w = id.wrapping_sub(self.base_vertices) as usize;
+        if let Some(word) = self.morphing.get_mut(w / 32) {
+            if on {
+                *word |= 1 << (w % 32);
+            } else {
+                *word &= !(1 << (w % 32));
+            }
+        }
+    }
+
+    /// Starts (or turns around) wavelet `id`'s geomorph towards leaving or towards staying,
+    /// from where it is, over the set number of frames (`frames` 0: at once); `false` when the
+    /// arena is full.
+    fn start_morph(&mut self, id: u32, leaving: bool, frames: u16) -> bool {
+        let n = frames.max(1) as f32;
+        let at = self.morph_at(id);
+        let mut weight = match at {
+            Ok(i) => self.morphs.as_slice()[i].weight,
+            Err(_) if leaving => 1.0,
+            Err(_) => 0.0,
+        };
+        let step = match (leaving, frames) {
+            (true, 0) => {
+                // Left the view: gone as soon as its children are.
+                weight = 0.0;
+                0.0
+            }
+            (true, _) => -weight / n,
+            (false, _) => (1.0 - weight) / n,
+        };
+        let morph = Morph {
+            id,
+            weight,
+            step,
+            leaving,
+        };
+        match at {
+            Ok(i) => self.morphs.as_mut_slice()[i] = morph,
+            Err(_) => {
+                let i = self.morphs.as_slice().partition_point(|m| m.id < id);
+                if self.morphs.push(morph).is_err() {
+                    return false;
+                }
+                self.morphs.as_mut_slice()[i..].rotate_right(1);
+                self.set_morphing(id, true);
+            }
+        }
+        true
+    }
+
+    /// Ends wavelet `id`'s geomorph, if any.
+    fn end_morph(&mut self, id: u32) {
+        if let Ok(i) = self.morph_at(id) {
+            self.morphs.as_mut_slice()[i..].rotate_left(1);
+            self.morphs.pop();
+            self.set_morphing(id, false);
+        }
+    }
+
+    /// One frame of every geomorph: weights move; joined wavelets stop blending.
+    fn advance_morphs(&mut self) {
+        let mut i = 0;
+        while i < self.morphs.len() {
+            let m = &mut self.morphs.as_mut_slice()[i];
+            m.weight = (m.weight + m.step).clamp(0.0, 1.0);
+            if !m.leaving && m.weight >= 1.0 {
+                let id = m.id;
+                self.end_morph(id);
+            } else {
+                i += 1;
+            }
+        }
+    }
+
+    /// Removes the leaving wavelets whose weight reached 0 and whose children are gone
+    /// (children first, so a parent that finished with them goes in the same frame).
+    fn finish_leaving(&mut self, s: &SemiRegularView<'_>) {
+        loop {
+            let mut done = false;
+            let mut i = 0;
+            while i < self.morphs.len() {
+                let m = self.morphs.as_slice()[i];
+                let gone = m.leaving
+                    && m.weight <= 0.0
+                    && s.point(m.id).is_some_and(|p| {
+                        let level = s.level(p);
+                        !self.any_child_in(s, p, level, false)
+                    });
+                if gone {
+                    if let Some(p) = s.point(m.id) {
+                        self.toggle(s, m.id, p, s.level(p));
+                    }
+                    self.end_morph(m.id);
+                    done = true;
+                } else {
+                    i += 1;
+                }
+            }
+            if !done {
+                break;
+            }
+        }
+    }
+
+    /// Moves the cut for one frame seen from `view`: running geomorphs advance; wavelets the
+    /// policy no longer wants leave (finest first: a wavelet may start leaving once its
+    /// children are leaving, and is gone once they are); then wanted wavelets whose parents
+    /// are in join, largest error first, while [`Budget::max_triangles`], [`Budget::max_ops`]
+    /// and the arenas allow; then the triangles are emitted.
+    ///
+    /// With geomorphs ([`WaveletCut::set_geomorph_frames`]) a wavelet joins with its coefficient
+    /// scaled from 0 to 1 and leaves scaled from where it is to 0 (the paper's equation 6); a
+    /// wavelet and its descendants may blend at the same time, and a wavelet the policy wants
+    /// back while leaving turns around from where it is. Wavelets that join or leave because
+    /// they entered or left the view (frustum or back-face) do so at once.
     pub fn adapt<P: Policy>(
         &mut self,
         s: &SemiRegularView<'_>,
@@ -408,11 +601,13 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         let max_vertices = (V.min(self.map.capacity()) as u32).max(self.base_vertices);
         let mut ops = 0u32;
         let words = (self.wavelets as usize).div_ceil(32).min(WORDS);
+        self.advance_morphs();
+        self.finish_leaving(s);
 
-        // Coarsen: a member with no member child leaves when unwanted; its parents may follow
-        // in the next pass.
+        // Coarsen: a member none of whose children stays leaves when unwanted (blending unless
+        // it left the view); its parents may follow in the next pass.
         'coarsen: loop {
-            let mut removed = false;
+            let mut changed = false;
             for word in 0..words {
                 let mut bits = self.included[word];
                 while bits != 0 {
@@ -420,25 +615,42 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
                     bits &= bits - 1;
                     let Some(p) = s.point(id) else { continue };
                     let level = s.level(p);
-                    if self.any_child_in(s, p, level)
-                        || Self::wants(s, id, view, policy, t).is_some()
-                    {
+                    let d = policy.demand(&s.bounds(id), view);
+                    let wanted = d.visible && d.error > t;
+                    if self.leaving(id) {
+                        if wanted {
+                            // Wanted back: it turns around where it is.
+                            self.start_morph(id, false, self.geomorph_frames);
+                        }
+                        continue;
+                    }
+                    if wanted || self.any_child_in(s, p, level, true) {
                         continue;
                     }
                     if ops >= budget.max_ops {
                         stats.ops_limited = true;
                         break 'coarsen;
                     }
-                    self.toggle(s, id, p, level);
+                    let children = self.any_child_in(s, p, level, false);
+                    let frames = if d.visible { self.geomorph_frames } else { 0 };
+                    if (frames == 0 && !children) || !self.start_morph(id, true, frames) {
+                        if children {
+                            stats.blend_limited = true;
+                            continue;
+                        }
+                        self.end_morph(id);
+                        self.toggle(s, id, p, level);
+                    }
                     ops += 1;
                     stats.ecols += 1;
-                    removed = true;
+                    changed = true;
                 }
             }
-            if !removed {
+            if !changed {
                 break;
             }
         }
+        self.finish_leaving(s);
 
         if self.triangles > max_triangles || self.vertices > max_vertices {
             self.enforce_max(s, view, policy, max_triangles, max_vertices, &mut stats);
@@ -459,7 +671,9 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
             while bits != 0 {
                 let id = self.base_vertices + (word as u32) * 32 + bits.trailing_zeros();
                 bits &= bits - 1;
-                self.offer_children(s, id, true, view, policy, t, &mut stats);
+                if !self.leaving(id) {
+                    self.offer_children(s, id, true, view, policy, t, &mut stats);
+                }
             }
         }
         while let Some((_, id)) = self.heap.heap_pop() {
@@ -485,6 +699,14 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
                 }
                 break;
             }
+            // It blends in unless it just came into view.
+            if self.geomorph_frames > 0
+                && self.has_previous
+                && policy.demand(&s.bounds(id), &self.previous).visible
+                && !self.start_morph(id, false, self.geomorph_frames)
+            {
+                stats.blend_limited = true;
+            }
             ops += 1;
             stats.vsplits += 1;
             self.offer_children(s, id, false, view, policy, t, &mut stats);
@@ -494,10 +716,13 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         if !self.emit(s) {
             stats.capacity_limited = true;
         }
+        self.previous = *view;
+        self.has_previous = true;
         self.threshold = budget.regulate(self.threshold, self.triangles);
         stats.triangles = self.tris.len() as u32;
         stats.vertices = self.ids.len() as u32;
         stats.threshold = t;
+        stats.blending = self.blending();
         stats.over_budget = stats.triangles > budget.max_triangles;
         stats
     }
@@ -526,7 +751,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
                 let id = self.base_vertices + (word as u32) * 32 + bits.trailing_zeros();
                 bits &= bits - 1;
                 let Some(p) = s.point(id) else { continue };
-                if !self.any_child_in(s, p, s.level(p))
+                if !self.any_child_in(s, p, s.level(p), false)
                     && self.heap.heap_push((priority(id), id)).is_err()
                 {
                     stats.queue_overflow = true;
@@ -539,16 +764,17 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
             };
             let Some(p) = s.point(id) else { continue };
             let level = s.level(p);
-            if !self.includes(id) || self.any_child_in(s, p, level) {
+            if !self.includes(id) || self.any_child_in(s, p, level, false) {
                 continue;
             }
+            self.end_morph(id);
             self.toggle(s, id, p, level);
             stats.ecols += 1;
             stats.budget_ecols += 1;
             for q in s.parents(p, level) {
                 let Some(pq) = s.point(q) else { continue };
                 if self.includes(q)
-                    && !self.any_child_in(s, pq, s.level(pq))
+                    && !self.any_child_in(s, pq, s.level(pq), false)
                     && self.heap.heap_push((priority(q), q)).is_err()
                 {
                     stats.queue_overflow = true;
@@ -630,15 +856,39 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         if let Some(slot) = self.map.get(id, self.ids.as_slice()) {
             return Ok(slot);
         }
-        let position = if id < self.base_vertices || self.includes(id) {
-            s.position(id)
+        let end = |k: usize| ends[k] as usize;
+        let ends_moved = ends[0] != NIL && (self.moved[end(0)] || self.moved[end(1)]);
+        let at_own = id < self.base_vertices
+            || (self.includes(id) && !ends_moved && !self.morphing_bit(id));
+        let (position, moved) = if at_own {
+            (s.position(id), false)
         } else {
-            let a = self.position(ends[0] as usize);
-            let b = self.position(ends[1] as usize);
-            [0, 1, 2].map(|k| (a[k] + b[k]) * 0.5)
+            // rho_t at this vertex: the midpoint of its parent edge as drawn, plus its
+            // coefficient (its own position minus its parent edge's midpoint) scaled by its
+            // weight (0 when it is not in the mesh).
+            let a = self.position(end(0));
+            let b = self.position(end(1));
+            let w = if self.includes(id) {
+                self.weight(id)
+            } else {
+                0.0
+            };
+            let mut p = [0, 1, 2].map(|k| (a[k] + b[k]) * 0.5);
+            if w > 0.0 {
+                let (own, x, y) = (
+                    s.position(id),
+                    s.position(self.vertex_id(end(0))),
+                    s.position(self.vertex_id(end(1))),
+                );
+                for k in 0..3 {
+                    p[k] += w * (own[k] - (x[k] + y[k]) * 0.5);
+                }
+            }
+            (p, true)
         };
         let slot = self.ids.push(id).map_err(|_| Full)?;
         self.positions[slot as usize] = position;
+        self.moved[slot as usize] = moved;
         if !self.map.insert(slot, self.ids.as_slice()) {
             return Err(Full);
         }

@@ -77,7 +77,7 @@ fn random_camera_paths_keep_the_mesh_closed_and_the_counts_exact() {
         seen = (seen.0.min(stats.triangles), seen.1.max(stats.triangles));
     }
     // The paths went from coarse to fine.
-    assert!(seen.0 < 400 && seen.1 > 1000, "{seen:?}");
+    assert!(seen.0 < 400 && seen.1 > 500, "{seen:?}");
 }
 
 #[test]
@@ -153,4 +153,68 @@ fn the_budget_keeps_the_largest_errors() {
         capped.triangles + 8 >= budget.max_triangles / 2,
         "{capped:?}"
     );
+}
+
+#[test]
+fn geomorphs_blend_and_settle() {
+    let bytes = sphere(4);
+    let s = SemiRegularView::parse(&bytes).unwrap();
+    let mut cut = Cut::boxed();
+    cut.reset(&s).unwrap();
+    cut.set_geomorph_frames(4);
+    let mut scratch = vec![[0u32; 2]; 3 * 16_384];
+    let mut rng = Rng(0x1234_5678);
+    let mut blended = 0;
+    for frame in 0..200 {
+        let view = random_view(&mut rng);
+        let policy = QRefine::new(0.3 + 3.0 * rng.next());
+        let budget = if frame % 4 == 0 {
+            Budget {
+                max_triangles: 200 + (rng.next() * 1500.0) as u32,
+                ..Budget::default()
+            }
+        } else {
+            Budget::default()
+        };
+        let stats = cut.adapt(&s, &view, &policy, &budget);
+        cut.check(&s, true, &mut scratch)
+            .unwrap_or_else(|d| panic!("frame {frame}: {d}"));
+        assert!(stats.triangles <= budget.max_triangles);
+        blended = blended.max(stats.blending);
+    }
+    assert!(blended > 0);
+    // A joining wavelet starts on its parent edge; a still view settles every blend, and every
+    // member is then at its own position.
+    let view = View::look_at([0.0, 0.3, 2.2], [0.0; 3], [0.0, 1.0, 0.0], 0.9, 1.0, 480.0);
+    cut.reset(&s).unwrap();
+    cut.adapt(&s, &view, &QRefine::new(4.0), &Budget::default());
+    let first = cut.adapt(&s, &view, &QRefine::new(0.5), &Budget::default());
+    assert!(first.vsplits > 0 && first.blending > 0, "{first:?}");
+    for _ in 0..5 {
+        cut.adapt(&s, &view, &QRefine::new(0.5), &Budget::default());
+    }
+    let settled = cut.adapt(&s, &view, &QRefine::new(0.5), &Budget::default());
+    assert_eq!(
+        (settled.blending, settled.vsplits, settled.ecols),
+        (0, 0, 0)
+    );
+    for i in 0..cut.vertex_count() {
+        let id = cut.vertex_id(i);
+        if id < 6 || cut.includes(id) {
+            assert_eq!(cut.position(i), s.position(id));
+        }
+    }
+    // Coarser again: wavelets leave over four frames, then are gone.
+    let leave = cut.adapt(&s, &view, &QRefine::new(4.0), &Budget::default());
+    assert!(leave.ecols > 0 && leave.blending > 0);
+    assert_eq!(
+        leave.triangles, settled.triangles,
+        "leaving wavelets stay until they are flat"
+    );
+    for _ in 0..8 {
+        cut.adapt(&s, &view, &QRefine::new(4.0), &Budget::default());
+    }
+    let gone = cut.adapt(&s, &view, &QRefine::new(4.0), &Budget::default());
+    assert_eq!(gone.blending, 0);
+    assert!(gone.triangles < settled.triangles);
 }
