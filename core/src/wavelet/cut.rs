@@ -22,10 +22,16 @@
 //! budget is hard: a wavelet joins only when the triangles it brings fit
 //! [`Budget::max_triangles`] and the arenas.
 //!
-//! Memory (`Self::BYTES`): the bits (`4 WORDS`), 16 B per vertex slot (id and position), 6 B
-//! (`u16`) per triangle slot, 2 B per triangle slot of vertex map, 8 B per queue entry. With
-//! `V = T / 2` (a closed mesh has about half as many vertices as triangles) and `Q = T / 8`, that is
-//! 17 B per triangle of capacity plus the bits.
+//! Geomorphs (§3.5, equation 6) scale a joining or leaving wavelet's coefficient over a set
+//! number of frames ([`WaveletCut::set_geomorph_frames`]); they overlap in space and time, and a
+//! wavelet turned around mid-way starts from where it is.
+//!
+//! Memory (`Self::BYTES`, asserted in a test): two bits per wavelet (`8 WORDS`: in the mesh,
+//! blending), 17 B per vertex slot (id, position, whether it is moved), 8 B per triangle slot
+//! (corners as `u16`, vertex map), 24 B per queue entry (a candidate and a geomorph), and under
+//! 256 B of counts and the previous view. With `V = T / 2` (a closed mesh has about half as many
+//! vertices as triangles) and `Q = T / 8`, that is 19.5 B per triangle of capacity beside the
+//! bits.
 
 use crate::adapt::{Budget, FrameStats};
 use crate::cut::slot::{Arena, SlotIndex};
@@ -858,8 +864,8 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         }
         let end = |k: usize| ends[k] as usize;
         let ends_moved = ends[0] != NIL && (self.moved[end(0)] || self.moved[end(1)]);
-        let at_own = id < self.base_vertices
-            || (self.includes(id) && !ends_moved && !self.morphing_bit(id));
+        let at_own =
+            id < self.base_vertices || (self.includes(id) && !ends_moved && !self.morphing_bit(id));
         let (position, moved) = if at_own {
             (s.position(id), false)
         } else {
