@@ -138,6 +138,13 @@ impl Eye {
     fn spheroid(self, b: &Bounds) -> f32 {
         (b.a2 * self.d2 + (b.b2 - b.a2) * self.rn * self.rn).max(b.b2 * self.d2)
     }
+
+    /// Hoppe's sphere-plus-cones shape with `a` as its `delta` (along the axis) and `b` as its
+    /// `mu` (around it): its squared projected radius times `d^4`.
+    #[inline(always)]
+    fn sphere_and_cones(self, b: &Bounds) -> f32 {
+        (b.b2 * self.d2).max(b.a2 * (self.d2 - self.rn * self.rn))
+    }
 }
 
 fn cross(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
@@ -420,6 +427,49 @@ impl Policy for ScreenError {
         } else {
             f32::INFINITY
         }
+    }
+}
+
+/// [`ScreenError`] with Hoppe's bound instead of the spheroid ("View-dependent refinement of
+/// progressive meshes", 1997): the error lies in a sphere of radius `mu` swept along the axis
+/// by `delta`, read from [`Bounds::b2`] (`mu^2`) and [`Bounds::a2`] (`delta^2`). A split is
+/// wanted while `mu^2 >= k^2 |d|^2` or `delta^2 (|d|^2 - (d.n)^2) >= k^2 |d|^4`, `k` the
+/// tolerance over the pixels per unit length. For the wavelet paper's comparison (its Fig. 10)
+/// with bounds built as Hoppe's ([`crate::wavelet::build::Bound::Hoppe`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HoppeError {
+    /// Screen-space tolerances.
+    pub error: ScreenError,
+}
+
+impl Policy for HoppeError {
+    #[inline]
+    fn demand(&self, b: &Bounds, view: &View) -> Demand {
+        let e = Eye::of(b, view);
+        let lhs = e.sphere_and_cones(b);
+        let tol = if e.on_silhouette(b) {
+            self.error.silhouette
+        } else {
+            self.error.interior
+        };
+        let rhs = tol * tol * e.d2 * e.d2;
+        let error = if rhs > 0.0 {
+            lhs * (view.pixels_per_unit * view.pixels_per_unit) / rhs
+        } else if lhs > 0.0 {
+            f32::MAX
+        } else {
+            0.0
+        };
+        Demand {
+            visible: true,
+            error,
+        }
+    }
+
+    /// `lhs <= max(mu^2, delta^2) |d|^2`, as for the spheroid.
+    #[inline]
+    fn error_bound(&self, center: [f32; 3], s2: f32, view: &View) -> f32 {
+        self.error.error_bound(center, s2, view)
     }
 }
 

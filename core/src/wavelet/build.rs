@@ -28,8 +28,8 @@ use alloc::vec::Vec;
 use core::fmt;
 
 use super::format::{
-    Counts, SemiRegularView, CRC_OFFSET, FACE_SIZE, FLAG_COLORS, HEADER_SIZE, MAGIC, MAX_LEVELS,
-    NONE, VERSION, VERTEX_SIZE,
+    Counts, SemiRegularView, CRC_OFFSET, FACE_SIZE, FLAG_COLORS, FLAG_HOPPE, HEADER_SIZE, MAGIC,
+    MAX_LEVELS, NONE, VERSION, VERTEX_SIZE,
 };
 use super::lattice::{hex_len, Point};
 use crate::format::{crc32, encode_length, oct_decode, oct_encode, POSITION_STEPS};
@@ -77,6 +77,25 @@ impl fmt::Display for SemiRegularBuildError {
 }
 
 impl core::error::Error for SemiRegularBuildError {}
+
+/// The shape that bounds a wavelet's error in the file.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Bound {
+    /// The spheroid of equation 3 (the default; read by [`crate::policy::ScreenError`]).
+    Spheroid,
+    /// Hoppe's sphere of radius `mu` swept along the normal by `delta`, in the `a` and `b`
+    /// fields (read by [`crate::policy::HoppeError`]; for the paper's Fig. 10).
+    Hoppe,
+}
+
+/// How [`SemiRegular::subdivide`] places the vertices of each level.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Scheme {
+    /// On the base triangles: every wavelet coefficient is zero.
+    Midpoint,
+    /// Loop subdivision.
+    Loop,
+}
 
 /// A semi-regular mesh in memory: a base mesh, its levels, and every vertex's position (and
 /// colour) in the file's vertex order.
@@ -312,6 +331,121 @@ impl SemiRegular {
         })
     }
 
+    /// The base mesh `faces` over `base` subdivided `levels` times by `scheme`: midpoint
+    /// subdivision keeps every level flat on the base triangles; Loop subdivision (Loop, "Smooth
+    /// subdivision surfaces based on triangles", 1987) smooths every level, moving the old
+    /// vertices too (borders follow the cubic B-spline rule), so the base vertices of the
+    /// result sit where the finest level puts them.
+    pub fn subdivide(
+        base: &[[f32; 3]],
+        faces: &[[u32; 3]],
+        levels: u32,
+        scheme: Scheme,
+    ) -> Result<SemiRegular, SemiRegularBuildError> {
+        let n = (1u32 << levels.min(MAX_LEVELS)) as f32;
+        let mut mesh = SemiRegular::from_fn(base, faces, levels, |f, w| {
+            let c = faces[f as usize].map(|v| base[v as usize]);
+            core::array::from_fn(|k| (0..3).map(|i| c[i][k] * w[i] as f32 / n).sum())
+        })?;
+        if scheme == Scheme::Midpoint {
+            return Ok(mesh);
+        }
+        let view = mesh.view();
+        let count = view.vertices() as usize;
+        let nb = base.len();
+        // The faces around each base vertex, and every vertex's level.
+        let mut around: Vec<Vec<(u32, usize)>> = vec![Vec::new(); nb];
+        for (f, c) in faces.iter().enumerate() {
+            for (k, &v) in c.iter().enumerate() {
+                around[v as usize].push((f as u32, k));
+            }
+        }
+        let level: Vec<u32> = (0..count as u32)
+            .map(|v| view.point(v).map_or(0, |p| view.level(p)))
+            .collect();
+        let corner = |f: u32, k: usize| {
+            let mut w = [0; 3];
+            w[k] = view.steps();
+            Point { face: f, w }
+        };
+        let id_of = |p: Point| view.canonical(p).and_then(|q| view.vertex_id(q));
+        let border = |p: Point, q: Point| {
+            view.canonical(p.left_of(q)).is_none() || view.canonical(p.right_of(q)).is_none()
+        };
+        let mut pos = mesh.positions.clone();
+        for j in 0..levels {
+            let step = view.step_of(j);
+            let mut next = pos.clone();
+            for v in 0..count {
+                let lv = level[v];
+                if lv == j + 1 {
+                    // A new vertex: 3/8 of its edge's ends and 1/8 of the far corners.
+                    let Some(p) = view.point(v as u32) else {
+                        continue;
+                    };
+                    let [x, y] = view.parent_edge(p, lv);
+                    let ends = [id_of(x), id_of(y)];
+                    let far = [id_of(x.left_of(y)), id_of(x.right_of(y))];
+                    let at = |id: Option<u32>| id.map_or([0.0; 3], |i| pos[i as usize]);
+                    let (a, b) = (at(ends[0]), at(ends[1]));
+                    next[v] = match far {
+                        [Some(c), Some(d)] => {
+                            let (c, d) = (pos[c as usize], pos[d as usize]);
+                            [0, 1, 2].map(|k| 0.375 * (a[k] + b[k]) + 0.125 * (c[k] + d[k]))
+                        }
+                        _ => [0, 1, 2].map(|k| 0.5 * (a[k] + b[k])),
+                    };
+                } else if lv <= j {
+                    // An old vertex: its ring at level j.
+                    let mut ring: Vec<(u32, bool)> = Vec::new();
+                    let mut add = |p: Point, q: Point| {
+                        if let Some(id) = id_of(q) {
+                            if ring.iter().all(|&(r, _)| r != id) {
+                                ring.push((id, border(p, q)));
+                            }
+                        }
+                    };
+                    if v < nb {
+                        for &(f, k) in &around[v] {
+                            let c = corner(f, k);
+                            let toward = |m: usize| {
+                                let d = c.to(corner(f, m));
+                                let unit = [0, 1, 2].map(|i| d[i] / view.steps());
+                                c.offset(unit, step)
+                            };
+                            add(c, toward((k + 1) % 3));
+                            add(c, toward((k + 2) % 3));
+                        }
+                    } else if let Some(p) = view.point(v as u32) {
+                        for d in super::lattice::DIRECTIONS {
+                            add(p, p.offset(d, step));
+                        }
+                    }
+                    let here = pos[v];
+                    let edges: Vec<u32> = ring.iter().filter(|r| r.1).map(|r| r.0).collect();
+                    next[v] = if edges.len() >= 2 {
+                        let (a, b) = (pos[edges[0] as usize], pos[edges[1] as usize]);
+                        [0, 1, 2].map(|k| 0.75 * here[k] + 0.125 * (a[k] + b[k]))
+                    } else if ring.is_empty() {
+                        here
+                    } else {
+                        let m = ring.len() as f32;
+                        let c = 0.375 + 0.25 * libm::cosf(core::f32::consts::TAU / m);
+                        let beta = (0.625 - c * c) / m;
+                        let sum = ring.iter().fold([0.0f32; 3], |acc, &(r, _)| {
+                            let q = pos[r as usize];
+                            [acc[0] + q[0], acc[1] + q[1], acc[2] + q[2]]
+                        });
+                        [0, 1, 2].map(|k| (1.0 - m * beta) * here[k] + beta * sum[k])
+                    };
+                }
+            }
+            pos = next;
+        }
+        mesh.positions = pos;
+        Ok(mesh)
+    }
+
     /// The lattice of this mesh (every record zero).
     fn view(&self) -> SemiRegularView<'_> {
         // `from_fn` parsed these bytes already.
@@ -334,8 +468,13 @@ impl SemiRegular {
     }
 
     /// The file: positions quantized over the bounding box, normals, and every wavelet's bounds
-    /// (see the module documentation).
+    /// (see the module documentation), with the error bounded by the spheroid.
     pub fn to_bytes(&self) -> Result<Vec<u8>, SemiRegularBuildError> {
+        self.to_bytes_with(Bound::Spheroid)
+    }
+
+    /// [`SemiRegular::to_bytes`] with the error bounded by `bound`.
+    pub fn to_bytes_with(&self, bound: Bound) -> Result<Vec<u8>, SemiRegularBuildError> {
         let view = self.view();
         let counts = view.counts();
         let n = counts.vertices() as usize;
@@ -394,15 +533,19 @@ impl SemiRegular {
         for (k, b) in bounds.iter().enumerate() {
             let r = &mut records[base + k];
             r[8] = encode_length(b.radius / unit);
-            r[9] = encode_length(b.a / unit);
-            r[10] = encode_length(b.b / unit);
+            let (a, bb) = match bound {
+                Bound::Spheroid => (b.a, b.b),
+                Bound::Hoppe => (b.delta, b.mu),
+            };
+            r[9] = encode_length(a / unit);
+            r[10] = encode_length(bb / unit);
             r[11] = if b.cone >= core::f32::consts::FRAC_PI_2 {
                 255
             } else {
                 libm::ceilf(libm::sinf(b.cone) * 255.0).clamp(0.0, 255.0) as u8
             };
         }
-        Ok(file_bytes(
+        let mut out = file_bytes(
             counts,
             face_bytes,
             edge_bytes,
@@ -411,7 +554,14 @@ impl SemiRegular {
             origin,
             extent,
             unit,
-        ))
+        );
+        if bound == Bound::Hoppe {
+            let flags = u16::from_le_bytes([out[6], out[7]]) | FLAG_HOPPE;
+            out[6..8].copy_from_slice(&flags.to_le_bytes());
+            let crc = crc32(&out[HEADER_SIZE..]);
+            out[CRC_OFFSET..CRC_OFFSET + 4].copy_from_slice(&crc.to_le_bytes());
+        }
+        Ok(out)
     }
 }
 
@@ -488,6 +638,9 @@ struct WaveletBounds {
     radius: f32,
     a: f32,
     b: f32,
+    /// Hoppe's `delta` (largest error along the normal) and `mu` (largest across it).
+    delta: f32,
+    mu: f32,
     /// Cone half-angle in radians.
     cone: f32,
 }
@@ -623,6 +776,7 @@ fn wavelet_bounds(
             }
             let max_a = worst.iter().fold(0.0f32, |m, w| m.max(w.0));
             let max_b = worst.iter().fold(0.0f32, |m, w| m.max(w.1));
+            (out.delta, out.mu) = (max_a, max_b);
             if max_b <= 0.0 {
                 out.a = max_a;
             } else if max_a <= 0.0 {
@@ -690,6 +844,8 @@ fn monotonic(
             parent.radius = parent.radius.max(gap + child.radius);
             parent.a = parent.a.max(child.a);
             parent.b = parent.b.max(child.b);
+            parent.delta = parent.delta.max(child.delta);
+            parent.mu = parent.mu.max(child.mu);
             parent.cone = parent.cone.max(turn + child.cone);
         }
     }
@@ -710,6 +866,46 @@ mod tests {
             assert_eq!(view.vertex_id(p), Some(v), "{p:?}");
             assert!(matches!(view.site(p), Site::Edge(..) | Site::Inner));
         }
+    }
+
+    #[test]
+    fn loop_subdivision_smooths_an_octahedron_towards_a_sphere() {
+        let base = [
+            [1.0, 0.0, 0.0],
+            [-1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, -1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [0.0, 0.0, -1.0],
+        ];
+        let faces = [
+            [0, 2, 4],
+            [2, 1, 4],
+            [1, 3, 4],
+            [3, 0, 4],
+            [2, 0, 5],
+            [1, 2, 5],
+            [3, 1, 5],
+            [0, 3, 5],
+        ];
+        let spread = |m: &SemiRegular| {
+            let r: Vec<f32> = m.positions.iter().map(|&p| norm(p)).collect();
+            let (lo, hi) = r
+                .iter()
+                .fold((f32::MAX, 0.0f32), |(a, b), &x| (a.min(x), b.max(x)));
+            hi / lo
+        };
+        let flat = SemiRegular::subdivide(&base, &faces, 3, Scheme::Midpoint).unwrap();
+        let smooth = SemiRegular::subdivide(&base, &faces, 3, Scheme::Loop).unwrap();
+        // The flat octahedron's radii range over 1/sqrt(3) .. 1; Loop's are within a few %.
+        assert!(spread(&flat) > 1.7);
+        assert!(spread(&smooth) < 1.1, "{}", spread(&smooth));
+        // Symmetric: the six base vertices stay on their axes at one radius.
+        let r0 = norm(smooth.positions[0]);
+        for v in 0..6 {
+            assert!((norm(smooth.positions[v]) - r0).abs() < 1e-5);
+        }
+        smooth.to_bytes().unwrap();
     }
 
     #[test]

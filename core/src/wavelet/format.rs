@@ -23,7 +23,8 @@
 //! | vertices | 12 per vertex | position `3 x u16` (`origin + q * extent / 65535`); normal octahedral `2 x i8` (also the axis of the cone of normals); codes of the bounding radius, spheroid `a` and `b` ([`crate::format::decode_length`], in units of the header's length unit) and the cone's sine (`ceil(255 sin)`; 255: no useful cone), 8 bits each; zeros but the position and normal for a base vertex |
 //! | colours | 3 per vertex, only with flag bit 0 | `3 x u8` |
 //!
-//! Header: offset 0 magic `VDLW`; 4 version `u16` = 1; 6 flags `u16` (bit 0: colours); 8
+//! Header: offset 0 magic `VDLW`; 4 version `u16` = 1; 6 flags `u16` (bit 0: colours; bit 1:
+//! the `a` and `b` codes hold Hoppe's `delta` and `mu` instead of the spheroid's radii); 8
 //! `levels` (`J`, 1 to [`MAX_LEVELS`]), 12 `base_vertices`, 16 `base_faces`, 20 `base_edges`
 //! (`u32` each); 24 CRC-32 of everything after the header; 28 bounding-box origin `3 x f32`; 40
 //! extent `3 x f32` (non-negative); 52 the length unit of the bound codes, `f32`; 56 to 63 zero.
@@ -61,6 +62,9 @@ pub const VERTEX_SIZE: usize = 12;
 pub const COLOR_SIZE: usize = 3;
 /// Header flag: the vertices carry colours.
 pub const FLAG_COLORS: u16 = 1;
+/// Header flag: the `a` and `b` codes are Hoppe's `delta` and `mu` (see
+/// [`crate::policy::HoppeError`]), not the spheroid's radii.
+pub const FLAG_HOPPE: u16 = 2;
 /// The most subdivision levels a file may have (`N = 4096` steps per base edge).
 pub const MAX_LEVELS: u32 = 12;
 /// "No face" in the across fields.
@@ -276,7 +280,9 @@ impl<'a> SemiRegularView<'a> {
             return Err(E::UnsupportedVersion(version));
         }
         let flags = u16_at(bytes, 6);
-        if flags & !FLAG_COLORS != 0 || bytes[56..HEADER_SIZE].iter().any(|&b| b != 0) {
+        if flags & !(FLAG_COLORS | FLAG_HOPPE) != 0
+            || bytes[56..HEADER_SIZE].iter().any(|&b| b != 0)
+        {
             return Err(E::BadCounts("unknown flags or non-zero reserved bytes"));
         }
         let counts = Counts {
@@ -441,6 +447,13 @@ impl<'a> SemiRegularView<'a> {
     #[must_use]
     pub fn size(&self) -> usize {
         self.bytes.len()
+    }
+
+    /// Whether the `a` and `b` bounds are Hoppe's `delta` and `mu` rather than the spheroid's
+    /// radii (flag bit 1).
+    #[must_use]
+    pub fn hoppe_bounds(&self) -> bool {
+        self.flags & FLAG_HOPPE != 0
     }
 
     /// The box every position lies in, as its minimum and maximum corners.

@@ -21,6 +21,8 @@ pub mod cut;
 pub mod format;
 pub mod lattice;
 
+#[cfg(feature = "build")]
+pub use build::{Bound, Scheme, SemiRegular, SemiRegularBuildError};
 pub use cut::{WaveletCut, WaveletCutError, WaveletDefect};
 pub use format::{SemiRegularError, SemiRegularView};
 pub use lattice::Point;
