@@ -4,6 +4,7 @@
 //! benchmarks use it too, so what they render is exactly what the demo renders.
 
 pub mod camera;
+pub mod chart;
 pub mod frame;
 pub mod hierarchy;
 pub mod label;

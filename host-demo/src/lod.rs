@@ -17,6 +17,7 @@ use vdlod_core::policy::{
 use vdlod_raster::{Rgba8, Shading, VertexIndex};
 
 use crate::camera::{merge_tree_orbit, peer_orbit, Camera, Orbit};
+use crate::chart::{self, Panel, BLUE, GREY, ORANGE};
 use crate::frame::{encode_png, Frame, FrameError};
 use crate::label;
 use crate::mesh::{vertex_normals, Bounds, IndexedMesh};
@@ -326,119 +327,29 @@ pub fn side_by_side(width: usize, height: usize, a: &[Rgba8], b: &[Rgba8]) -> Ve
 }
 
 /// The smallest 1, 2 or 5 times a power of ten not below `v`.
-fn nice_ceiling(v: f64) -> f64 {
-    if v <= 0.0 || !v.is_finite() {
-        return 1.0;
-    }
-    let p = 10f64.powf(v.log10().floor());
-    [1.0, 2.0, 5.0, 10.0]
-        .iter()
-        .map(|m| m * p)
-        .find(|&c| c >= v * (1.0 - 1e-9))
-        .unwrap_or(10.0 * p)
-}
-
-fn tick(v: f64) -> String {
-    if v >= 100.0 || v == v.round() {
-        format!("{v:.0}")
-    } else if v >= 1.0 {
-        format!("{v:.1}")
-    } else {
-        format!("{v:.2}")
-    }
-}
-
 /// A plot of triangles (top, blue) and milliseconds (bottom: adapt + render in orange, the
 /// full-detail render in grey) per frame, labelled.
 pub fn plot(frames: &[OrbitFrame]) -> Result<Vec<u8>, FrameError> {
-    let (w, h) = (820u32, 470u32);
-    let mut pixmap = tiny_skia::Pixmap::new(w, h)
-        .ok_or_else(|| FrameError::Png("cannot make the plot".into()))?;
-    pixmap.fill(tiny_skia::Color::WHITE);
-    let (left, width, height) = (70.0f32, w as f32 - 90.0, 160.0f32);
-    let tops = [34.0f32, 264.0];
-    let panel = |top: f32| tiny_skia::Rect::from_xywh(left, top, width, height);
-    let n = frames.len().max(2) as f32;
-    let ink = (60, 60, 60);
-    let mut grid = tiny_skia::Paint::default();
-    grid.set_color_rgba8(215, 215, 215, 255);
-    let draw_line =
-        |pixmap: &mut tiny_skia::Pixmap, top: f32, values: &[f64], max: f64, rgb: (u8, u8, u8)| {
-            let Some(r) = panel(top) else { return };
-            let mut pb = tiny_skia::PathBuilder::new();
-            for (i, v) in values.iter().enumerate() {
-                let x = r.left() + r.width() * i as f32 / (n - 1.0);
-                let y = r.bottom() - r.height() * (v / max).min(1.0) as f32;
-                if i == 0 {
-                    pb.move_to(x, y);
-                } else {
-                    pb.line_to(x, y);
-                }
-            }
-            if let Some(path) = pb.finish() {
-                let mut paint = tiny_skia::Paint::default();
-                paint.set_color_rgba8(rgb.0, rgb.1, rgb.2, 255);
-                paint.anti_alias = true;
-                let stroke = tiny_skia::Stroke {
-                    width: 2.0,
-                    ..Default::default()
-                };
-                pixmap.stroke_path(
-                    &path,
-                    &paint,
-                    &stroke,
-                    tiny_skia::Transform::identity(),
-                    None,
-                );
-            }
-        };
     let tris: Vec<f64> = frames.iter().map(|f| f.stats.triangles as f64).collect();
     let ours: Vec<f64> = frames
         .iter()
         .map(|f| (f.adapt_us + f.render_us) / 1e3)
         .collect();
     let full: Vec<f64> = frames.iter().map(|f| f.full_render_us / 1e3).collect();
-    let tmax = nice_ceiling(tris.iter().cloned().fold(0.0, f64::max));
-    let mmax = nice_ceiling(ours.iter().chain(&full).cloned().fold(0.0, f64::max));
-    for (top, max) in [(tops[0], tmax), (tops[1], mmax)] {
-        let Some(r) = panel(top) else { continue };
-        for q in 0..=4 {
-            let y = r.top() + r.height() * q as f32 / 4.0;
-            if let Some(line) = tiny_skia::Rect::from_xywh(r.left(), y, r.width(), 1.0) {
-                pixmap.fill_rect(line, &grid, tiny_skia::Transform::identity(), None);
-            }
-            let label = tick(max * (4 - q) as f64 / 4.0);
-            let x = r.left() - 8.0 - 8.0 * label.len() as f32;
-            label::draw(&mut pixmap, &label, x, y - 5.0, 2.0, ink);
-        }
-        label::draw(&mut pixmap, "0", r.left(), r.bottom() + 6.0, 2.0, ink);
-        let last = format!("frame {}", frames.len().saturating_sub(1));
-        let x = r.right() - 8.0 * last.len() as f32;
-        label::draw(&mut pixmap, &last, x, r.bottom() + 6.0, 2.0, ink);
-    }
-    label::draw(
-        &mut pixmap,
-        "triangles per frame",
-        left,
-        10.0,
-        2.0,
-        (40, 90, 200),
-    );
-    let x = label::draw(
-        &mut pixmap,
-        "ms per frame: adapt + render",
-        left,
-        240.0,
-        2.0,
-        (230, 120, 20),
-    );
-    label::draw(&mut pixmap, ", full detail", x, 240.0, 2.0, (130, 130, 130));
-    draw_line(&mut pixmap, tops[0], &tris, tmax, (40, 90, 200));
-    draw_line(&mut pixmap, tops[1], &full, mmax, (150, 150, 150));
-    draw_line(&mut pixmap, tops[1], &ours, mmax, (230, 120, 20));
-    pixmap
-        .encode_png()
-        .map_err(|e| FrameError::Png(e.to_string()))
+    let panels = [
+        Panel {
+            title: vec![("triangles per frame", BLUE)],
+            series: vec![(tris, BLUE)],
+        },
+        Panel {
+            title: vec![
+                ("ms per frame: adapt + render", ORANGE),
+                (", full detail", GREY),
+            ],
+            series: vec![(full, GREY), (ours, ORANGE)],
+        },
+    ];
+    chart::panels(&panels).map_err(FrameError::Png)
 }
 
 /// The three panels of [`side_by_side`] as a PNG, each with its caption along the top.

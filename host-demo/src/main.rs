@@ -10,7 +10,7 @@ use clap::{Parser, Subcommand, ValueEnum};
 use vdlod_core::adapt::Budget;
 use vdlod_core::build::{BuildOptions, Cost};
 use vdlod_core::format::HierarchyView;
-use vdlod_core::wavelet::build::SemiRegular;
+use vdlod_core::wavelet::build::{Scheme, SemiRegular};
 use vdlod_core::wavelet::SemiRegularView;
 use vdlod_demo::hierarchy;
 use vdlod_demo::lod::{self, OrbitOptions, PolicyChoice};
@@ -47,6 +47,9 @@ enum Command {
     /// Write the unit sphere as a semi-regular mesh for the wavelet engine: an octahedron
     /// subdivided LEVELS times (8,192 faces at 5 levels).
     Sphere(SphereArgs),
+    /// Subdivide a mesh into a semi-regular one for the wavelet engine: its triangles (or, with
+    /// --base, a simplification of it to about that many faces) become the base mesh.
+    Subdivide(SubdivideArgs),
     /// Run one of the papers' experiments: pictures and CSV into OUT/NAME/, one `key=value`
     /// summary line per engine or setting.
     Reproduce(ReproduceArgs),
@@ -66,10 +69,45 @@ struct SphereArgs {
 }
 
 #[derive(Clone, Copy, ValueEnum)]
+enum SchemeArg {
+    /// Loop subdivision (smooth).
+    Loop,
+    /// Midpoint subdivision (flat: every wavelet coefficient is zero).
+    Midpoint,
+}
+
+#[derive(clap::Args)]
+struct SubdivideArgs {
+    /// OBJ file: a manifold triangle mesh, consistently oriented.
+    mesh: PathBuf,
+    /// Subdivision levels.
+    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=8))]
+    levels: u32,
+    /// How the new vertices are placed.
+    #[arg(long, value_enum, default_value = "loop")]
+    scheme: SchemeArg,
+    /// Simplify the mesh to about this many faces first (0: use it as it is).
+    #[arg(long, default_value_t = 0)]
+    base: u32,
+    /// Output file (.vdw).
+    #[arg(long, short)]
+    out: PathBuf,
+    /// Also write the finest level as an OBJ file.
+    #[arg(long)]
+    obj: Option<PathBuf>,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
 enum Experiment {
     /// The wavelet paper (Azuma et al. 2003), Fig. 11: the 8,192-face sphere at 0.5 px
     /// silhouette / 3.5 px interior tolerance (paper: 732 faces), both engines.
     Fig11,
+    /// The wavelet paper, Fig. 9 (and Fig. 13's face counts): a session that turns around the
+    /// model, then zooms in, over the sphere and a 51,200-face subdivided mesh with a 200-face
+    /// base; faces and milliseconds per frame.
+    Fig9,
+    /// The wavelet paper, Fig. 10: the spheroid against Hoppe's bound over the same session.
+    Fig10,
 }
 
 #[derive(clap::Args)]
@@ -461,9 +499,41 @@ fn sphere(args: SphereArgs) -> Result<(), String> {
     Ok(())
 }
 
+fn subdivide(args: SubdivideArgs) -> Result<(), String> {
+    let mesh = load_obj(&args.mesh).map_err(|e| e.to_string())?;
+    let base = if args.base > 0 {
+        wavelet::simplified_base(&mesh, args.base)
+            .map_err(|e| format!("{}: {e}", args.mesh.display()))?
+    } else {
+        wavelet::BaseMesh {
+            positions: mesh.positions.clone(),
+            triangles: mesh.triangles.clone(),
+        }
+    };
+    let scheme = match args.scheme {
+        SchemeArg::Loop => Scheme::Loop,
+        SchemeArg::Midpoint => Scheme::Midpoint,
+    };
+    let semi = SemiRegular::subdivide(&base.positions, &base.triangles, args.levels, scheme)
+        .map_err(|e| format!("{}: {e}", args.mesh.display()))?;
+    let bytes = semi
+        .to_bytes()
+        .map_err(|e| format!("{}: {e}", args.mesh.display()))?;
+    let s = SemiRegularView::parse(&bytes).map_err(|e| format!("{}: {e}", args.out.display()))?;
+    wavelet::write_file(&args.out, &bytes)?;
+    println!("{}: {}", args.out.display(), wavelet::summarize(&s));
+    if let Some(obj) = args.obj {
+        wavelet::write_obj(&semi, &obj)?;
+        println!("{}: the finest level as OBJ", obj.display());
+    }
+    Ok(())
+}
+
 fn reproduce(args: ReproduceArgs) -> Result<(), String> {
     let (name, lines) = match args.name {
         Experiment::Fig11 => ("fig11", wavelet::fig11(&args.out.join("fig11"))?),
+        Experiment::Fig9 => ("fig9", wavelet::fig9(&args.out.join("fig9"))?),
+        Experiment::Fig10 => ("fig10", wavelet::fig10(&args.out.join("fig10"))?),
     };
     for line in lines {
         println!("{line}");
@@ -480,6 +550,7 @@ fn main() -> ExitCode {
         Some(Command::Build(args)) => build_command(args),
         Some(Command::Info { file }) => info(file),
         Some(Command::Sphere(args)) => sphere(args),
+        Some(Command::Subdivide(args)) => subdivide(args),
         Some(Command::Reproduce(args)) => reproduce(args),
         None => orbit_command(OrbitArgs::default()),
     };

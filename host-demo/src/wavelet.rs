@@ -12,13 +12,15 @@ use vdlod_core::adapt::{Budget, FrameStats};
 use vdlod_core::build::{build, BuildOptions, InputMesh};
 use vdlod_core::cut::Cut;
 use vdlod_core::format::HierarchyView;
-use vdlod_core::policy::{QRefine, ScreenError};
-use vdlod_core::wavelet::build::SemiRegular;
+use vdlod_core::policy::{BackFace, Frustum, HoppeError, Policy, QRefine, ScreenError};
+use vdlod_core::wavelet::build::{Bound, Scheme, SemiRegular};
 use vdlod_core::wavelet::{SemiRegularView, WaveletCut};
 use vdlod_raster::Rgba8;
 
+use crate::chart::{self, Panel, BLUE, GREEN, GREY, ORANGE};
 use crate::frame::{encode_png, Frame};
 use crate::lod::psnr;
+use crate::mesh::{load_obj_bytes, vertex_normals, IndexedMesh, COW_NAME, COW_OBJ};
 
 /// The demo's wavelet cut: up to 262,144 wavelets, 60,000 triangles and 30,000 vertices (about
 /// 1.1 MB, on the heap).
@@ -294,4 +296,345 @@ pub fn fig11(out: &Path) -> Result<Vec<String>, String> {
     let path = out.join("fig11.csv");
     std::fs::write(&path, csv).map_err(|e| format!("{}: cannot write: {e}", path.display()))?;
     Ok(lines)
+}
+
+/// A base mesh of about `faces` triangles made from `mesh` by the vertex hierarchy's edge
+/// collapses (its roots and base triangles, renumbered), so that any mesh can be subdivided
+/// into a semi-regular one with a small base.
+pub fn simplified_base(mesh: &IndexedMesh, faces: u32) -> Result<BaseMesh, String> {
+    let input = InputMesh {
+        positions: &mesh.positions,
+        colors: None,
+        triangles: &mesh.triangles,
+    };
+    let opts = BuildOptions {
+        base_vertices: faces / 2 + 2,
+        ..BuildOptions::default()
+    };
+    let h = build(&input, &opts, &mut |_| {}).map_err(|e| e.to_string())?;
+    let mut index = std::collections::BTreeMap::new();
+    let mut positions = Vec::new();
+    let triangles = h
+        .base_triangles
+        .iter()
+        .map(|t| {
+            t.map(|v| {
+                *index.entry(v).or_insert_with(|| {
+                    positions.push(h.nodes[v as usize].position);
+                    positions.len() as u32 - 1
+                })
+            })
+        })
+        .collect();
+    Ok(BaseMesh {
+        positions,
+        triangles,
+    })
+}
+
+/// A base mesh: positions and counter-clockwise triangles.
+#[derive(Clone, Debug)]
+pub struct BaseMesh {
+    /// Vertex positions.
+    pub positions: Vec<[f32; 3]>,
+    /// Triangles.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// The demo's subdivided mesh for the paper's fish experiments: the cow simplified to a base
+/// of about 200 faces and Loop-subdivided four times (the fish: 199 base faces, 50,944 at four
+/// levels).
+pub fn cow_loop() -> Result<SemiRegular, String> {
+    let cow = load_obj_bytes(COW_NAME, COW_OBJ).map_err(|e| e.to_string())?;
+    let base = simplified_base(&cow, 200)?;
+    SemiRegular::subdivide(&base.positions, &base.triangles, 4, Scheme::Loop)
+        .map_err(|e| e.to_string())
+}
+
+/// The paper's interactive-style session (§4): `frames` cameras, the first two thirds turning
+/// once around the model at three radii, where it lies whole in the view, the rest zooming in
+/// to a close-up of its surface.
+pub fn session(center: Vec3, radius: f32, frames: u32, width: usize, height: usize) -> Vec<Camera> {
+    let turn = (frames * 2 / 3).max(1);
+    let direction = |i: u32| {
+        let a = std::f32::consts::TAU * i.min(turn - 1) as f32 / turn as f32;
+        Vec3::new(a.sin(), 0.35, a.cos()).normalize()
+    };
+    (0..frames)
+        .map(|i| {
+            let dir = direction(i);
+            let (eye, target) = if i < turn {
+                (center + dir * 3.0 * radius, center)
+            } else {
+                let t = (i - turn + 1) as f32 / (frames - turn) as f32;
+                let surface = center + dir * radius;
+                let distance = 3.0 * (1.0 - t) + 1.3 * t;
+                (center + dir * distance * radius, center.lerp(surface, t))
+            };
+            Camera {
+                eye,
+                target,
+                up: Vec3::Y,
+                fov_y: 45f32.to_radians(),
+                near: radius * 0.01,
+                far: radius * 10.0,
+                width,
+                height,
+            }
+        })
+        .collect()
+}
+
+/// One frame of a session.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct SessionFrame {
+    /// Triangles drawn.
+    pub faces: u32,
+    /// Wavelets in the mesh (0 for the vertex forest).
+    pub wavelets: u32,
+    /// Milliseconds adapting, drawing the adapted mesh, drawing the full mesh.
+    pub adapt_ms: f64,
+    /// Milliseconds drawing the adapted mesh.
+    pub render_ms: f64,
+    /// Milliseconds drawing the full-detail mesh.
+    pub full_ms: f64,
+    /// PSNR against the full-detail frame.
+    pub psnr_db: f64,
+}
+
+/// The full-detail mesh of a semi-regular mesh, for drawing.
+pub fn finest_mesh(mesh: &SemiRegular) -> IndexedMesh {
+    let triangles = mesh.finest_triangles();
+    IndexedMesh {
+        normals: vertex_normals(&mesh.positions, &triangles),
+        positions: mesh.positions.clone(),
+        colors: None,
+        triangles,
+    }
+}
+
+fn ms(start: Instant) -> f64 {
+    start.elapsed().as_secs_f64() * 1e3
+}
+
+/// Flies a wavelet cut of `s` along `cameras` with `policy`, drawing each frame and the full
+/// mesh beside it.
+pub fn fly_wavelets<P: Policy>(
+    s: &SemiRegularView<'_>,
+    full: &IndexedMesh,
+    cameras: &[Camera],
+    policy: &P,
+) -> Result<Vec<SessionFrame>, String> {
+    let mut cut = DemoWaveletCut::boxed();
+    cut.reset(s).map_err(|e| e.to_string())?;
+    let Some(first) = cameras.first() else {
+        return Ok(Vec::new());
+    };
+    let mut frame = Frame::new(first.width, first.height).map_err(|e| e.to_string())?;
+    let style = Style::default();
+    let mut out = Vec::with_capacity(cameras.len());
+    for camera in cameras {
+        let start = Instant::now();
+        let stats = vdlod::adapt_wavelets(&mut cut, s, camera, policy, &Budget::default())
+            .map_err(|e| e.to_string())?;
+        let adapt_ms = ms(start);
+        let start = Instant::now();
+        frame
+            .draw(&full.as_raster_mesh(), &style.params(camera))
+            .map_err(|e| e.to_string())?;
+        let full_ms = ms(start);
+        let reference = frame.pixels().to_vec();
+        let start = Instant::now();
+        frame
+            .draw_styled(&WaveletMesh::new(&cut, s, false), camera, &style)
+            .map_err(|e| e.to_string())?;
+        out.push(SessionFrame {
+            faces: stats.triangles,
+            wavelets: cut.included(),
+            adapt_ms,
+            render_ms: ms(start),
+            full_ms,
+            psnr_db: psnr(frame.pixels(), &reference),
+        });
+    }
+    Ok(out)
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v.get(v.len() / 2).copied().unwrap_or(0.0)
+}
+
+fn mean(v: impl Iterator<Item = f64>) -> f64 {
+    let (sum, n) = v.fold((0.0, 0usize), |(s, n), x| (s + x, n + 1));
+    sum / n.max(1) as f64
+}
+
+fn write_csv(path: &Path, frames: &[SessionFrame]) -> Result<(), String> {
+    let mut csv = String::from("frame,faces,wavelets,adapt_ms,render_ms,full_render_ms,psnr_db\n");
+    for (i, f) in frames.iter().enumerate() {
+        let _ = writeln!(
+            csv,
+            "{i},{},{},{:.3},{:.3},{:.3},{:.2}",
+            f.faces, f.wavelets, f.adapt_ms, f.render_ms, f.full_ms, f.psnr_db
+        );
+    }
+    std::fs::write(path, csv).map_err(|e| format!("{}: cannot write: {e}", path.display()))
+}
+
+/// The paper's Fig. 9: the session over the 8,192-face sphere and over the cow subdivided to
+/// 51,200 faces from a 200-face base (our stand-in for the fish), at a 0.5 px silhouette and 3.5
+/// px interior tolerance (7x, as the paper sets it), with faces and milliseconds per frame;
+/// and, as in its Fig. 13, the subdivided cow at 2 / 10 px from the first camera against three
+/// uniform levels. Writes `NAME.csv` and `NAME.png` per mesh into `out`.
+pub fn fig9(out: &Path) -> Result<Vec<String>, String> {
+    std::fs::create_dir_all(out).map_err(|e| format!("{}: {e}", out.display()))?;
+    let policy = QRefine {
+        error: ScreenError {
+            silhouette: 0.5,
+            interior: 3.5,
+        },
+    };
+    let mut lines = Vec::new();
+    for (name, mesh) in [
+        ("sphere", SemiRegular::sphere(5).map_err(|e| e.to_string())?),
+        ("cow_loop4", cow_loop()?),
+    ] {
+        let bytes = mesh.to_bytes().map_err(|e| e.to_string())?;
+        let s = SemiRegularView::parse(&bytes).map_err(|e| e.to_string())?;
+        let full = finest_mesh(&mesh);
+        let b = full.bounds();
+        let cameras = session(b.center(), b.radius(), 90, 512, 512);
+        let frames = fly_wavelets(&s, &full, &cameras, &policy)?;
+        write_csv(&out.join(format!("{name}.csv")), &frames)?;
+        let faces: Vec<f64> = frames.iter().map(|f| f.faces as f64).collect();
+        let full_faces = vec![full.triangles.len() as f64; frames.len()];
+        let ours: Vec<f64> = frames.iter().map(|f| f.adapt_ms + f.render_ms).collect();
+        let adapt: Vec<f64> = frames.iter().map(|f| f.adapt_ms).collect();
+        let full_ms: Vec<f64> = frames.iter().map(|f| f.full_ms).collect();
+        let png = chart::panels(&[
+            Panel {
+                title: vec![("faces per frame", BLUE), (", full model", GREY)],
+                series: vec![(full_faces, GREY), (faces.clone(), BLUE)],
+            },
+            Panel {
+                title: vec![
+                    ("ms: adapt + render", ORANGE),
+                    (", adapt", GREEN),
+                    (", full model", GREY),
+                ],
+                series: vec![
+                    (full_ms.clone(), GREY),
+                    (ours, ORANGE),
+                    (adapt.clone(), GREEN),
+                ],
+            },
+        ])?;
+        save(out, &format!("{name}.png"), &png)?;
+        let mut line = format!(
+            "experiment=fig9 mesh={name} full_faces={} base_faces={} faces_mean={:.0} faces_max={:.0} faces_last={:.0} psnr_db_mean={:.2} adapt_ms_median={:.3} render_ms_median={:.3} full_render_ms_median={:.3}",
+            full.triangles.len(),
+            s.counts().base_faces,
+            mean(faces.iter().cloned()),
+            faces.iter().cloned().fold(0.0, f64::max),
+            faces.last().copied().unwrap_or(0.0),
+            mean(frames.iter().map(|f| f.psnr_db.min(99.0))),
+            median(adapt),
+            median(frames.iter().map(|f| f.render_ms).collect()),
+            median(full_ms),
+        );
+        if name == "cow_loop4" {
+            let coarse = QRefine {
+                error: ScreenError {
+                    silhouette: 2.0,
+                    interior: 10.0,
+                },
+            };
+            let one = fly_wavelets(&s, &full, &cameras[..1], &coarse)?;
+            let _ = write!(
+                line,
+                " adaptive_2_10px_faces={} uniform3_faces={} paper_adaptive_faces=3943 paper_uniform3_faces=12736",
+                one[0].faces,
+                s.counts().base_faces * 64
+            );
+        }
+        lines.push(line);
+    }
+    Ok(lines)
+}
+
+/// The paper's Fig. 10: the spheroid against Hoppe's bound over the session on the subdivided
+/// cow, face counts per frame (at a distance, and in the close-up). Writes `fig10.csv` and
+/// `fig10.png` into `out`.
+pub fn fig10(out: &Path) -> Result<Vec<String>, String> {
+    std::fs::create_dir_all(out).map_err(|e| format!("{}: {e}", out.display()))?;
+    let mesh = cow_loop()?;
+    let full = finest_mesh(&mesh);
+    let b = full.bounds();
+    let cameras = session(b.center(), b.radius(), 90, 512, 512);
+    let error = ScreenError {
+        silhouette: 0.5,
+        interior: 3.5,
+    };
+    let spheroid = mesh
+        .to_bytes_with(Bound::Spheroid)
+        .map_err(|e| e.to_string())?;
+    let hoppe = mesh
+        .to_bytes_with(Bound::Hoppe)
+        .map_err(|e| e.to_string())?;
+    let s = SemiRegularView::parse(&spheroid).map_err(|e| e.to_string())?;
+    let h = SemiRegularView::parse(&hoppe).map_err(|e| e.to_string())?;
+    let runs = [
+        (
+            "spheroid",
+            fly_wavelets(&s, &full, &cameras, &QRefine { error })?,
+        ),
+        (
+            "hoppe",
+            fly_wavelets(
+                &h,
+                &full,
+                &cameras,
+                &(Frustum, (BackFace, HoppeError { error })),
+            )?,
+        ),
+    ];
+    let turn = cameras.len() * 2 / 3;
+    let mut csv =
+        String::from("frame,spheroid_faces,hoppe_faces,spheroid_adapt_ms,hoppe_adapt_ms\n");
+    for i in 0..cameras.len() {
+        let (a, b) = (runs[0].1[i], runs[1].1[i]);
+        let _ = writeln!(
+            csv,
+            "{i},{},{},{:.3},{:.3}",
+            a.faces, b.faces, a.adapt_ms, b.adapt_ms
+        );
+    }
+    let path = out.join("fig10.csv");
+    std::fs::write(&path, csv).map_err(|e| format!("{}: cannot write: {e}", path.display()))?;
+    let faces = |k: usize| runs[k].1.iter().map(|f| f.faces as f64).collect::<Vec<_>>();
+    let adapt = |k: usize| runs[k].1.iter().map(|f| f.adapt_ms).collect::<Vec<_>>();
+    let png = chart::panels(&[
+        Panel {
+            title: vec![("faces: spheroid", BLUE), (", hoppe", ORANGE)],
+            series: vec![(faces(1), ORANGE), (faces(0), BLUE)],
+        },
+        Panel {
+            title: vec![("adapt ms: spheroid", BLUE), (", hoppe", ORANGE)],
+            series: vec![(adapt(1), ORANGE), (adapt(0), BLUE)],
+        },
+    ])?;
+    save(out, "fig10.png", &png)?;
+    Ok(runs
+        .iter()
+        .map(|(bound, frames)| {
+            format!(
+                "experiment=fig10 mesh=cow_loop4 bound={bound} faces_far_mean={:.0} faces_close_mean={:.0} psnr_db_mean={:.2} adapt_ms_median={:.3}",
+                mean(frames[..turn].iter().map(|f| f.faces as f64)),
+                mean(frames[turn..].iter().map(|f| f.faces as f64)),
+                mean(frames.iter().map(|f| f.psnr_db.min(99.0))),
+                median(frames.iter().map(|f| f.adapt_ms).collect()),
+            )
+        })
+        .collect())
 }

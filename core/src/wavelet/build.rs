@@ -14,10 +14,11 @@
 //!   puts the ancestors in, and the monotonic bounds below make the coarser neighbours wanted
 //!   wherever the wavelet is); the wavelet and its descendants are out; and every other
 //!   wavelet of its level or finer whose hat is not zero at `q` (the four siblings and their
-//!   descendants) may be in or out: the bound holds for all of those sets. Along the normal the
-//!   extremes of the sums are exact; across it the lengths add. The ratio `a / b` is that of
-//!   the largest along and across parts (equation 3), and the spheroid is then scaled to hold
-//!   every vertex's worst case.
+//!   descendants) may be in or out: the bound holds for all of those sets. The error vectors
+//!   of every such set (up to ten candidates at a vertex, 1,024 sets; beyond, a box of the
+//!   extremes along and across the normal) are listed; the ratio `a / b` is that of their
+//!   largest parts along and across the normal (equation 3), and the spheroid is then scaled to
+//!   hold them all. Hoppe's `delta` and `mu` ([`Bound::Hoppe`]) are those largest parts.
 //!
 //! Bounds are then made monotonic down the dependency graph (a parent's sphere holds its
 //! children's, its cone theirs, its `a` and `b` are at least theirs), so that a wavelet the tests
@@ -730,7 +731,7 @@ fn wavelet_bounds(
                     // The error at q: what the wavelet and its descendants carry, plus what
                     // the others may or may not.
                     let mut out_part = [0.0f32; 3];
-                    let (mut lo, mut hi, mut across) = (0.0f32, 0.0f32, 0.0f32);
+                    let mut either: Vec<[f32; 3]> = Vec::new();
                     for l in 1..=levels {
                         let sl = view.step_of(l);
                         for (corner, weight) in containing(q, sl) {
@@ -759,19 +760,11 @@ fn wavelet_bounds(
                                     }
                                 }
                                 Kin::In => {}
-                                Kin::Either => {
-                                    let along = dot(contrib, axis);
-                                    lo += along.min(0.0);
-                                    hi += along.max(0.0);
-                                    across += norm(cross(contrib, axis));
-                                }
+                                Kin::Either => either.push(contrib),
                             }
                         }
                     }
-                    let along = dot(out_part, axis);
-                    let a_q = (along + lo).abs().max((along + hi).abs());
-                    let b_q = norm(cross(out_part, axis)) + across;
-                    worst.push((a_q, b_q));
+                    worst_case(out_part, &either, axis, &mut worst);
                 }
             }
             let max_a = worst.iter().fold(0.0f32, |m, w| m.max(w.0));
@@ -792,6 +785,39 @@ fn wavelet_bounds(
             out
         })
         .collect()
+}
+
+/// Candidates beyond which [`worst_case`] bounds the error set by a box instead of listing it.
+const MAX_LISTED: usize = 10;
+
+/// Appends to `worst` the (along, across) lengths of the error vectors `fixed + sum(S)` for
+/// every subset `S` of `either`: their convex hull holds every error the cut can show, and a
+/// spheroid that holds those points holds the hull. With more than [`MAX_LISTED`] candidates,
+/// one point instead: the extremes along the normal (exact) and across it (the lengths added).
+fn worst_case(fixed: [f32; 3], either: &[[f32; 3]], axis: [f32; 3], worst: &mut Vec<(f32, f32)>) {
+    if either.len() <= MAX_LISTED {
+        for mask in 0u32..1 << either.len() {
+            let mut e = fixed;
+            for (k, c) in either.iter().enumerate() {
+                if mask >> k & 1 == 1 {
+                    for i in 0..3 {
+                        e[i] += c[i];
+                    }
+                }
+            }
+            worst.push((dot(e, axis).abs(), norm(cross(e, axis))));
+        }
+        return;
+    }
+    let along = dot(fixed, axis);
+    let (lo, hi) = either.iter().fold((along, along), |(lo, hi), c| {
+        let x = dot(*c, axis);
+        (lo + x.min(0.0), hi + x.max(0.0))
+    });
+    let across = either.iter().fold(norm(cross(fixed, axis)), |acc, c| {
+        acc + norm(cross(*c, axis))
+    });
+    worst.push((lo.abs().max(hi.abs()), across));
 }
 
 /// The corners of the lattice triangle of step `s` holding `q` (same frame), each with `q`'s
