@@ -108,6 +108,9 @@ enum Experiment {
     Fig9,
     /// The wavelet paper, Fig. 10: the spheroid against Hoppe's bound over the same session.
     Fig10,
+    /// Both engines (wavelets, vertex forest) on the same meshes at equal triangle counts: PSNR,
+    /// adaptation time, file and cut sizes.
+    Engines,
 }
 
 #[derive(clap::Args)]
@@ -534,6 +537,7 @@ fn reproduce(args: ReproduceArgs) -> Result<(), String> {
         Experiment::Fig11 => ("fig11", wavelet::fig11(&args.out.join("fig11"))?),
         Experiment::Fig9 => ("fig9", wavelet::fig9(&args.out.join("fig9"))?),
         Experiment::Fig10 => ("fig10", wavelet::fig10(&args.out.join("fig10"))?),
+        Experiment::Engines => ("engines", wavelet::engines(&args.out.join("engines"))?),
     };
     for line in lines {
         println!("{line}");

@@ -417,16 +417,87 @@ fn ms(start: Instant) -> f64 {
     start.elapsed().as_secs_f64() * 1e3
 }
 
-/// Flies a wavelet cut of `s` along `cameras` with `policy`, drawing each frame and the full
-/// mesh beside it.
-pub fn fly_wavelets<P: Policy>(
-    s: &SemiRegularView<'_>,
+/// What a session needs of an engine: adapt to a camera, then draw.
+trait Engine {
+    fn adapt(&mut self, camera: &Camera) -> Result<FrameStats, String>;
+    fn draw(&self, frame: &mut Frame, camera: &Camera, style: &Style) -> Result<(), String>;
+    /// Wavelets in the mesh (0 for the vertex forest).
+    fn wavelets(&self) -> u32;
+}
+
+/// The wavelet engine with a policy.
+struct Wavelets<'a, 's, P> {
+    cut: Box<DemoWaveletCut>,
+    s: &'a SemiRegularView<'s>,
+    policy: P,
+}
+
+impl<P: Policy> Engine for Wavelets<'_, '_, P> {
+    fn adapt(&mut self, camera: &Camera) -> Result<FrameStats, String> {
+        vdlod::adapt_wavelets(
+            &mut self.cut,
+            self.s,
+            camera,
+            &self.policy,
+            &Budget::default(),
+        )
+        .map_err(|e| e.to_string())
+    }
+
+    fn draw(&self, frame: &mut Frame, camera: &Camera, style: &Style) -> Result<(), String> {
+        let mesh = WaveletMesh::new(&self.cut, self.s, false);
+        frame
+            .draw_styled(&mesh, camera, style)
+            .map_err(|e| e.to_string())?;
+        Ok(())
+    }
+
+    fn wavelets(&self) -> u32 {
+        self.cut.included()
+    }
+}
+
+/// The demo's vertex-forest cut for the experiments' meshes (up to 32,000 triangles).
+type ForestCut = Cut<16_000, 32_000, 2_000>;
+
+/// The vertex forest with a policy and, per frame, a triangle budget.
+struct Forest<'a, 'h, P> {
+    cut: Box<ForestCut>,
+    h: &'a HierarchyView<'h>,
+    policy: P,
+    budgets: Vec<u32>,
+    frame: usize,
+}
+
+impl<P: Policy> Engine for Forest<'_, '_, P> {
+    fn adapt(&mut self, camera: &Camera) -> Result<FrameStats, String> {
+        let budget = Budget {
+            max_triangles: self.budgets.get(self.frame).copied().unwrap_or(u32::MAX),
+            ..Budget::default()
+        };
+        self.frame += 1;
+        vdlod::adapt(&mut self.cut, self.h, camera, &self.policy, &budget)
+            .map_err(|e| e.to_string())
+    }
+
+    fn draw(&self, frame: &mut Frame, camera: &Camera, style: &Style) -> Result<(), String> {
+        frame
+            .draw_cut(&self.cut, self.h, camera, style)
+            .map_err(|e| e.to_string())?;
+        Ok(())
+    }
+
+    fn wavelets(&self) -> u32 {
+        0
+    }
+}
+
+/// Flies `engine` along `cameras`, drawing each frame and the full mesh beside it.
+fn fly(
+    engine: &mut impl Engine,
     full: &IndexedMesh,
     cameras: &[Camera],
-    policy: &P,
 ) -> Result<Vec<SessionFrame>, String> {
-    let mut cut = DemoWaveletCut::boxed();
-    cut.reset(s).map_err(|e| e.to_string())?;
     let Some(first) = cameras.first() else {
         return Ok(Vec::new());
     };
@@ -435,8 +506,7 @@ pub fn fly_wavelets<P: Policy>(
     let mut out = Vec::with_capacity(cameras.len());
     for camera in cameras {
         let start = Instant::now();
-        let stats = vdlod::adapt_wavelets(&mut cut, s, camera, policy, &Budget::default())
-            .map_err(|e| e.to_string())?;
+        let stats = engine.adapt(camera)?;
         let adapt_ms = ms(start);
         let start = Instant::now();
         frame
@@ -445,12 +515,10 @@ pub fn fly_wavelets<P: Policy>(
         let full_ms = ms(start);
         let reference = frame.pixels().to_vec();
         let start = Instant::now();
-        frame
-            .draw_styled(&WaveletMesh::new(&cut, s, false), camera, &style)
-            .map_err(|e| e.to_string())?;
+        engine.draw(&mut frame, camera, &style)?;
         out.push(SessionFrame {
             faces: stats.triangles,
-            wavelets: cut.included(),
+            wavelets: engine.wavelets(),
             adapt_ms,
             render_ms: ms(start),
             full_ms,
@@ -458,6 +526,24 @@ pub fn fly_wavelets<P: Policy>(
         });
     }
     Ok(out)
+}
+
+/// Flies a wavelet cut of `s` along `cameras` with `policy`, drawing each frame and the full
+/// mesh beside it.
+pub fn fly_wavelets<P: Policy + Copy>(
+    s: &SemiRegularView<'_>,
+    full: &IndexedMesh,
+    cameras: &[Camera],
+    policy: &P,
+) -> Result<Vec<SessionFrame>, String> {
+    let mut cut = DemoWaveletCut::boxed();
+    cut.reset(s).map_err(|e| e.to_string())?;
+    let mut engine = Wavelets {
+        cut,
+        s,
+        policy: *policy,
+    };
+    fly(&mut engine, full, cameras)
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -637,4 +723,78 @@ pub fn fig10(out: &Path) -> Result<Vec<String>, String> {
             )
         })
         .collect())
+}
+
+/// Both engines over the same meshes at equal triangle counts: the wavelet engine at 1 px over
+/// the session, the vertex forest of the same finest mesh held to the wavelet engine's triangle
+/// count frame by frame (a budget, with a tolerance fine enough that it binds); PSNR against
+/// full detail, adaptation time, file bytes per vertex and the cuts' memory at a 5,000-triangle
+/// capacity. Writes `NAME.csv` per mesh into `out`.
+pub fn engines(out: &Path) -> Result<Vec<String>, String> {
+    std::fs::create_dir_all(out).map_err(|e| format!("{}: {e}", out.display()))?;
+    let mut lines = Vec::new();
+    for (name, mesh) in [
+        ("sphere", SemiRegular::sphere(5).map_err(|e| e.to_string())?),
+        ("cow_loop4", cow_loop()?),
+    ] {
+        let bytes = mesh.to_bytes().map_err(|e| e.to_string())?;
+        let s = SemiRegularView::parse(&bytes).map_err(|e| e.to_string())?;
+        let full = finest_mesh(&mesh);
+        let b = full.bounds();
+        let cameras = session(b.center(), b.radius(), 90, 512, 512);
+        let wavelet = fly_wavelets(&s, &full, &cameras, &QRefine::new(1.0))?;
+        let input = InputMesh {
+            positions: &full.positions,
+            colors: None,
+            triangles: &full.triangles,
+        };
+        let hierarchy =
+            build(&input, &BuildOptions::default(), &mut |_| {}).map_err(|e| e.to_string())?;
+        let hbytes = hierarchy.to_bytes(false);
+        let h = HierarchyView::parse(&hbytes).map_err(|e| e.to_string())?;
+        let mut cut = ForestCut::boxed();
+        cut.reset(&h).map_err(|e| e.to_string())?;
+        let mut engine = Forest {
+            cut,
+            h: &h,
+            policy: QRefine::new(0.1),
+            budgets: wavelet.iter().map(|f| f.faces).collect(),
+            frame: 0,
+        };
+        let forest = fly(&mut engine, &full, &cameras)?;
+        let mut csv = String::from("frame,wavelet_faces,forest_faces,wavelet_psnr_db,forest_psnr_db,wavelet_adapt_ms,forest_adapt_ms\n");
+        for (i, (w, f)) in wavelet.iter().zip(&forest).enumerate() {
+            let _ = writeln!(
+                csv,
+                "{i},{},{},{:.2},{:.2},{:.3},{:.3}",
+                w.faces, f.faces, w.psnr_db, f.psnr_db, w.adapt_ms, f.adapt_ms
+            );
+        }
+        let path = out.join(format!("{name}.csv"));
+        std::fs::write(&path, csv).map_err(|e| format!("{}: cannot write: {e}", path.display()))?;
+        let vertices = mesh.positions.len() as f64;
+        for (engine, frames, file, cut_bytes) in [
+            (
+                "wavelet",
+                &wavelet,
+                bytes.len(),
+                WaveletCut::<1024, 5000, 2500, 625>::BYTES,
+            ),
+            (
+                "forest",
+                &forest,
+                hbytes.len(),
+                Cut::<2508, 5000, 313>::BYTES,
+            ),
+        ] {
+            lines.push(format!(
+                "experiment=engines mesh={name} engine={engine} triangles_mean={:.0} psnr_db_mean={:.2} adapt_us_median={:.0} file_bytes_per_vertex={:.1} cut_bytes_5k_triangles={cut_bytes}",
+                mean(frames.iter().map(|f| f.faces as f64)),
+                mean(frames.iter().map(|f| f.psnr_db.min(99.0))),
+                median(frames.iter().map(|f| f.adapt_ms * 1e3).collect()),
+                file as f64 / vertices,
+            ));
+        }
+    }
+    Ok(lines)
 }
