@@ -365,3 +365,100 @@ fn orbit_warns_once_when_the_base_mesh_exceeds_the_budget() {
     assert_eq!(stderr.matches("warning").count(), 1, "{stderr}");
     assert!(stderr.contains("more than the budget of 5"), "{stderr}");
 }
+
+#[test]
+fn sphere_info_and_subdivide_write_semi_regular_files() {
+    let dir = scratch_dir("cli_semi_regular");
+    let out = demo(
+        &["sphere", "--levels", "3", "-o", "s.vdw", "--obj", "s.obj"],
+        &dir,
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("8 faces") && stdout.contains("512 faces at full detail"),
+        "{stdout}"
+    );
+    let obj = std::fs::read_to_string(dir.join("s.obj")).unwrap();
+    assert_eq!(obj.lines().filter(|l| l.starts_with("f ")).count(), 512);
+    let info = demo(&["info", "s.vdw"], &dir);
+    assert!(String::from_utf8_lossy(&info.stdout).contains("252 wavelets"));
+    // A corrupted file: one line, the file and the problem.
+    let mut bytes = std::fs::read(dir.join("s.vdw")).unwrap();
+    let last = bytes.len() - 1;
+    bytes[last] ^= 0x40;
+    std::fs::write(dir.join("bad.vdw"), &bytes).unwrap();
+    let bad = demo(&["info", "bad.vdw"], &dir);
+    let stderr = String::from_utf8_lossy(&bad.stderr);
+    assert!(!bad.status.success());
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(
+        stderr.contains("bad.vdw") && stderr.contains("checksum"),
+        "{stderr}"
+    );
+    // Subdividing an OBJ (the sphere's own finest level, as a base of 512 faces).
+    let sub = demo(
+        &["subdivide", "s.obj", "--levels", "1", "-o", "t.vdw"],
+        &dir,
+    );
+    assert!(
+        sub.status.success(),
+        "{}",
+        String::from_utf8_lossy(&sub.stderr)
+    );
+    assert!(String::from_utf8_lossy(&sub.stdout).contains("2048 faces at full detail"));
+}
+
+#[test]
+fn subdivide_rejects_a_non_manifold_mesh_in_one_line() {
+    let fan = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 1 1 1\nf 1 2 3\nf 1 2 4\nf 1 2 5\n";
+    assert_one_line_failure(
+        "fan.obj",
+        fan,
+        &["subdivide", "FILE", "-o", "x.vdw"],
+        "not manifold",
+    );
+}
+
+#[test]
+fn reproduce_fig11_writes_pictures_csv_and_summary_lines() {
+    let dir = scratch_dir("cli_reproduce");
+    let help = demo(&["reproduce", "--help"], &dir);
+    let text = String::from_utf8_lossy(&help.stdout);
+    for name in ["fig11", "fig9", "fig10", "engines", "Azuma"] {
+        assert!(text.contains(name), "{name} missing from: {text}");
+    }
+    let out = demo(&["reproduce", "fig11", "-o", "out"], &dir);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let lines: Vec<&str> = stdout
+        .lines()
+        .filter(|l| l.starts_with("experiment=fig11"))
+        .collect();
+    assert_eq!(lines.len(), 2, "{stdout}");
+    for line in &lines {
+        let faces: u32 = line
+            .split(' ')
+            .find_map(|kv| kv.strip_prefix("faces="))
+            .and_then(|v| v.parse().ok())
+            .unwrap();
+        assert!(faces > 100 && faces < 8192, "{line}");
+    }
+    for file in [
+        "full.png",
+        "wavelet.png",
+        "forest.png",
+        "observer.png",
+        "fig11.csv",
+    ] {
+        assert!(dir.join("out/fig11").join(file).exists(), "{file}");
+    }
+}
