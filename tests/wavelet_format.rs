@@ -19,7 +19,12 @@ fn sphere_bytes() -> &'static [u8] {
 
 /// An open mesh: a square of two faces, subdivided twice, so borders are covered too.
 fn square_bytes() -> Vec<u8> {
-    let base = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]];
+    let base = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [0.0, 1.0, 0.0],
+    ];
     let faces = [[0, 1, 2], [0, 2, 3]];
     let n = 4.0;
     SemiRegular::from_fn(&base, &faces, 2, |f, w| {
@@ -95,7 +100,10 @@ fn each_kind_of_damage_has_its_own_error() {
     forged[HEADER_SIZE + 24..HEADER_SIZE + 28].copy_from_slice(&0u32.to_le_bytes());
     reseal(&mut forged);
     let e = SemiRegularView::parse(&forged).unwrap_err();
-    assert!(matches!(e, SemiRegularError::BadFace { face: 0, .. }), "{e}");
+    assert!(
+        matches!(e, SemiRegularError::BadFace { face: 0, .. }),
+        "{e}"
+    );
     // Levels beyond the limit.
     let mut deep = good.to_vec();
     deep[8..12].copy_from_slice(&13u32.to_le_bytes());
