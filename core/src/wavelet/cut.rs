@@ -621,16 +621,20 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
                     bits &= bits - 1;
                     let Some(p) = s.point(id) else { continue };
                     let level = s.level(p);
+                    let leaving = self.leaving(id);
+                    if !leaving && self.any_child_in(s, p, level, true) {
+                        continue;
+                    }
                     let d = policy.demand(&s.bounds(id), view);
                     let wanted = d.visible && d.error > t;
-                    if self.leaving(id) {
+                    if leaving {
                         if wanted {
                             // Wanted back: it turns around where it is.
                             self.start_morph(id, false, self.geomorph_frames);
                         }
                         continue;
                     }
-                    if wanted || self.any_child_in(s, p, level, true) {
+                    if wanted {
                         continue;
                     }
                     if ops >= budget.max_ops {
@@ -859,6 +863,11 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
     /// or a member, else at the midpoint of the slots `ends` (its parent edge).
     fn slot(&mut self, s: &SemiRegularView<'_>, p: Point, ends: [u32; 2]) -> Result<u32, Full> {
         let id = s.canonical(p).and_then(|q| s.vertex_id(q)).ok_or(Full)?;
+        self.slot_of(s, id, ends)
+    }
+
+    /// [`WaveletCut::slot`] of vertex `id`.
+    fn slot_of(&mut self, s: &SemiRegularView<'_>, id: u32, ends: [u32; 2]) -> Result<u32, Full> {
         if let Some(slot) = self.map.get(id, self.ids.as_slice()) {
             return Ok(slot);
         }
@@ -910,16 +919,20 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         v: [u32; 3],
         level: u32,
     ) -> Result<(), Full> {
-        let inc = |id| has(&self.included, self.base_vertices, self.wavelets, id);
-        if level >= self.levels || !s.subdivided(p[0], p[1], p[2], inc) {
+        if level >= self.levels {
             return self.emit_piece(s, p, v, [level; 3]);
         }
+        // The midpoints are inside this triangle's face: their ids need no unfolding.
         let m = [p[0].mid(p[1]), p[1].mid(p[2]), p[2].mid(p[0])];
-        let mv = [
-            self.slot(s, m[0], [v[0], v[1]])?,
-            self.slot(s, m[1], [v[1], v[2]])?,
-            self.slot(s, m[2], [v[2], v[0]])?,
-        ];
+        let ids = m.map(|q| s.vertex_id(q));
+        if !ids.iter().any(|&id| id.is_some_and(|id| self.includes(id))) {
+            return self.emit_piece(s, p, v, [level; 3]);
+        }
+        let mut mv = [0; 3];
+        for k in 0..3 {
+            let id = ids[k].ok_or(Full)?;
+            mv[k] = self.slot_of(s, id, [v[k], v[(k + 1) % 3]])?;
+        }
         let next = level + 1;
         self.emit_triangle(s, [p[0], m[0], m[2]], [v[0], mv[0], mv[2]], next)?;
         self.emit_triangle(s, [m[0], p[1], m[1]], [mv[0], v[1], mv[1]], next)?;
@@ -943,8 +956,18 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
                 continue;
             }
             let (a, b) = (p[i], p[j]);
-            let inc = |id| has(&self.included, self.base_vertices, self.wavelets, id);
-            if !s.subdivided(b, a, a.right_of(b), inc) {
+            // The midpoint of a leaf's edge is out (else the leaf would be subdivided), so the
+            // triangle across is subdivided when one of its two other midpoints is in.
+            let c = a.right_of(b);
+            if s.canonical(c).is_none() {
+                continue;
+            }
+            let inc = |q: Point| {
+                s.canonical(q)
+                    .and_then(|q| s.vertex_id(q))
+                    .is_some_and(|id| self.includes(id))
+            };
+            if !inc(b.mid(c)) && !inc(c.mid(a)) {
                 continue;
             }
             let m = a.mid(b);
