@@ -81,7 +81,28 @@ impl<
 }
 
 /// Adapts a wavelet cut to `camera` (see [`WaveletCut::adapt`]); a camera that cannot be used
-/// changes nothing.
+/// changes nothing. The cut is then drawn like any engine's mesh:
+///
+/// ```
+/// use vdlod::prelude::*;
+/// # fn main() -> Result<(), Box<dyn std::error::Error>> {
+/// use vdlod::core::wavelet::SemiRegular;
+/// let bytes = SemiRegular::sphere(3)?.to_bytes()?; // a device keeps these in flash
+/// let s = SemiRegularView::parse(&bytes)?;
+/// let mut cut = WaveletCut::<16, 1024, 600, 128>::boxed();
+/// cut.reset(&s)?;
+/// let camera = Orbit::peer(glam::Vec3::ZERO, 1.0, 8).viewport(40, 30).camera(0);
+/// vdlod::adapt_wavelets(&mut cut, &s, &camera, &QRefine::new(1.0), &Budget::default())?;
+/// let (mut color, mut depth) = (vec![Rgba8([0, 0, 0, 255]); 40 * 30], vec![0u32; 40 * 30]);
+/// let mut target = Target::new(&mut color, &mut depth, 40, 30)?;
+/// target.clear(Rgba8([0, 0, 0, 255]));
+/// let mut scratch = vec![ShadedVertex::default(); cut.vertex_count()];
+/// let mesh = WaveletMesh::new(&cut, &s, false);
+/// let stats = vdlod::draw_mesh(&mut target, &mesh, &camera, &Style::default(), &mut scratch)?;
+/// assert!(stats.rasterized > 0);
+/// # Ok(())
+/// # }
+/// ```
 pub fn adapt_wavelets<
     const W: usize,
     const T: usize,

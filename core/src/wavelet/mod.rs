@@ -14,6 +14,28 @@
 //! - [`lattice`]: every level's connectivity, computed from the base mesh.
 //! - [`cut`]: the set of wavelets as bits, its incremental adaptation and the emitted mesh.
 //! - `build` (feature `build`): sources of semi-regular meshes and the per-wavelet bounds.
+//!
+//! ```
+//! # #[cfg(feature = "build")] {
+//! use vdlod_core::adapt::Budget;
+//! use vdlod_core::policy::{QRefine, ScreenError, View};
+//! use vdlod_core::wavelet::{SemiRegular, SemiRegularView, WaveletCut};
+//! // The unit sphere as an octahedron subdivided four times (2,048 faces), as a file.
+//! let bytes = SemiRegular::sphere(4).unwrap().to_bytes().unwrap();
+//! let s = SemiRegularView::parse(&bytes).unwrap();
+//! // Up to 64 x 32 wavelets, 4,096 triangles, 2,100 vertices, 512 queued candidates.
+//! let mut cut = WaveletCut::<64, 4096, 2100, 512>::boxed();
+//! cut.reset(&s).unwrap();
+//! let view = View::look_at([0.0, 0.0, 3.0], [0.0; 3], [0.0, 1.0, 0.0], 0.8, 1.0, 480.0);
+//! let policy = QRefine { error: ScreenError { silhouette: 0.5, interior: 3.5 } };
+//! let stats = cut.adapt(&s, &view, &policy, &Budget::default());
+//! assert!(stats.triangles > 8 && stats.triangles < 2048);
+//! assert_eq!(stats.triangles as usize, cut.triangles().len());
+//! // Every edge of the closed sphere is shared by two triangles run opposite ways.
+//! let mut scratch = vec![[0u32; 2]; 3 * cut.triangles().len()];
+//! assert!(cut.check(&s, true, &mut scratch).is_ok());
+//! # }
+//! ```
 
 #[cfg(feature = "build")]
 pub mod build;
