@@ -220,6 +220,9 @@ pub struct SemiRegularView<'a> {
     /// `N`, and the number of vertices (which fits in `u32`).
     pub(super) n: i32,
     pub(super) vertices: u32,
+    /// The id of the first point inside a face, and the points inside each face.
+    pub(super) first_inner: u32,
+    pub(super) inner: u32,
 }
 
 impl fmt::Debug for SemiRegularView<'_> {
@@ -343,6 +346,8 @@ impl<'a> SemiRegularView<'a> {
             unit,
             n: 1 << counts.levels,
             vertices: counts.vertices() as u32,
+            first_inner: counts.base_vertices + counts.base_edges * ((1u32 << counts.levels) - 1),
+            inner: counts.inner_points() as u32,
         };
         view.check_faces()?;
         view.check_edges()?;
@@ -469,7 +474,18 @@ impl<'a> SemiRegularView<'a> {
     #[must_use]
     pub fn corners(&self, f: u32) -> [u32; 3] {
         let o = self.face_offset(f);
-        [0, 4, 8].map(|k| u32_at(self.bytes, o.saturating_add(k)))
+        match o.checked_add(12).and_then(|end| self.bytes.get(o..end)) {
+            Some(b) => [0, 4, 8].map(|k| u32::from_le_bytes([b[k], b[k + 1], b[k + 2], b[k + 3]])),
+            None => [NONE; 3],
+        }
+    }
+
+    /// Corners `k` and `k + 1` of base face `f` and the id of the edge between them (edge `k`).
+    #[inline]
+    pub(super) fn edge_of(&self, f: u32, k: usize) -> ([u32; 2], u32) {
+        let o = self.face_offset(f);
+        let at = |offset: usize| u32_at(self.bytes, o.saturating_add(offset));
+        ([at(4 * k), at(4 * ((k + 1) % 3))], at(12 + 4 * k))
     }
 
     /// The id of base face `f`'s edge `k` (from corner `k` to corner `k + 1`).

@@ -134,6 +134,9 @@ impl SemiRegularView<'_> {
         if w[0].checked_add(w[1])?.checked_add(w[2])? != self.n {
             return None;
         }
+        if w[0] >= 0 && w[1] >= 0 && w[2] >= 0 {
+            return Some(p);
+        }
         for k in 0..3 {
             let opp = (k + 2) % 3;
             if w[opp] >= 0 {
@@ -188,26 +191,27 @@ impl SemiRegularView<'_> {
     #[must_use]
     pub fn vertex_id(&self, p: Point) -> Option<u32> {
         let n = self.n;
-        if p.w.iter().any(|&x| x < 0 || x > n) || p.face >= self.counts.base_faces {
+        let [w0, w1, w2] = p.w;
+        if w0 < 0 || w1 < 0 || w2 < 0 || w0 > n || w1 > n || w2 > n {
             return None;
         }
-        let base = self.counts.base_vertices;
+        if p.face >= self.counts.base_faces {
+            return None;
+        }
+        if w0 != 0 && w1 != 0 && w2 != 0 {
+            // Inside the face: rows of increasing j, then i.
+            let (i, j, n) = (w1 as u32, w2 as u32, n as u32);
+            let row = (j - 1) * (n - 1) - (j - 1) * j / 2;
+            return Some(self.first_inner + p.face * self.inner + row + i - 1);
+        }
         match self.site(p) {
             Site::Corner(k) => Some(self.corners(p.face)[k]),
             Site::Edge(k, t) => {
-                let c = self.corners(p.face);
-                let t = if c[k] < c[(k + 1) % 3] { t } else { n - t };
-                let e = self.face_edge(p.face, k);
-                Some(base + e * (n as u32 - 1) + t as u32 - 1)
+                let ([a, b], e) = self.edge_of(p.face, k);
+                let t = if a < b { t } else { n - t };
+                Some(self.counts.base_vertices + e * (n as u32 - 1) + t as u32 - 1)
             }
-            Site::Inner => {
-                let (i, j) = (p.w[1] as u32, p.w[2] as u32);
-                let n = n as u32;
-                let first = base + self.counts.base_edges * (n - 1);
-                let row = (j - 1) * (n - 1) - (j - 1) * j / 2;
-                let inner = self.counts.inner_points() as u32;
-                Some(first + p.face * inner + row + i - 1)
-            }
+            Site::Inner => None,
         }
     }
 
