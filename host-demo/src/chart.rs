@@ -119,3 +119,17 @@ pub fn panels(panels: &[Panel<'_>; 2]) -> Result<Vec<u8>, String> {
     }
     pixmap.encode_png().map_err(|e| e.to_string())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn axis_maxima_are_round() {
+        assert_eq!(nice_ceiling(3120.0), 5000.0);
+        assert_eq!(nice_ceiling(8.7), 10.0);
+        assert_eq!(nice_ceiling(0.15), 0.2);
+        assert_eq!(nice_ceiling(2.0), 2.0);
+        assert_eq!(nice_ceiling(0.0), 1.0);
+    }
+}

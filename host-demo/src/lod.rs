@@ -591,15 +591,6 @@ mod tests {
     use super::*;
 
     #[test]
-    fn axis_maxima_are_round() {
-        assert_eq!(nice_ceiling(3120.0), 5000.0);
-        assert_eq!(nice_ceiling(8.7), 10.0);
-        assert_eq!(nice_ceiling(0.15), 0.2);
-        assert_eq!(nice_ceiling(2.0), 2.0);
-        assert_eq!(nice_ceiling(0.0), 1.0);
-    }
-
-    #[test]
     fn psnr_of_known_differences() {
         let a = vec![Rgba8([10, 20, 30, 255]); 100];
         assert_eq!(psnr(&a, &a), f64::INFINITY);
