@@ -102,8 +102,9 @@ pub enum Scheme {
 /// colour) in the file's vertex order.
 #[derive(Clone, Debug)]
 pub struct SemiRegular {
-    /// The file's bytes with every record zero but positions (a view for the lattice walks).
+    /// The file's bytes with every record zero (a view for the lattice walks).
     skeleton: Vec<u8>,
+    counts: Counts,
     /// Positions of every vertex, in file order.
     pub positions: Vec<[f32; 3]>,
     /// Colours of every vertex, if any.
@@ -296,6 +297,7 @@ impl SemiRegular {
         }
         Ok(SemiRegular {
             skeleton,
+            counts,
             positions,
             colors: None,
         })
@@ -351,7 +353,7 @@ impl SemiRegular {
         if scheme == Scheme::Midpoint {
             return Ok(mesh);
         }
-        let view = mesh.view();
+        let view = mesh.view().ok_or(SemiRegularBuildError::TooLarge)?;
         let count = view.vertices() as usize;
         let nb = base.len();
         // The faces around each base vertex, and every vertex's level.
@@ -447,22 +449,24 @@ impl SemiRegular {
         Ok(mesh)
     }
 
-    /// The lattice of this mesh (every record zero).
-    fn view(&self) -> SemiRegularView<'_> {
-        // `from_fn` parsed these bytes already.
-        SemiRegularView::parse(&self.skeleton).expect("the skeleton was validated when made")
+    /// The lattice of this mesh (every record zero); `from_fn` validated these bytes, so this
+    /// is never `None`.
+    fn view(&self) -> Option<SemiRegularView<'_>> {
+        SemiRegularView::parse(&self.skeleton).ok()
     }
 
     /// The header's counts.
     #[must_use]
     pub fn counts(&self) -> Counts {
-        self.view().counts()
+        self.counts
     }
 
     /// The finest level as a triangle mesh over [`SemiRegular::positions`] (counter-clockwise).
     #[must_use]
     pub fn finest_triangles(&self) -> Vec<[u32; 3]> {
-        let view = self.view();
+        let Some(view) = self.view() else {
+            return Vec::new();
+        };
         let mut out = Vec::with_capacity(view.counts().finest_faces() as usize);
         for_finest_triangles(&view, |_, t| out.push(t));
         out
@@ -476,7 +480,7 @@ impl SemiRegular {
 
     /// [`SemiRegular::to_bytes`] with the error bounded by `bound`.
     pub fn to_bytes_with(&self, bound: Bound) -> Result<Vec<u8>, SemiRegularBuildError> {
-        let view = self.view();
+        let view = self.view().ok_or(SemiRegularBuildError::TooLarge)?;
         let counts = view.counts();
         let n = counts.vertices() as usize;
         if self.positions.len() != n {
@@ -885,7 +889,7 @@ mod tests {
     #[test]
     fn vertex_ids_and_points_round_trip() {
         let s = SemiRegular::sphere(3).unwrap();
-        let view = s.view();
+        let view = s.view().unwrap();
         assert_eq!(view.vertices(), 6 + 12 * 7 + 8 * 21);
         for v in 6..view.vertices() {
             let p = view.point(v).unwrap();
