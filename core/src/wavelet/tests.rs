@@ -234,3 +234,88 @@ fn the_cut_costs_under_32_bytes_per_triangle_beside_its_bits() {
     let per_triangle = (C::BYTES - 128 * 8) as f64 / 5000.0;
     assert!(per_triangle <= 20.0, "{per_triangle}");
 }
+
+/// A bumpy open grid: 4 x 4 squares of two triangles, subdivided four times.
+fn open_grid() -> Vec<u8> {
+    let n = 4;
+    let base: Vec<[f32; 3]> = (0..=n * n + 2 * n)
+        .map(|i| {
+            [
+                (i % (n + 1)) as f32 * 0.5 - 1.0,
+                (i / (n + 1)) as f32 * 0.5 - 1.0,
+                0.0,
+            ]
+        })
+        .collect();
+    let mut faces = Vec::new();
+    for y in 0..n {
+        for x in 0..n {
+            let v = (y * (n + 1) + x) as u32;
+            let w = n as u32 + 1;
+            faces.push([v, v + 1, v + w + 1]);
+            faces.push([v, v + w + 1, v + w]);
+        }
+    }
+    let steps = 16.0;
+    SemiRegular::from_fn(&base, &faces, 4, |f, w| {
+        let c = faces[f as usize].map(|v| base[v as usize]);
+        let p: [f32; 3] =
+            core::array::from_fn(|k| (0..3).map(|i| c[i][k] * w[i] as f32 / steps).sum());
+        [
+            p[0],
+            p[1],
+            0.15 * libm::sinf(5.0 * p[0]) * libm::cosf(4.0 * p[1]),
+        ]
+    })
+    .unwrap()
+    .to_bytes()
+    .unwrap()
+}
+
+#[test]
+fn an_open_mesh_keeps_its_invariants_over_random_paths() {
+    let bytes = open_grid();
+    let s = SemiRegularView::parse(&bytes).unwrap();
+    let mut cut = Cut::boxed();
+    cut.reset(&s).unwrap();
+    cut.set_geomorph_frames(3);
+    let mut scratch = vec![[0u32; 2]; 3 * 16_384];
+    let mut rng = Rng(0xDEAD_BEEF);
+    let mut most = 0;
+    for frame in 0..200 {
+        let view = random_view(&mut rng);
+        let policy = QRefine::new(0.25 + 3.0 * rng.next());
+        let budget = Budget {
+            max_triangles: if frame % 2 == 0 {
+                100 + (rng.next() * 3000.0) as u32
+            } else {
+                u32::MAX
+            },
+            ..Budget::default()
+        };
+        let stats = cut.adapt(&s, &view, &policy, &budget);
+        cut.check(&s, false, &mut scratch)
+            .unwrap_or_else(|d| panic!("frame {frame}: {d}"));
+        assert!(stats.triangles <= budget.max_triangles);
+        most = most.max(stats.triangles);
+        // An edge with one side lies on the grid's border: no crack inside.
+        let mut sides = alloc::collections::BTreeMap::new();
+        for t in cut.triangles() {
+            for k in 0..3 {
+                let (a, b) = (t[k] as usize, t[(k + 1) % 3] as usize);
+                *sides.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+            }
+        }
+        let on_border = |i: usize| {
+            let p = cut.position(i);
+            (p[0].abs() - 1.0).abs() < 1e-3 || (p[1].abs() - 1.0).abs() < 1e-3
+        };
+        for (&(a, b), &n) in &sides {
+            assert!(
+                n == 2 || (on_border(a) && on_border(b)),
+                "frame {frame}: crack at {a}-{b}"
+            );
+        }
+    }
+    assert!(most > 1000, "{most}");
+}
