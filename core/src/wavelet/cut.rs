@@ -1,10 +1,11 @@
 //! The wavelet engine's cut: which wavelets are in this frame's mesh, and the crack-free
 //! triangles they make.
 //!
-//! The state is the paper's `U_t` (Azuma et al. §3.4) as one bit per wavelet, nothing per
-//! wavelet else. [`WaveletCut::adapt`] moves it incrementally: a wavelet in `U_t` none of whose
-//! children is in it leaves when the policy no longer wants it, and a wavelet both of whose
-//! parents are in `U_t` joins when the policy wants it, largest error first, so `U_t` always
+//! The state is the paper's `U_t` (Azuma et al. §3.4) as one bit per wavelet, and two bits
+//! more per wavelet: whether its vertex is in the emitted mesh, and whether it is blending.
+//! [`WaveletCut::adapt`] moves it incrementally: a wavelet in `U_t` none of whose children is
+//! in it leaves when the policy no longer wants it, and a wavelet both of whose parents are in
+//! `U_t` joins when the policy wants it, largest error first, so `U_t` always
 //! meets the closure condition (every ancestor of a member is a member). A frame's work is one
 //! pass over the members and their children, and a split or removal for each change.
 //!
@@ -18,7 +19,8 @@
 //!
 //! The triangle count is kept exactly as wavelets come and go, without emitting: every vertex of
 //! the emitted mesh that is not a base vertex adds two triangles (one on a border), and a vertex
-//! is in the mesh when one of the two triangles around its parent edge is subdivided. So the
+//! is in the mesh when one of the two triangles around its parent edge is subdivided (a bit per
+//! wavelet remembers which are, so emission tests a leaf's neighbours with one bit each). So the
 //! budget is hard: a wavelet joins only when the triangles it brings fit
 //! [`Budget::max_triangles`] and the arenas.
 //!
@@ -26,9 +28,9 @@
 //! number of frames ([`WaveletCut::set_geomorph_frames`]); they overlap in space and time, and a
 //! wavelet turned around mid-way starts from where it is.
 //!
-//! Memory (`Self::BYTES`, asserted in a test): two bits per wavelet (`8 WORDS`: in the mesh,
-//! blending), 17 B per vertex slot (id, position, whether it is moved), 8 B per triangle slot
-//! (corners as `u16`, vertex map), 24 B per queue entry (a candidate and a geomorph), and under
+//! Memory (`Self::BYTES`, asserted in a test): three bits per wavelet (`12 WORDS`: in the set,
+//! a vertex of the emitted mesh, blending), 17 B per vertex slot (id, position, whether it is
+//! moved), 8 B per triangle slot (corners as `u16`, vertex map), 24 B per queue entry (a candidate and a geomorph), and under
 //! 256 B of counts and the previous view. With `V = T / 2` (a closed mesh has about half as many
 //! vertices as triangles) and `Q = T / 8`, that is 19.5 B per triangle of capacity beside the
 //! bits.
@@ -120,6 +122,9 @@ pub struct WaveletCut<
     I: SlotIndex = u16,
 > {
     included: [u32; WORDS],
+    /// The wavelets whose vertex is in the emitted mesh (in, or a T-vertex or corner of a
+    /// subdivided triangle), kept as wavelets come and go.
+    present: [u32; WORDS],
     base_vertices: u32,
     base_faces: u32,
     wavelets: u32,
@@ -204,6 +209,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         let () = Self::CAPACITY_FITS;
         WaveletCut {
             included: [0; WORDS],
+            present: [0; WORDS],
             base_vertices: 0,
             base_faces: 0,
             wavelets: 0,
@@ -263,6 +269,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
             });
         }
         self.included.iter_mut().for_each(|w| *w = 0);
+        self.present.iter_mut().for_each(|w| *w = 0);
         self.morphing.iter_mut().for_each(|w| *w = 0);
         self.morphs.clear();
         self.has_previous = false;
@@ -349,10 +356,10 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         }
     }
 
-    /// Vertices and triangles that canonical point `v` (at level `level`) adds to the emitted
-    /// mesh: none when neither triangle around its parent edge is subdivided, else one vertex
-    /// and a triangle per side (two inside, one on a border).
-    fn presence(&self, s: &SemiRegularView<'_>, v: Point, level: u32) -> (u32, u32) {
+    /// Whether canonical point `v` (at level `level`) is a vertex of the emitted mesh (one of
+    /// the two triangles around its parent edge is subdivided), and how many triangles it then
+    /// adds: one per side of that edge (two inside, one on a border).
+    fn presence(&self, s: &SemiRegularView<'_>, v: Point, level: u32) -> (bool, u32) {
         let [x, y] = s.parent_edge(v, level);
         let inc = |id| has(&self.included, self.base_vertices, self.wavelets, id);
         let mut sides = 0;
@@ -363,11 +370,13 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
                 split |= s.subdivided(a, b, c, inc);
             }
         }
-        if split {
-            (1, sides)
-        } else {
-            (0, 0)
-        }
+        (split, sides)
+    }
+
+    /// Whether wavelet vertex `id` is in the emitted mesh.
+    #[inline]
+    fn is_present(&self, id: u32) -> bool {
+        has(&self.present, self.base_vertices, self.wavelets, id)
     }
 
     /// The points whose presence can change when wavelet `p` (at `level`) comes or goes: the
@@ -395,20 +404,24 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
     /// Adds or removes wavelet `p` (vertex `id`, at `level`) and updates the counts.
     fn toggle(&mut self, s: &SemiRegularView<'_>, id: u32, p: Point, level: u32) {
         let (around, n) = Self::neighbourhood(s, p, level);
-        let count = |cut: &Self| {
-            around[..n]
-                .iter()
-                .flatten()
-                .fold((0u32, 0u32), |(v, t), &(_, q)| {
-                    let (dv, dt) = cut.presence(s, q, s.level(q));
-                    (v + dv, t + dt)
-                })
-        };
-        let before = count(self);
         self.flip(id);
-        let after = count(self);
-        self.vertices = (self.vertices + after.0).saturating_sub(before.0);
-        self.triangles = (self.triangles + after.1).saturating_sub(before.1);
+        for &(vid, q) in around[..n].iter().flatten() {
+            let (now, sides) = self.presence(s, q, s.level(q));
+            if now == self.is_present(vid) {
+                continue;
+            }
+            let w = vid.wrapping_sub(self.base_vertices) as usize;
+            if let Some(word) = self.present.get_mut(w / 32) {
+                *word ^= 1 << (w % 32);
+            }
+            if now {
+                self.vertices += 1;
+                self.triangles += sides;
+            } else {
+                self.vertices = self.vertices.saturating_sub(1);
+                self.triangles = self.triangles.saturating_sub(sides);
+            }
+        }
     }
 
     /// Whether any child of wavelet `p` (at `level`) is in the mesh (with `staying`, only
@@ -696,12 +709,10 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
             }
             let Some(p) = s.point(id) else { continue };
             let level = s.level(p);
-            let before = (self.vertices, self.triangles);
             self.toggle(s, id, p, level);
             let (over_t, over_v) = (self.triangles > max_triangles, self.vertices > max_vertices);
             if over_t || over_v {
-                self.flip(id);
-                (self.vertices, self.triangles) = before;
+                self.toggle(s, id, p, level);
                 if over_t && !over_v && max_triangles == budget.max_triangles {
                     stats.budget_limited = true;
                 } else {
@@ -956,22 +967,16 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
                 continue;
             }
             let (a, b) = (p[i], p[j]);
-            // The midpoint of a leaf's edge is out (else the leaf would be subdivided), so the
-            // triangle across is subdivided when one of its two other midpoints is in.
-            let c = a.right_of(b);
-            if s.canonical(c).is_none() {
-                continue;
-            }
-            let inc = |q: Point| {
-                s.canonical(q)
-                    .and_then(|q| s.vertex_id(q))
-                    .is_some_and(|id| self.includes(id))
-            };
-            if !inc(b.mid(c)) && !inc(c.mid(a)) {
-                continue;
-            }
+            // The leaf is not subdivided, so the midpoint of this edge is a vertex of the mesh
+            // exactly when the triangle across is subdivided.
             let m = a.mid(b);
-            let mv = self.slot(s, m, [v[i], v[j]])?;
+            let Some(mid) = s.canonical(m).and_then(|q| s.vertex_id(q)) else {
+                continue;
+            };
+            if !self.is_present(mid) {
+                continue;
+            }
+            let mv = self.slot_of(s, mid, [v[i], v[j]])?;
             let finer = levels[i] + 1;
             self.emit_piece(
                 s,
@@ -1015,6 +1020,14 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
                 if parents.iter().any(|&q| q != NIL && !self.includes(q)) {
                     return Err(WaveletDefect("a member's parent is not a member"));
                 }
+            }
+        }
+        for id in self.base_vertices..self.base_vertices + self.wavelets {
+            let p = s
+                .point(id)
+                .ok_or(WaveletDefect("a wavelet has no lattice point"))?;
+            if self.presence(s, p, s.level(p)).0 != self.is_present(id) {
+                return Err(WaveletDefect("a kept presence bit is wrong"));
             }
         }
         if self.tris.len() as u32 != self.triangles || self.ids.len() as u32 != self.vertices {

@@ -222,16 +222,16 @@ fn geomorphs_blend_and_settle() {
 #[test]
 fn the_cut_costs_under_32_bytes_per_triangle_beside_its_bits() {
     // With V = T / 2 and Q = T / 8: 6 + 2 B per triangle slot (corners, vertex map), 17 per
-    // vertex slot (id, position, moved), 24 per queue entry (candidate, geomorph), 8 per word
-    // of bits (included, blending), and under 256 B of counts and the previous view.
+    // vertex slot (id, position, moved), 24 per queue entry (candidate, geomorph), 12 per word
+    // of bits (included, present, blending), and under 256 B of counts and the previous view.
     type C = WaveletCut<128, 5000, 2500, 625>;
-    let arenas = 5000 * 8 + 2500 * 17 + 625 * 24 + 128 * 8;
+    let arenas = 5000 * 8 + 2500 * 17 + 625 * 24 + 128 * 12;
     assert!(
         C::BYTES >= arenas && C::BYTES <= arenas + 256,
         "{}",
         C::BYTES
     );
-    let per_triangle = (C::BYTES - 128 * 8) as f64 / 5000.0;
+    let per_triangle = (C::BYTES - 128 * 12) as f64 / 5000.0;
     assert!(per_triangle <= 20.0, "{per_triangle}");
 }
 
