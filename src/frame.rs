@@ -226,7 +226,7 @@ where
     )
 }
 
-/// Draws any engine's mesh (a [`CutMesh`], a [`WaveletMesh`], or any [`MeshSource`]) as
+/// Draws any engine's mesh (a [`CutMesh`], a [`crate::WaveletMesh`], or any [`MeshSource`]) as
 /// `camera` sees it into `target`: [`draw`] for whichever engine made the mesh.
 pub fn draw_mesh<P: Pixel, D: Depth, M: MeshSource>(
     target: &mut Target<'_, P, D>,
