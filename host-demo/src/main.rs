@@ -19,6 +19,13 @@ use vdlod_demo::render::{render_orbit, RenderOptions};
 use vdlod_demo::wavelet;
 use vdlod_raster::Shading;
 
+/// `println!` through [`say`].
+macro_rules! say {
+    ($($arg:tt)*) => {
+        say(format_args!($($arg)*))
+    };
+}
+
 #[derive(Parser)]
 #[command(
     name = "vdlod-demo",
@@ -318,7 +325,7 @@ fn render(args: RenderArgs) -> Result<(), String> {
         },
         wireframe: args.wireframe,
     };
-    println!(
+    say!(
         "{name}: {} vertices, {} triangles; {} frames at {}x{} into {}",
         mesh.positions.len(),
         mesh.triangles.len(),
@@ -328,15 +335,18 @@ fn render(args: RenderArgs) -> Result<(), String> {
         args.out.display()
     );
     let reports = render_orbit(&mesh, &opts, &args.out, |r| {
-        println!(
+        say!(
             "frame {:04}  triangles {:>7} of {:>7}  {:>8.3} ms",
-            r.index, r.rasterized, r.submitted, r.ms
+            r.index,
+            r.rasterized,
+            r.submitted,
+            r.ms
         )
     })
     .map_err(|e| format!("{}: {e}", args.out.display()))?;
     let mut ms: Vec<f64> = reports.iter().map(|r| r.ms).collect();
     ms.sort_by(f64::total_cmp);
-    println!(
+    say!(
         "median {:.3} ms per frame over {} frames",
         ms[ms.len() / 2],
         ms.len()
@@ -357,7 +367,7 @@ fn load_lod(mesh: Option<&PathBuf>) -> Result<(String, Vec<u8>, IndexedMesh), St
     let show = std::io::IsTerminal::is_terminal(&std::io::stderr());
     let (_, bytes, seconds) = hierarchy::build_with_progress(&full, &BuildOptions::default(), show)
         .map_err(|e| format!("{name}: {e}"))?;
-    println!("{name}: hierarchy built in {seconds:.2} s");
+    say!("{name}: hierarchy built in {seconds:.2} s");
     full.reorder_for_locality();
     Ok((name, bytes, full))
 }
@@ -398,7 +408,7 @@ fn orbit_command(args: OrbitArgs) -> Result<(), String> {
         peer_orbit: args.peer_orbit,
         observer: args.observer,
     };
-    println!(
+    say!(
         "{name}: {} vertices, {} triangles at full detail; {} frames at {}x{} into {}",
         full.positions.len(),
         full.triangles.len(),
@@ -408,7 +418,7 @@ fn orbit_command(args: OrbitArgs) -> Result<(), String> {
         args.out.display()
     );
     let summary = lod::run_orbit(&bytes, &full, &opts, &args.out, |f| {
-        println!(
+        say!(
                 "frame {:04}  triangles {:>7}  splits {:>5}  collapses {:>5}  adapt {:>8.1} us  render {:>7.2} ms  full {:>7.2} ms  PSNR {:>6.2} dB",
                 f.index,
                 f.stats.triangles,
@@ -421,11 +431,13 @@ fn orbit_command(args: OrbitArgs) -> Result<(), String> {
             )
     })?;
     let first = summary.frames[0];
-    println!(
+    say!(
         "first frame (from the base mesh): {} triangles, {} splits, {:.1} us",
-        first.stats.triangles, first.stats.vsplits, first.adapt_us
+        first.stats.triangles,
+        first.stats.vsplits,
+        first.adapt_us
     );
-    println!(
+    say!(
         "other frames, median: adapt {:.1} us, {:.0} triangles, {:.1} splits + {:.1} collapses; adapt + render {:.2} ms vs full detail {:.2} ms; PSNR mean {:.2} dB",
         summary.median_after_first(|f| f.adapt_us),
         summary.median_after_first(|f| f.stats.triangles as f64),
@@ -435,7 +447,7 @@ fn orbit_command(args: OrbitArgs) -> Result<(), String> {
         summary.median_after_first(|f| f.full_render_us / 1e3),
         summary.mean_after_first(|f| f.psnr_db.min(99.0)),
     );
-    println!(
+    say!(
         "wrote {}/stats.csv, plot.png, side_by_side.png (frame {})",
         args.out.display(),
         summary.compared
@@ -469,8 +481,8 @@ fn build_command(args: BuildArgs) -> Result<(), String> {
             let _ = std::fs::remove_file(&partial);
             format!("{}: cannot write: {e}", args.out.display())
         })?;
-    println!("{}: {}", args.out.display(), hierarchy::summarize(&view));
-    println!("built in {seconds:.3} s");
+    say!("{}: {}", args.out.display(), hierarchy::summarize(&view));
+    say!("built in {seconds:.3} s");
     Ok(())
 }
 
@@ -478,14 +490,14 @@ fn info(file: PathBuf) -> Result<(), String> {
     let raw = std::fs::read(&file).map_err(|e| format!("{}: cannot read: {e}", file.display()))?;
     if raw.starts_with(&vdlod_core::wavelet::format::MAGIC) {
         let s = SemiRegularView::parse(&raw).map_err(|e| format!("{}: {e}", file.display()))?;
-        println!("{}: {}", file.display(), wavelet::summarize(&s));
+        say!("{}: {}", file.display(), wavelet::summarize(&s));
         return Ok(());
     }
     let bytes = hierarchy::read(&file)?;
     let view = HierarchyView::parse(&bytes).map_err(|e| format!("{}: {e}", file.display()))?;
     // What `orbit` would reject, `info` rejects: refine it fully and check the mesh.
     lod::full_detail(&view).map_err(|e| format!("{}: {e}", file.display()))?;
-    println!("{}: {}", file.display(), hierarchy::summarize(&view));
+    say!("{}: {}", file.display(), hierarchy::summarize(&view));
     Ok(())
 }
 
@@ -494,10 +506,10 @@ fn sphere(args: SphereArgs) -> Result<(), String> {
     let bytes = mesh.to_bytes().map_err(|e| e.to_string())?;
     let s = SemiRegularView::parse(&bytes).map_err(|e| format!("{}: {e}", args.out.display()))?;
     wavelet::write_file(&args.out, &bytes)?;
-    println!("{}: {}", args.out.display(), wavelet::summarize(&s));
+    say!("{}: {}", args.out.display(), wavelet::summarize(&s));
     if let Some(obj) = args.obj {
         wavelet::write_obj(&mesh, &obj)?;
-        println!("{}: the finest level as OBJ", obj.display());
+        say!("{}: the finest level as OBJ", obj.display());
     }
     Ok(())
 }
@@ -524,10 +536,10 @@ fn subdivide(args: SubdivideArgs) -> Result<(), String> {
         .map_err(|e| format!("{}: {e}", args.mesh.display()))?;
     let s = SemiRegularView::parse(&bytes).map_err(|e| format!("{}: {e}", args.out.display()))?;
     wavelet::write_file(&args.out, &bytes)?;
-    println!("{}: {}", args.out.display(), wavelet::summarize(&s));
+    say!("{}: {}", args.out.display(), wavelet::summarize(&s));
     if let Some(obj) = args.obj {
         wavelet::write_obj(&semi, &obj)?;
-        println!("{}: the finest level as OBJ", obj.display());
+        say!("{}: the finest level as OBJ", obj.display());
     }
     Ok(())
 }
@@ -540,10 +552,25 @@ fn reproduce(args: ReproduceArgs) -> Result<(), String> {
         Experiment::Engines => ("engines", wavelet::engines(&args.out.join("engines"))?),
     };
     for line in lines {
-        println!("{line}");
+        say!("{line}");
     }
-    println!("wrote {}", args.out.join(name).display());
+    say!("wrote {}", args.out.join(name).display());
     Ok(())
+}
+
+/// Writes one line to standard output. When the reader has gone (`vdlod-demo ... | head -1`)
+/// the command ends there, successfully: nobody is listening. When the output cannot be written
+/// (`> /dev/full`) it ends with one error line.
+fn say(line: std::fmt::Arguments<'_>) {
+    use std::io::Write as _;
+    let mut out = std::io::stdout().lock();
+    if let Err(e) = out.write_fmt(line).and_then(|()| out.write_all(b"\n")) {
+        if e.kind() == std::io::ErrorKind::BrokenPipe {
+            std::process::exit(0);
+        }
+        eprintln!("vdlod-demo: error: standard output: {e}");
+        std::process::exit(1);
+    }
 }
 
 fn main() -> ExitCode {

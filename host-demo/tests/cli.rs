@@ -462,3 +462,42 @@ fn reproduce_fig11_writes_pictures_csv_and_summary_lines() {
         assert!(dir.join("out/fig11").join(file).exists(), "{file}");
     }
 }
+
+/// Runs the demo with standard output going to `stdout`.
+fn demo_into(args: &[&str], cwd: &Path, stdout: std::process::Stdio) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_vdlod-demo"))
+        .args(args)
+        .current_dir(cwd)
+        .stdout(stdout)
+        .stderr(std::process::Stdio::piped())
+        .output()
+        .expect("run vdlod-demo")
+}
+
+#[test]
+fn a_closed_standard_output_is_a_normal_end_and_a_full_one_an_error_line() {
+    let dir = scratch_dir("cli_stdout");
+    let render = ["render", "--frames", "2", "--width", "32", "--height", "24"];
+    for args in [&["sphere", "--levels", "2", "-o", "s.vdw"][..], &render[..]] {
+        // The reader is gone before the first line: `vdlod-demo ... | head -0`.
+        let (reader, writer) = std::io::pipe().unwrap();
+        drop(reader);
+        let out = demo_into(args, &dir, writer.into());
+        assert!(out.status.success(), "{args:?}: {:?}", out.status);
+        assert!(
+            out.stderr.is_empty(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        // `> /dev/full`: one line saying so, and a failure.
+        let full = std::fs::OpenOptions::new()
+            .write(true)
+            .open("/dev/full")
+            .unwrap();
+        let out = demo_into(args, &dir, full.into());
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {stderr}");
+        assert_eq!(stderr.lines().count(), 1, "{stderr}");
+        assert!(stderr.contains("standard output"), "{stderr}");
+    }
+}
