@@ -19,6 +19,34 @@ use vdlod_demo::render::{render_orbit, RenderOptions};
 use vdlod_demo::wavelet;
 use vdlod_raster::Shading;
 
+/// A finite number of at least 0, for tolerances and thresholds.
+fn non_negative(text: &str) -> Result<f32, String> {
+    match text.parse::<f32>() {
+        Ok(v) if v.is_finite() && v >= 0.0 => Ok(v),
+        Ok(_) => Err("must be a finite number of at least 0".into()),
+        Err(e) => Err(e.to_string()),
+    }
+}
+
+/// A finite number above 0.
+fn positive(text: &str) -> Result<f32, String> {
+    match text.parse::<f32>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        Ok(_) => Err("must be a finite number above 0".into()),
+        Err(e) => Err(e.to_string()),
+    }
+}
+
+/// A frame size the rasterizer takes: 1 to 4096 pixels.
+fn dimension(text: &str) -> Result<usize, String> {
+    let max = vdlod_raster::MAX_DIMENSION;
+    match text.parse::<usize>() {
+        Ok(v) if (1..=max).contains(&v) => Ok(v),
+        Ok(_) => Err(format!("must be 1 to {max} pixels")),
+        Err(e) => Err(e.to_string()),
+    }
+}
+
 /// `println!` through [`say`].
 macro_rules! say {
     ($($arg:tt)*) => {
@@ -175,39 +203,40 @@ struct OrbitArgs {
     /// Output directory.
     #[arg(long, short, default_value = "out")]
     out: PathBuf,
-    /// Triangle budget: the cut never has more.
-    #[arg(long)]
+    /// Triangle budget: the cut never has more (at least 1).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     budget: Option<u32>,
-    /// Regulate the tolerance towards this many triangles.
-    #[arg(long)]
+    /// Regulate the tolerance towards this many triangles (at least 1).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     target: Option<u32>,
-    /// Splits plus collapses per frame at most.
-    #[arg(long)]
+    /// Splits plus collapses per frame at most (at least 1).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     max_ops: Option<u32>,
-    /// Screen-space tolerance in pixels (at the silhouette, and inside unless --interior).
-    #[arg(long, default_value_t = 1.0)]
+    /// Screen-space tolerance in pixels (at the silhouette, and inside unless --interior); 0
+    /// asks for full detail.
+    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true, value_parser = non_negative)]
     tolerance: f32,
-    /// Screen-space tolerance in pixels inside the silhouette.
-    #[arg(long)]
+    /// Screen-space tolerance in pixels inside the silhouette (0: full detail).
+    #[arg(long, allow_negative_numbers = true, value_parser = non_negative)]
     interior: Option<f32>,
     /// Refinement policy.
     #[arg(long, value_enum, default_value = "screen")]
     policy: PolicyArg,
-    /// Importance threshold (with --policy importance).
-    #[arg(long, default_value_t = 0.3)]
+    /// Importance threshold (with --policy importance; 0 refines everything visible).
+    #[arg(long, default_value_t = 0.3, allow_negative_numbers = true, value_parser = non_negative)]
     threshold: f32,
     /// Frustum size: the refinement frustum's width and height relative to the camera's
-    /// (the merge-tree paper's Table 1 uses 0.4, 0.2, 0.1).
-    #[arg(long, default_value_t = 1.0)]
+    /// (the merge-tree paper's Table 1 uses 0.4, 0.2, 0.1; above 0).
+    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true, value_parser = positive)]
     frustum: f32,
     /// Frames in one revolution.
     #[arg(long, default_value_t = 72, value_parser = clap::value_parser!(u32).range(1..=100_000))]
     frames: u32,
-    /// Frame width in pixels.
-    #[arg(long, default_value_t = 640)]
+    /// Frame width in pixels (1 to 4096).
+    #[arg(long, default_value_t = 640, value_parser = dimension)]
     width: usize,
-    /// Frame height in pixels.
-    #[arg(long, default_value_t = 480)]
+    /// Frame height in pixels (1 to 4096).
+    #[arg(long, default_value_t = 480, value_parser = dimension)]
     height: usize,
     /// Geomorph length in frames (0: none).
     #[arg(long, default_value_t = 4)]
@@ -273,11 +302,11 @@ struct RenderArgs {
     /// Frames in one revolution.
     #[arg(long, default_value_t = 36, value_parser = clap::value_parser!(u32).range(1..=100_000))]
     frames: u32,
-    /// Frame width in pixels.
-    #[arg(long, default_value_t = 640)]
+    /// Frame width in pixels (1 to 4096).
+    #[arg(long, default_value_t = 640, value_parser = dimension)]
     width: usize,
-    /// Frame height in pixels.
-    #[arg(long, default_value_t = 480)]
+    /// Frame height in pixels (1 to 4096).
+    #[arg(long, default_value_t = 480, value_parser = dimension)]
     height: usize,
     /// Shading mode.
     #[arg(long, value_enum, default_value = "gouraud")]

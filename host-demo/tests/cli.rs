@@ -105,14 +105,37 @@ fn no_triangles() {
     );
 }
 
+/// Flag values that mean nothing are refused before any work, with the allowed range.
 #[test]
-fn bad_viewport() {
-    let dir = scratch_dir("cli_viewport");
-    let out = demo(&["render", "--frames", "1", "--width", "0"], &dir);
-    assert!(!out.status.success());
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(stderr.lines().count(), 1, "{stderr}");
-    assert!(stderr.contains("zero width or height"), "{stderr}");
+fn bad_flag_values_are_refused_with_their_range() {
+    let dir = scratch_dir("cli_flags");
+    for (args, range) in [
+        (
+            &["render", "--frames", "1", "--width", "0"][..],
+            "1 to 4096",
+        ),
+        (&["render", "--height", "5000"][..], "1 to 4096"),
+        (&["orbit", "--width", "0"][..], "1 to 4096"),
+        (&["orbit", "--tolerance", "nan"][..], "at least 0"),
+        (&["orbit", "--tolerance", "-1"][..], "at least 0"),
+        (&["orbit", "--interior", "inf"][..], "at least 0"),
+        (&["orbit", "--threshold", "-0.5"][..], "at least 0"),
+        (&["orbit", "--frustum", "0"][..], "above 0"),
+        (&["orbit", "--budget", "0"][..], "1.."),
+        (&["orbit", "--target", "0"][..], "1.."),
+        (&["orbit", "--max-ops", "0"][..], "1.."),
+    ] {
+        let out = demo(args, &dir);
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        let first = stderr.lines().next().unwrap_or("");
+        assert!(first.contains(args[args.len() - 2]), "{args:?}: {stderr}");
+        assert!(first.contains(range), "{args:?}: {stderr}");
+        assert!(
+            !dir.join("out").exists(),
+            "{args:?} did work before refusing"
+        );
+    }
 }
 
 #[test]
