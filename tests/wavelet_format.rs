@@ -8,7 +8,7 @@ use proptest::prelude::*;
 use vdlod_core::adapt::Budget;
 use vdlod_core::format::crc32;
 use vdlod_core::policy::{QRefine, View};
-use vdlod_core::wavelet::build::SemiRegular;
+use vdlod_core::wavelet::build::{interpolate, SemiRegular};
 use vdlod_core::wavelet::format::{CRC_OFFSET, HEADER_SIZE, VERSION};
 use vdlod_core::wavelet::{SemiRegularError, SemiRegularView, WaveletCut};
 
@@ -28,8 +28,7 @@ fn square_bytes() -> Vec<u8> {
     let faces = [[0, 1, 2], [0, 2, 3]];
     let n = 4.0;
     SemiRegular::from_fn(&base, &faces, 2, |f, w| {
-        let c = faces[f as usize].map(|v| base[v as usize]);
-        let p: [f32; 3] = std::array::from_fn(|k| (0..3).map(|i| c[i][k] * w[i] as f32 / n).sum());
+        let p = interpolate(faces[f as usize].map(|v| base[v as usize]), w, n);
         [p[0], p[1], 0.1 * (p[0] * 7.0).sin() * (p[1] * 5.0).cos()]
     })
     .unwrap()

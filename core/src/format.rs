@@ -237,6 +237,150 @@ const CONE_SINES: [f32; 256] = {
     t
 };
 
+/// The sine a cone code stands for (`code / 255`).
+#[inline(always)]
+pub(crate) fn cone_sine(code: u8) -> f32 {
+    CONE_SINES[code as usize]
+}
+
+/// The model's bounding box and length unit as both file formats store them (seven `f32`s:
+/// origin, extent, unit): positions are 16-bit fractions of the box ([`POSITION_STEPS`] steps
+/// per axis), bound codes lengths in the unit ([`decode_length`]), so a model built at any scale
+/// gives the same file but for these seven numbers.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct ModelBox {
+    /// Position of quantum 0, size of one quantum per axis, and the length unit.
+    origin: [f32; 3],
+    step: [f32; 3],
+    unit: f32,
+    /// The box's size as stored (only a writer needs it again).
+    #[cfg_attr(not(feature = "build"), allow(dead_code))]
+    extent: [f32; 3],
+}
+
+impl ModelBox {
+    #[cfg(feature = "build")]
+    const ZERO: ModelBox = ModelBox {
+        origin: [0.0; 3],
+        step: [0.0; 3],
+        unit: 1.0,
+        extent: [0.0; 3],
+    };
+
+    fn new(origin: [f32; 3], extent: [f32; 3], unit: f32) -> ModelBox {
+        ModelBox {
+            origin,
+            step: extent.map(|e| e / POSITION_STEPS),
+            unit,
+            extent,
+        }
+    }
+
+    /// The box stored at byte `offset`; `None` when a number is not finite, an extent is
+    /// negative or the unit is not positive.
+    pub(crate) fn read(bytes: &[u8], offset: usize) -> Option<ModelBox> {
+        let float = |k: usize| f32_at(bytes, offset.saturating_add(4 * k));
+        let origin = [float(0), float(1), float(2)];
+        let extent = [float(3), float(4), float(5)];
+        let unit = float(6);
+        let valid = origin.iter().chain(&extent).all(|c| c.is_finite())
+            && extent.iter().all(|&e| e >= 0.0)
+            && unit.is_finite()
+            && unit > 0.0;
+        valid.then(|| ModelBox::new(origin, extent, unit))
+    }
+
+    /// The box around `points` with its diagonal as the unit (1 when the diagonal is zero; a
+    /// box at the origin for no points).
+    #[cfg(feature = "build")]
+    pub(crate) fn around(points: impl Iterator<Item = [f32; 3]>) -> ModelBox {
+        let mut lo = [f32::INFINITY; 3];
+        let mut hi = [f32::NEG_INFINITY; 3];
+        let mut any = false;
+        for p in points {
+            any = true;
+            for k in 0..3 {
+                lo[k] = lo[k].min(p[k]);
+                hi[k] = hi[k].max(p[k]);
+            }
+        }
+        if !any {
+            return ModelBox::ZERO;
+        }
+        let extent = [0, 1, 2].map(|k| (hi[k] - lo[k]).max(0.0));
+        let diagonal = libm::sqrtf(extent.iter().map(|e| e * e).sum::<f32>());
+        let unit = if diagonal.is_finite() && diagonal > 0.0 {
+            diagonal
+        } else {
+            1.0
+        };
+        ModelBox::new(lo, extent, unit)
+    }
+
+    /// Writes the seven numbers at byte `offset` of `out`.
+    #[cfg(feature = "build")]
+    pub(crate) fn write(&self, out: &mut [u8], offset: usize) {
+        for (k, v) in self
+            .origin
+            .iter()
+            .chain(&self.extent)
+            .chain([&self.unit])
+            .enumerate()
+        {
+            let o = offset + 4 * k;
+            out[o..o + 4].copy_from_slice(&v.to_le_bytes());
+        }
+    }
+
+    /// The nearest 16-bit fractions of the box to `p`.
+    #[cfg(feature = "build")]
+    pub(crate) fn quantize(&self, p: [f32; 3]) -> [u16; 3] {
+        [0, 1, 2].map(|k| {
+            if self.step[k] > 0.0 {
+                libm::roundf((p[k] - self.origin[k]) / self.step[k]).clamp(0.0, POSITION_STEPS)
+                    as u16
+            } else {
+                0
+            }
+        })
+    }
+
+    /// A quantized position in the model's coordinates.
+    #[inline(always)]
+    pub(crate) fn dequantize(&self, q: [u16; 3]) -> [f32; 3] {
+        [
+            self.origin[0] + q[0] as f32 * self.step[0],
+            self.origin[1] + q[1] as f32 * self.step[1],
+            self.origin[2] + q[2] as f32 * self.step[2],
+        ]
+    }
+
+    /// The position a record starts with (`3 x u16`, little-endian).
+    #[inline(always)]
+    pub(crate) fn position(&self, r: &[u8]) -> [f32; 3] {
+        let q = |k: usize| u16_at(r, 2 * k);
+        self.dequantize([q(0), q(1), q(2)])
+    }
+
+    /// The box's minimum and maximum corners.
+    pub(crate) fn corners(&self) -> ([f32; 3], [f32; 3]) {
+        let max = core::array::from_fn(|k| self.origin[k] + self.step[k] * POSITION_STEPS);
+        (self.origin, max)
+    }
+
+    /// The length unit of the bound codes.
+    #[cfg(feature = "build")]
+    pub(crate) fn unit(&self) -> f32 {
+        self.unit
+    }
+
+    /// The length a bound code stands for.
+    #[inline(always)]
+    pub(crate) fn length(&self, code: u8) -> f32 {
+        LENGTHS[code as usize] * self.unit
+    }
+}
+
 /// The smallest code whose length is at least `v` (in the file's unit), so that a bound stays a
 /// bound; 0 for `v <= 0` or NaN; 255 (the largest length) above it.
 #[must_use]
@@ -315,11 +459,8 @@ pub struct HierarchyView<'a> {
     /// Byte offsets of the node, colour, parent, split and base-triangle sections, and of the
     /// parents' records inside the node section.
     offsets: [usize; 6],
-    /// Position of quantum 0 and size of one quantum, per axis.
-    origin: [f32; 3],
-    step: [f32; 3],
-    /// The unit of the bound codes.
-    unit: f32,
+    /// The positions' box and the bounds' unit.
+    model: ModelBox,
 }
 
 impl fmt::Debug for HierarchyView<'_> {
@@ -418,7 +559,7 @@ fn record(base: usize, index: u32, size: usize) -> usize {
 }
 
 #[inline]
-fn u16_at(b: &[u8], o: usize) -> u16 {
+pub(crate) fn u16_at(b: &[u8], o: usize) -> u16 {
     match b.get(o..o.saturating_add(2)) {
         Some(s) => u16::from_le_bytes([s[0], s[1]]),
         None => 0,
@@ -426,7 +567,7 @@ fn u16_at(b: &[u8], o: usize) -> u16 {
 }
 
 #[inline]
-fn u32_at(b: &[u8], o: usize) -> u32 {
+pub(crate) fn u32_at(b: &[u8], o: usize) -> u32 {
     match b.get(o..o.saturating_add(4)) {
         Some(s) => u32::from_le_bytes([s[0], s[1], s[2], s[3]]),
         None => NONE,
@@ -532,16 +673,7 @@ impl<'a> HierarchyView<'a> {
         {
             return Err(FormatError::BadCounts);
         }
-        let float = |k: usize| f32_at(bytes, BOX_OFFSET + 4 * k);
-        let origin = [float(0), float(1), float(2)];
-        let extent = [float(3), float(4), float(5)];
-        let unit = float(6);
-        if !origin.iter().chain(&extent).all(|c| c.is_finite())
-            || extent.iter().any(|&e| e < 0.0)
-            || !(unit.is_finite() && unit > 0.0)
-        {
-            return Err(FormatError::BadBox);
-        }
+        let model = ModelBox::read(bytes, BOX_OFFSET).ok_or(FormatError::BadBox)?;
         let layout = Self::layout(leaves, nodes, base, flags & FLAG_COLORS != 0);
         let end = layout[5];
         let actual = bytes.len() as u64;
@@ -579,9 +711,7 @@ impl<'a> HierarchyView<'a> {
                 layout[4] as usize,
                 HEADER_SIZE + leaves as usize * NODE_SIZE,
             ],
-            origin,
-            step: extent.map(|e| e / POSITION_STEPS),
-            unit,
+            model,
         };
         view.check_nodes()?;
         view.check_splits()?;
@@ -658,8 +788,7 @@ impl<'a> HierarchyView<'a> {
     /// The box every position of the file lies in, as its minimum and maximum corners.
     #[must_use]
     pub fn bounding_box(&self) -> ([f32; 3], [f32; 3]) {
-        let max = core::array::from_fn(|k| self.origin[k] + self.step[k] * POSITION_STEPS);
-        (self.origin, max)
+        self.model.corners()
     }
 
     /// The centre of [`HierarchyView::bounding_box`] and the radius of the sphere through its
@@ -775,24 +904,14 @@ impl<'a> HierarchyView<'a> {
     #[inline(always)]
     #[must_use]
     pub fn digest_center(&self, d: &Digest) -> [f32; 3] {
-        self.dequantize(d.position)
-    }
-
-    /// A quantized position in the model's coordinates.
-    #[inline(always)]
-    fn dequantize(&self, q: [u16; 3]) -> [f32; 3] {
-        [
-            self.origin[0] + q[0] as f32 * self.step[0],
-            self.origin[1] + q[1] as f32 * self.step[1],
-            self.origin[2] + q[2] as f32 * self.step[2],
-        ]
+        self.model.dequantize(d.position)
     }
 
     /// The length a bound code stands for in this file's units.
     #[inline(always)]
     #[must_use]
     pub fn length(&self, code: u8) -> f32 {
-        LENGTHS[code as usize] * self.unit
+        self.model.length(code)
     }
 
     /// Leaf `i`'s position.
@@ -804,7 +923,7 @@ impl<'a> HierarchyView<'a> {
             usize::MAX
         };
         let r: [u8; 6] = self.fixed(at).unwrap_or([0; 6]);
-        self.position_of(&r)
+        self.model.position(&r)
     }
 
     /// Node `i`'s record: position, normal and (for a parent) its bound codes (radius, `a`, `b`,
@@ -813,7 +932,7 @@ impl<'a> HierarchyView<'a> {
     fn node_record(&self, i: u32) -> ([f32; 3], [f32; 3], [u8; 4]) {
         let r = self.record_bytes(i);
         let normal = oct_decode(r[6] as i8, r[7] as i8);
-        (self.position_of(&r), normal, [r[8], r[9], r[10], r[11]])
+        (self.model.position(&r), normal, [r[8], r[9], r[10], r[11]])
     }
 
     /// Node `i`'s record as a parent's: a leaf's padded with zero codes and no cone, anything
@@ -843,13 +962,6 @@ impl<'a> HierarchyView<'a> {
         self.fixed(o)
     }
 
-    /// The position in a node record.
-    #[inline(always)]
-    fn position_of(&self, r: &[u8]) -> [f32; 3] {
-        let q = |k: usize| u16::from_le_bytes([r[2 * k], r[2 * k + 1]]);
-        self.dequantize([q(0), q(1), q(2)])
-    }
-
     #[inline]
     fn split_bit(&self, p: u32) -> u64 {
         let k = p.wrapping_sub(self.leaves) as u64;
@@ -865,7 +977,7 @@ impl<'a> HierarchyView<'a> {
             radius: self.length(r),
             spheroid: [self.length(a), self.length(b)],
             normal,
-            cone_sin: CONE_SINES[cone as usize],
+            cone_sin: cone_sine(cone),
             color: self.color(i),
             depth: self.depth(i),
             parent: self.parent(i),
@@ -921,10 +1033,10 @@ impl<'a> HierarchyView<'a> {
         };
         let (a, b) = (self.length(r[9]), self.length(r[10]));
         crate::policy::Bounds {
-            center: self.position_of(&r),
+            center: self.model.position(&r),
             radius: self.length(r[8]),
             axis: oct_decode(r[6] as i8, r[7] as i8),
-            cone_sin: CONE_SINES[r[11] as usize],
+            cone_sin: cone_sine(r[11]),
             a2: a * a,
             b2: b * b,
         }

@@ -4,8 +4,8 @@ use alloc::vec::Vec;
 
 use super::Hierarchy;
 use crate::format::{
-    crc32, encode_length, id_width, oct_encode, BOX_OFFSET, COUNT_OFFSETS, CRC_OFFSET, FLAG_COLORS,
-    HEADER_SIZE, MAGIC, NONE, POSITION_STEPS, VERSION,
+    crc32, encode_length, id_width, oct_encode, ModelBox, BOX_OFFSET, COUNT_OFFSETS, CRC_OFFSET,
+    FLAG_COLORS, HEADER_SIZE, MAGIC, NONE, VERSION,
 };
 
 /// Appends values of a few bits each, least significant first.
@@ -68,38 +68,11 @@ impl Hierarchy {
         let faces = base.saturating_add((n - leaves).saturating_mul(2));
         let (wn, wf) = (id_width(n), id_width(faces));
 
-        let mut lo = [f32::INFINITY; 3];
-        let mut hi = [f32::NEG_INFINITY; 3];
-        for node in &self.nodes {
-            for k in 0..3 {
-                lo[k] = lo[k].min(node.position[k]);
-                hi[k] = hi[k].max(node.position[k]);
-            }
-        }
-        if self.nodes.is_empty() {
-            (lo, hi) = ([0.0; 3], [0.0; 3]);
-        }
-        let extent = [0, 1, 2].map(|k| (hi[k] - lo[k]).max(0.0));
-        let step = extent.map(|e| e / POSITION_STEPS);
-        let diagonal = libm::sqrtf(extent.iter().map(|e| e * e).sum::<f32>());
-        let unit = if diagonal.is_finite() && diagonal > 0.0 {
-            diagonal
-        } else {
-            1.0
-        };
-        let quantize = |p: [f32; 3]| -> [u16; 3] {
-            [0, 1, 2].map(|k| {
-                if step[k] > 0.0 {
-                    libm::roundf((p[k] - lo[k]) / step[k]).clamp(0.0, POSITION_STEPS) as u16
-                } else {
-                    0
-                }
-            })
-        };
-        let decoded = |q: [u16; 3]| [0, 1, 2].map(|k| lo[k] + q[k] as f32 * step[k]);
+        let model = ModelBox::around(self.nodes.iter().map(|node| node.position));
+        let decoded = |p: [f32; 3]| model.dequantize(model.quantize(p));
         let mut moved = 0.0f64;
         for node in &self.nodes {
-            let d = decoded(quantize(node.position));
+            let d = decoded(node.position);
             let e: f64 = (0..3)
                 .map(|k| {
                     let x = d[k] as f64 - node.position[k] as f64;
@@ -109,7 +82,7 @@ impl Hierarchy {
             moved = moved.max(libm::sqrt(e));
         }
         let grow = (2.0 * moved) as f32 * 1.001;
-        let code = |v: f32| encode_length((v + grow) / unit);
+        let code = |v: f32| encode_length((v + grow) / model.unit());
 
         let mut out = Vec::new();
         out.extend_from_slice(&MAGIC);
@@ -119,12 +92,9 @@ impl Hierarchy {
         for (o, c) in COUNT_OFFSETS.into_iter().zip([leaves, n, base]) {
             out[o..o + 4].copy_from_slice(&c.to_le_bytes());
         }
-        for (k, v) in lo.iter().chain(&extent).chain([&unit]).enumerate() {
-            let o = BOX_OFFSET + 4 * k;
-            out[o..o + 4].copy_from_slice(&v.to_le_bytes());
-        }
+        model.write(&mut out, BOX_OFFSET);
         for (i, node) in self.nodes.iter().enumerate() {
-            for q in quantize(node.position) {
+            for q in model.quantize(node.position) {
                 out.extend_from_slice(&q.to_le_bytes());
             }
             let (x, y) = oct_encode(node.normal);

@@ -33,7 +33,7 @@ use super::format::{
     MAX_LEVELS, NONE, VERSION, VERTEX_SIZE,
 };
 use super::lattice::{hex_len, Point};
-use crate::format::{crc32, encode_length, oct_decode, oct_encode, POSITION_STEPS};
+use crate::format::{crc32, encode_length, oct_decode, oct_encode, ModelBox};
 
 /// Why a semi-regular mesh cannot be made.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -78,6 +78,34 @@ impl fmt::Display for SemiRegularBuildError {
 }
 
 impl core::error::Error for SemiRegularBuildError {}
+
+/// The unit octahedron's vertices: the base of [`SemiRegular::sphere`].
+pub const OCTAHEDRON_VERTICES: [[f32; 3]; 6] = [
+    [1.0, 0.0, 0.0],
+    [-1.0, 0.0, 0.0],
+    [0.0, 1.0, 0.0],
+    [0.0, -1.0, 0.0],
+    [0.0, 0.0, 1.0],
+    [0.0, 0.0, -1.0],
+];
+
+/// The unit octahedron's faces, counter-clockwise seen from outside.
+pub const OCTAHEDRON_FACES: [[u32; 3]; 8] = [
+    [0, 2, 4],
+    [2, 1, 4],
+    [1, 3, 4],
+    [3, 0, 4],
+    [2, 0, 5],
+    [1, 2, 5],
+    [3, 1, 5],
+    [0, 3, 5],
+];
+
+/// The point at weights `w` (summing to `n`) of the triangle with corners `c`, on its plane.
+#[must_use]
+pub fn interpolate(c: [[f32; 3]; 3], w: [i32; 3], n: f32) -> [f32; 3] {
+    core::array::from_fn(|k| (0..3).map(|i| c[i][k] * w[i] as f32 / n).sum())
+}
 
 /// The shape that bounds a wavelet's error in the file.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -179,14 +207,13 @@ fn file_bytes(
     edges: &[u8],
     records: &[[u8; VERTEX_SIZE]],
     colors: Option<&[[u8; 3]]>,
-    origin: [f32; 3],
-    extent: [f32; 3],
-    unit: f32,
+    hoppe: bool,
+    model: &ModelBox,
 ) -> Vec<u8> {
     let mut out = vec![0u8; HEADER_SIZE];
     out[0..4].copy_from_slice(&MAGIC);
     out[4..6].copy_from_slice(&VERSION.to_le_bytes());
-    let flags = if colors.is_some() { FLAG_COLORS } else { 0 };
+    let flags = if colors.is_some() { FLAG_COLORS } else { 0 } | if hoppe { FLAG_HOPPE } else { 0 };
     out[6..8].copy_from_slice(&flags.to_le_bytes());
     for (k, v) in [
         counts.levels,
@@ -199,10 +226,7 @@ fn file_bytes(
     {
         out[8 + 4 * k..12 + 4 * k].copy_from_slice(&v.to_le_bytes());
     }
-    for (k, v) in origin.iter().chain(&extent).chain([&unit]).enumerate() {
-        let o = super::format::BOX_OFFSET + 4 * k;
-        out[o..o + 4].copy_from_slice(&v.to_le_bytes());
-    }
+    model.write(&mut out, super::format::BOX_OFFSET);
     out.extend_from_slice(faces);
     out.extend_from_slice(edges);
     for r in records {
@@ -216,33 +240,6 @@ fn file_bytes(
     let crc = crc32(&out[HEADER_SIZE..]);
     out[CRC_OFFSET..CRC_OFFSET + 4].copy_from_slice(&crc.to_le_bytes());
     out
-}
-
-/// The box of `positions`, its 16-bit quantizer and the length unit (the diagonal).
-fn frame(positions: &[[f32; 3]]) -> ([f32; 3], [f32; 3], f32) {
-    let mut lo = [f32::MAX; 3];
-    let mut hi = [f32::MIN; 3];
-    for p in positions {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
-    let extent = [0, 1, 2].map(|k| (hi[k] - lo[k]).max(0.0));
-    let d = libm::sqrtf(extent.iter().map(|e| e * e).sum::<f32>());
-    let unit = if d.is_finite() && d > 0.0 { d } else { 1.0 };
-    (lo, extent, unit)
-}
-
-fn quantize(p: [f32; 3], origin: [f32; 3], extent: [f32; 3]) -> [u16; 3] {
-    [0, 1, 2].map(|k| {
-        let step = extent[k] / POSITION_STEPS;
-        if step > 0.0 {
-            libm::roundf((p[k] - origin[k]) / step).clamp(0.0, POSITION_STEPS) as u16
-        } else {
-            0
-        }
-    })
 }
 
 impl SemiRegular {
@@ -277,9 +274,8 @@ impl SemiRegular {
             &edge_bytes,
             &records,
             None,
-            [0.0; 3],
-            [1.0; 3],
-            1.0,
+            false,
+            &ModelBox::around(core::iter::empty()),
         );
         let view =
             SemiRegularView::parse(&skeleton).map_err(|_| SemiRegularBuildError::TooLarge)?;
@@ -306,29 +302,10 @@ impl SemiRegular {
     /// The unit sphere as an octahedron subdivided `levels` times, each new vertex pushed out
     /// to the sphere: `8 * 4^levels` faces (8,192 at 5 levels, the paper's Fig. 11 sphere).
     pub fn sphere(levels: u32) -> Result<SemiRegular, SemiRegularBuildError> {
-        let base = [
-            [1.0, 0.0, 0.0],
-            [-1.0, 0.0, 0.0],
-            [0.0, 1.0, 0.0],
-            [0.0, -1.0, 0.0],
-            [0.0, 0.0, 1.0],
-            [0.0, 0.0, -1.0],
-        ];
-        let faces = [
-            [0, 2, 4],
-            [2, 1, 4],
-            [1, 3, 4],
-            [3, 0, 4],
-            [2, 0, 5],
-            [1, 2, 5],
-            [3, 1, 5],
-            [0, 3, 5],
-        ];
         let n = (1u32 << levels.min(MAX_LEVELS)) as f32;
-        SemiRegular::from_fn(&base, &faces, levels, |f, w| {
-            let c = faces[f as usize].map(|v| base[v as usize]);
-            let p: [f32; 3] =
-                core::array::from_fn(|k| (0..3).map(|i| c[i][k] * w[i] as f32 / n).sum());
+        SemiRegular::from_fn(&OCTAHEDRON_VERTICES, &OCTAHEDRON_FACES, levels, |f, w| {
+            let c = OCTAHEDRON_FACES[f as usize].map(|v| OCTAHEDRON_VERTICES[v as usize]);
+            let p = interpolate(c, w, n);
             let l = libm::sqrtf(p.iter().map(|x| x * x).sum());
             p.map(|x| x / l)
         })
@@ -347,8 +324,7 @@ impl SemiRegular {
     ) -> Result<SemiRegular, SemiRegularBuildError> {
         let n = (1u32 << levels.min(MAX_LEVELS)) as f32;
         let mut mesh = SemiRegular::from_fn(base, faces, levels, |f, w| {
-            let c = faces[f as usize].map(|v| base[v as usize]);
-            core::array::from_fn(|k| (0..3).map(|i| c[i][k] * w[i] as f32 / n).sum())
+            interpolate(faces[f as usize].map(|v| base[v as usize]), w, n)
         })?;
         if scheme == Scheme::Midpoint {
             return Ok(mesh);
@@ -497,18 +473,18 @@ impl SemiRegular {
                 });
             }
         }
-        let (origin, extent, unit) = frame(&self.positions);
+        let model = ModelBox::around(self.positions.iter().copied());
         let faces_at = HEADER_SIZE;
         let edges_at = faces_at + counts.base_faces as usize * FACE_SIZE;
         let records_at = edges_at + counts.base_edges as usize * super::format::EDGE_SIZE;
         let face_bytes = &self.skeleton[faces_at..edges_at];
         let edge_bytes = &self.skeleton[edges_at..records_at];
         // Quantized positions first: every bound is measured on what the file will hold.
-        let mut records: Vec<[u8; VERTEX_SIZE]> = self
-            .positions
+        let quantized: Vec<[u16; 3]> = self.positions.iter().map(|&p| model.quantize(p)).collect();
+        let positions: Vec<[f32; 3]> = quantized.iter().map(|&q| model.dequantize(q)).collect();
+        let mut records: Vec<[u8; VERTEX_SIZE]> = quantized
             .iter()
-            .map(|&p| {
-                let q = quantize(p, origin, extent);
+            .map(|q| {
                 let mut r = [0u8; VERTEX_SIZE];
                 for k in 0..3 {
                     r[2 * k..2 * k + 2].copy_from_slice(&q[k].to_le_bytes());
@@ -516,13 +492,7 @@ impl SemiRegular {
                 r
             })
             .collect();
-        let staged = file_bytes(
-            counts, face_bytes, edge_bytes, &records, None, origin, extent, unit,
-        );
-        let staged =
-            SemiRegularView::parse(&staged).map_err(|_| SemiRegularBuildError::TooLarge)?;
-        let positions: Vec<[f32; 3]> = (0..n as u32).map(|v| staged.position(v)).collect();
-        let normals = vertex_normals(&staged, &positions);
+        let normals = vertex_normals(&view, &positions);
         for (r, nrm) in records.iter_mut().zip(&normals) {
             let (x, y) = oct_encode(*nrm);
             r[6] = x as u8;
@@ -532,41 +502,33 @@ impl SemiRegular {
             .iter()
             .map(|r| oct_decode(r[6] as i8, r[7] as i8))
             .collect();
-        let mut bounds = wavelet_bounds(&staged, &positions, &axes);
-        monotonic(&staged, &positions, &axes, &mut bounds);
+        let mut bounds = wavelet_bounds(&view, &positions, &axes);
+        monotonic(&view, &positions, &axes, &mut bounds);
         let base = counts.base_vertices as usize;
         for (k, b) in bounds.iter().enumerate() {
             let r = &mut records[base + k];
-            r[8] = encode_length(b.radius / unit);
+            r[8] = encode_length(b.radius / model.unit());
             let (a, bb) = match bound {
                 Bound::Spheroid => (b.a, b.b),
                 Bound::Hoppe => (b.delta, b.mu),
             };
-            r[9] = encode_length(a / unit);
-            r[10] = encode_length(bb / unit);
+            r[9] = encode_length(a / model.unit());
+            r[10] = encode_length(bb / model.unit());
             r[11] = if b.cone >= core::f32::consts::FRAC_PI_2 {
                 255
             } else {
                 libm::ceilf(libm::sinf(b.cone) * 255.0).clamp(0.0, 255.0) as u8
             };
         }
-        let mut out = file_bytes(
+        Ok(file_bytes(
             counts,
             face_bytes,
             edge_bytes,
             &records,
             self.colors.as_deref(),
-            origin,
-            extent,
-            unit,
-        );
-        if bound == Bound::Hoppe {
-            let flags = u16::from_le_bytes([out[6], out[7]]) | FLAG_HOPPE;
-            out[6..8].copy_from_slice(&flags.to_le_bytes());
-            let crc = crc32(&out[HEADER_SIZE..]);
-            out[CRC_OFFSET..CRC_OFFSET + 4].copy_from_slice(&crc.to_le_bytes());
-        }
-        Ok(out)
+            bound == Bound::Hoppe,
+            &model,
+        ))
     }
 }
 
@@ -900,24 +862,7 @@ mod tests {
 
     #[test]
     fn loop_subdivision_smooths_an_octahedron_towards_a_sphere() {
-        let base = [
-            [1.0, 0.0, 0.0],
-            [-1.0, 0.0, 0.0],
-            [0.0, 1.0, 0.0],
-            [0.0, -1.0, 0.0],
-            [0.0, 0.0, 1.0],
-            [0.0, 0.0, -1.0],
-        ];
-        let faces = [
-            [0, 2, 4],
-            [2, 1, 4],
-            [1, 3, 4],
-            [3, 0, 4],
-            [2, 0, 5],
-            [1, 2, 5],
-            [3, 1, 5],
-            [0, 3, 5],
-        ];
+        let (base, faces) = (OCTAHEDRON_VERTICES, OCTAHEDRON_FACES);
         let spread = |m: &SemiRegular| {
             let r: Vec<f32> = m.positions.iter().map(|&p| norm(p)).collect();
             let (lo, hi) = r

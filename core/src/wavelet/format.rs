@@ -39,7 +39,7 @@
 
 use core::fmt;
 
-use crate::format::{crc32, decode_length, oct_decode};
+use crate::format::{cone_sine, crc32, oct_decode, u16_at, u32_at, ModelBox};
 use crate::policy::Bounds;
 
 /// First four bytes of a semi-regular file.
@@ -214,9 +214,8 @@ pub struct SemiRegularView<'a> {
     flags: u16,
     /// Offsets of the face, edge, vertex and colour sections.
     offsets: [usize; 4],
-    origin: [f32; 3],
-    step: [f32; 3],
-    unit: f32,
+    /// The positions' box and the bounds' unit.
+    model: ModelBox,
     /// `N`, and the number of vertices (which fits in `u32`).
     pub(super) n: i32,
     pub(super) vertices: u32,
@@ -234,33 +233,6 @@ impl fmt::Debug for SemiRegularView<'_> {
             .finish()
     }
 }
-
-#[inline]
-fn u16_at(b: &[u8], o: usize) -> u16 {
-    match b.get(o..o.saturating_add(2)) {
-        Some(s) => u16::from_le_bytes([s[0], s[1]]),
-        None => 0,
-    }
-}
-
-#[inline]
-fn u32_at(b: &[u8], o: usize) -> u32 {
-    match b.get(o..o.saturating_add(4)) {
-        Some(s) => u32::from_le_bytes([s[0], s[1], s[2], s[3]]),
-        None => NONE,
-    }
-}
-
-/// `k / 255` for every cone code `k`.
-const CONE_SINES: [f32; 256] = {
-    let mut t = [0.0f32; 256];
-    let mut k = 0;
-    while k < 256 {
-        t[k] = k as f32 / 255.0;
-        k += 1;
-    }
-    t
-};
 
 impl<'a> SemiRegularView<'a> {
     /// Validates `bytes` and returns a view of them: sizes, magic, version, checksum, the
@@ -306,16 +278,7 @@ impl<'a> SemiRegularView<'a> {
         if counts.vertices() >= 1 << 31 {
             return Err(E::BadCounts("more than 2^31 vertices"));
         }
-        let float = |k: usize| f32::from_bits(u32_at(bytes, BOX_OFFSET + 4 * k));
-        let origin = [float(0), float(1), float(2)];
-        let extent = [float(3), float(4), float(5)];
-        let unit = float(6);
-        if !origin.iter().chain(&extent).all(|c| c.is_finite())
-            || extent.iter().any(|&e| e < 0.0)
-            || !(unit.is_finite() && unit > 0.0)
-        {
-            return Err(E::BadBox);
-        }
+        let model = ModelBox::read(bytes, BOX_OFFSET).ok_or(E::BadBox)?;
         let colors = flags & FLAG_COLORS != 0;
         let layout = counts.layout(colors);
         let (needed, actual) = (layout[4], bytes.len() as u64);
@@ -341,9 +304,7 @@ impl<'a> SemiRegularView<'a> {
                 layout[2] as usize,
                 layout[3] as usize,
             ],
-            origin,
-            step: extent.map(|e| e / crate::format::POSITION_STEPS),
-            unit,
+            model,
             n: 1 << counts.levels,
             vertices: counts.vertices() as u32,
             first_inner: counts.base_vertices + counts.base_edges * ((1u32 << counts.levels) - 1),
@@ -464,9 +425,7 @@ impl<'a> SemiRegularView<'a> {
     /// The box every position lies in, as its minimum and maximum corners.
     #[must_use]
     pub fn bounding_box(&self) -> ([f32; 3], [f32; 3]) {
-        let max =
-            core::array::from_fn(|k| self.origin[k] + self.step[k] * crate::format::POSITION_STEPS);
-        (self.origin, max)
+        self.model.corners()
     }
 
     /// Base face `f`'s corners (out of range: all ones).
@@ -539,21 +498,11 @@ impl<'a> SemiRegularView<'a> {
             .unwrap_or([0; VERTEX_SIZE])
     }
 
-    #[inline]
-    fn position_of(&self, r: &[u8; VERTEX_SIZE]) -> [f32; 3] {
-        let q = |k: usize| u16::from_le_bytes([r[2 * k], r[2 * k + 1]]) as f32;
-        [
-            self.origin[0] + q(0) * self.step[0],
-            self.origin[1] + q(1) * self.step[1],
-            self.origin[2] + q(2) * self.step[2],
-        ]
-    }
-
     /// Vertex `v`'s position on the finest surface, `rho(v)`.
     #[inline]
     #[must_use]
     pub fn position(&self, v: u32) -> [f32; 3] {
-        self.position_of(&self.record(v))
+        self.model.position(&self.record(v))
     }
 
     /// Vertex `v`'s normal (unit length).
@@ -583,7 +532,7 @@ impl<'a> SemiRegularView<'a> {
     #[inline]
     #[must_use]
     pub fn length(&self, code: u8) -> f32 {
-        decode_length(code) * self.unit
+        self.model.length(code)
     }
 
     /// What the refinement policies need of wavelet vertex `v`: its position, the radius of a
@@ -595,10 +544,10 @@ impl<'a> SemiRegularView<'a> {
         let r = self.record(v);
         let (a, b) = (self.length(r[9]), self.length(r[10]));
         Bounds {
-            center: self.position_of(&r),
+            center: self.model.position(&r),
             radius: self.length(r[8]),
             axis: oct_decode(r[6] as i8, r[7] as i8),
-            cone_sin: CONE_SINES[r[11] as usize],
+            cone_sin: cone_sine(r[11]),
             a2: a * a,
             b2: b * b,
         }

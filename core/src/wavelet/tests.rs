@@ -4,9 +4,9 @@
 use alloc::vec;
 use alloc::vec::Vec;
 
-use super::build::SemiRegular;
+use super::build::{interpolate, SemiRegular};
 use super::{SemiRegularView, WaveletCut};
-use crate::adapt::Budget;
+use crate::adapt::{Budget, FrameStats};
 use crate::policy::{QRefine, ScreenError, View};
 
 type Cut = WaveletCut<1024, 16_384, 8_192, 4_096>;
@@ -42,18 +42,51 @@ fn random_view(rng: &mut Rng) -> View {
     View::look_at(eye, target, [0.0, 1.0, 0.0], 0.9, 4.0 / 3.0, 480.0)
 }
 
+/// A budget of at most `most` triangles (from `least`) every `every`-th frame, none otherwise.
+fn sometimes(frame: u32, every: u32, least: u32, most: f32, rng: &mut Rng) -> Budget {
+    if frame % every == 0 {
+        Budget {
+            max_triangles: least + (rng.next() * most) as u32,
+            ..Budget::default()
+        }
+    } else {
+        Budget::default()
+    }
+}
+
+/// Flies `cut` over `frames` random views with the policy and budget `pick` gives each frame,
+/// checking the invariants (`closed`: every edge has two sides) and the budget after each, and
+/// hands every frame to `each`.
+fn fly_random(
+    cut: &mut Cut,
+    s: &SemiRegularView<'_>,
+    rng: &mut Rng,
+    frames: u32,
+    closed: bool,
+    pick: impl Fn(u32, &mut Rng) -> (QRefine, Budget),
+    mut each: impl FnMut(u32, &FrameStats, &Cut),
+) {
+    let mut scratch = vec![[0u32; 2]; 3 * 16_384];
+    cut.check(s, closed, &mut scratch).unwrap();
+    for frame in 0..frames {
+        let view = random_view(rng);
+        let (policy, budget) = pick(frame, rng);
+        let stats = cut.adapt(s, &view, &policy, &budget);
+        cut.check(s, closed, &mut scratch)
+            .unwrap_or_else(|d| panic!("frame {frame}: {d}"));
+        assert!(stats.triangles <= budget.max_triangles, "frame {frame}");
+        each(frame, &stats, cut);
+    }
+}
+
 #[test]
 fn random_camera_paths_keep_the_mesh_closed_and_the_counts_exact() {
     let bytes = sphere(4);
     let s = SemiRegularView::parse(&bytes).unwrap();
     let mut cut = Cut::boxed();
     cut.reset(&s).unwrap();
-    let mut scratch = vec![[0u32; 2]; 3 * 16_384];
-    cut.check(&s, true, &mut scratch).unwrap();
-    let mut rng = Rng(0x9E37_79B9);
     let mut seen = (u32::MAX, 0);
-    for frame in 0..300 {
-        let view = random_view(&mut rng);
+    let pick = |frame, rng: &mut Rng| {
         let tol = 0.25 + 4.0 * rng.next();
         let policy = QRefine {
             error: ScreenError {
@@ -61,21 +94,20 @@ fn random_camera_paths_keep_the_mesh_closed_and_the_counts_exact() {
                 interior: tol * 7.0,
             },
         };
-        let budget = if frame % 3 == 0 {
-            Budget {
-                max_triangles: 300 + (rng.next() * 2000.0) as u32,
-                ..Budget::default()
-            }
-        } else {
-            Budget::default()
-        };
-        let stats = cut.adapt(&s, &view, &policy, &budget);
-        cut.check(&s, true, &mut scratch)
-            .unwrap_or_else(|d| panic!("frame {frame}: {d}"));
-        assert!(stats.triangles <= budget.max_triangles, "frame {frame}");
-        assert_eq!(stats.triangles as usize, cut.triangles().len());
-        seen = (seen.0.min(stats.triangles), seen.1.max(stats.triangles));
-    }
+        (policy, sometimes(frame, 3, 300, 2000.0, rng))
+    };
+    fly_random(
+        &mut cut,
+        &s,
+        &mut Rng(0x9E37_79B9),
+        300,
+        true,
+        pick,
+        |_, stats, cut| {
+            assert_eq!(stats.triangles as usize, cut.triangles().len());
+            seen = (seen.0.min(stats.triangles), seen.1.max(stats.triangles));
+        },
+    );
     // The paths went from coarse to fine.
     assert!(seen.0 < 400 && seen.1 > 500, "{seen:?}");
 }
@@ -162,26 +194,22 @@ fn geomorphs_blend_and_settle() {
     let mut cut = Cut::boxed();
     cut.reset(&s).unwrap();
     cut.set_geomorph_frames(4);
-    let mut scratch = vec![[0u32; 2]; 3 * 16_384];
-    let mut rng = Rng(0x1234_5678);
     let mut blended = 0;
-    for frame in 0..200 {
-        let view = random_view(&mut rng);
+    let pick = |frame, rng: &mut Rng| {
         let policy = QRefine::new(0.3 + 3.0 * rng.next());
-        let budget = if frame % 4 == 0 {
-            Budget {
-                max_triangles: 200 + (rng.next() * 1500.0) as u32,
-                ..Budget::default()
-            }
-        } else {
-            Budget::default()
-        };
-        let stats = cut.adapt(&s, &view, &policy, &budget);
-        cut.check(&s, true, &mut scratch)
-            .unwrap_or_else(|d| panic!("frame {frame}: {d}"));
-        assert!(stats.triangles <= budget.max_triangles);
-        blended = blended.max(stats.blending);
-    }
+        (policy, sometimes(frame, 4, 200, 1500.0, rng))
+    };
+    fly_random(
+        &mut cut,
+        &s,
+        &mut Rng(0x1234_5678),
+        200,
+        true,
+        pick,
+        |_, stats, _| {
+            blended = blended.max(stats.blending);
+        },
+    );
     assert!(blended > 0);
     // A joining wavelet starts on its parent edge; a still view settles every blend, and every
     // member is then at its own position.
@@ -258,9 +286,7 @@ fn open_grid() -> Vec<u8> {
     }
     let steps = 16.0;
     SemiRegular::from_fn(&base, &faces, 4, |f, w| {
-        let c = faces[f as usize].map(|v| base[v as usize]);
-        let p: [f32; 3] =
-            core::array::from_fn(|k| (0..3).map(|i| c[i][k] * w[i] as f32 / steps).sum());
+        let p = interpolate(faces[f as usize].map(|v| base[v as usize]), w, steps);
         [
             p[0],
             p[1],
@@ -279,43 +305,39 @@ fn an_open_mesh_keeps_its_invariants_over_random_paths() {
     let mut cut = Cut::boxed();
     cut.reset(&s).unwrap();
     cut.set_geomorph_frames(3);
-    let mut scratch = vec![[0u32; 2]; 3 * 16_384];
-    let mut rng = Rng(0xDEAD_BEEF);
     let mut most = 0;
-    for frame in 0..200 {
-        let view = random_view(&mut rng);
+    let pick = |frame, rng: &mut Rng| {
         let policy = QRefine::new(0.25 + 3.0 * rng.next());
-        let budget = Budget {
-            max_triangles: if frame % 2 == 0 {
-                100 + (rng.next() * 3000.0) as u32
-            } else {
-                u32::MAX
-            },
-            ..Budget::default()
-        };
-        let stats = cut.adapt(&s, &view, &policy, &budget);
-        cut.check(&s, false, &mut scratch)
-            .unwrap_or_else(|d| panic!("frame {frame}: {d}"));
-        assert!(stats.triangles <= budget.max_triangles);
-        most = most.max(stats.triangles);
-        // An edge with one side lies on the grid's border: no crack inside.
-        let mut sides = alloc::collections::BTreeMap::new();
-        for t in cut.triangles() {
-            for k in 0..3 {
-                let (a, b) = (t[k] as usize, t[(k + 1) % 3] as usize);
-                *sides.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+        (policy, sometimes(frame, 2, 100, 3000.0, rng))
+    };
+    fly_random(
+        &mut cut,
+        &s,
+        &mut Rng(0xDEAD_BEEF),
+        200,
+        false,
+        pick,
+        |frame, stats, cut| {
+            most = most.max(stats.triangles);
+            // An edge with one side lies on the grid's border: no crack inside.
+            let mut sides = alloc::collections::BTreeMap::new();
+            for t in cut.triangles() {
+                for k in 0..3 {
+                    let (a, b) = (t[k] as usize, t[(k + 1) % 3] as usize);
+                    *sides.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+                }
             }
-        }
-        let on_border = |i: usize| {
-            let p = cut.position(i);
-            (p[0].abs() - 1.0).abs() < 1e-3 || (p[1].abs() - 1.0).abs() < 1e-3
-        };
-        for (&(a, b), &n) in &sides {
-            assert!(
-                n == 2 || (on_border(a) && on_border(b)),
-                "frame {frame}: crack at {a}-{b}"
-            );
-        }
-    }
+            let on_border = |i: usize| {
+                let p = cut.position(i);
+                (p[0].abs() - 1.0).abs() < 1e-3 || (p[1].abs() - 1.0).abs() < 1e-3
+            };
+            for (&(a, b), &n) in &sides {
+                assert!(
+                    n == 2 || (on_border(a) && on_border(b)),
+                    "frame {frame}: crack at {a}-{b}"
+                );
+            }
+        },
+    );
     assert!(most > 1000, "{most}");
 }
