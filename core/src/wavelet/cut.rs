@@ -291,6 +291,24 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         has(&self.morphing, self.base_vertices, self.wavelets, id)
     }
 
+    /// The first member whose wavelet index is `from` or more, as a vertex id (members may come
+    /// and go behind it while a loop walks them).
+    fn member_from(&self, from: u32) -> Option<u32> {
+        let words = (self.wavelets as usize).div_ceil(32).min(WORDS);
+        let mut word = (from / 32) as usize;
+        let mut bits = self.included.get(word)? & (u32::MAX << (from % 32));
+        loop {
+            if bits != 0 {
+                return Some(self.base_vertices + word as u32 * 32 + bits.trailing_zeros());
+            }
+            word += 1;
+            if word >= words {
+                return None;
+            }
+            bits = self.included[word];
+        }
+    }
+
     /// Whether wavelet vertex `id` is in this frame's mesh.
     #[inline]
     #[must_use]
@@ -619,7 +637,6 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         let max_triangles = budget.max_triangles.min(T as u32);
         let max_vertices = (V.min(self.map.capacity()) as u32).max(self.base_vertices);
         let mut ops = 0u32;
-        let words = (self.wavelets as usize).div_ceil(32).min(WORDS);
         self.advance_morphs();
         self.finish_leaving(s);
 
@@ -627,47 +644,44 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         // it left the view); its parents may follow in the next pass.
         'coarsen: loop {
             let mut changed = false;
-            for word in 0..words {
-                let mut bits = self.included[word];
-                while bits != 0 {
-                    let id = self.base_vertices + (word as u32) * 32 + bits.trailing_zeros();
-                    bits &= bits - 1;
-                    let Some(p) = s.point(id) else { continue };
-                    let level = s.level(p);
-                    let leaving = self.leaving(id);
-                    if !leaving && self.any_child_in(s, p, level, true) {
-                        continue;
-                    }
-                    let d = policy.demand(&s.bounds(id), view);
-                    let wanted = d.visible && d.error > t;
-                    if leaving {
-                        if wanted {
-                            // Wanted back: it turns around where it is.
-                            self.start_morph(id, false, self.geomorph_frames);
-                        }
-                        continue;
-                    }
-                    if wanted {
-                        continue;
-                    }
-                    if ops >= budget.max_ops {
-                        stats.ops_limited = true;
-                        break 'coarsen;
-                    }
-                    let children = self.any_child_in(s, p, level, false);
-                    let frames = if d.visible { self.geomorph_frames } else { 0 };
-                    if (frames == 0 && !children) || !self.start_morph(id, true, frames) {
-                        if children {
-                            stats.blend_limited = true;
-                            continue;
-                        }
-                        self.end_morph(id);
-                        self.toggle(s, id, p, level);
-                    }
-                    ops += 1;
-                    stats.ecols += 1;
-                    changed = true;
+            let mut next = 0;
+            while let Some(id) = self.member_from(next) {
+                next = id - self.base_vertices + 1;
+                let Some(p) = s.point(id) else { continue };
+                let level = s.level(p);
+                let leaving = self.leaving(id);
+                if !leaving && self.any_child_in(s, p, level, true) {
+                    continue;
                 }
+                let d = policy.demand(&s.bounds(id), view);
+                let wanted = d.visible && d.error > t;
+                if leaving {
+                    if wanted {
+                        // Wanted back: it turns around where it is.
+                        self.start_morph(id, false, self.geomorph_frames);
+                    }
+                    continue;
+                }
+                if wanted {
+                    continue;
+                }
+                if ops >= budget.max_ops {
+                    stats.ops_limited = true;
+                    break 'coarsen;
+                }
+                let children = self.any_child_in(s, p, level, false);
+                let frames = if d.visible { self.geomorph_frames } else { 0 };
+                if (frames == 0 && !children) || !self.start_morph(id, true, frames) {
+                    if children {
+                        stats.blend_limited = true;
+                        continue;
+                    }
+                    self.end_morph(id);
+                    self.toggle(s, id, p, level);
+                }
+                ops += 1;
+                stats.ecols += 1;
+                changed = true;
             }
             if !changed {
                 break;
@@ -689,14 +703,11 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
                 self.offer(s, id, view, policy, t, &mut stats);
             }
         }
-        for word in 0..words {
-            let mut bits = self.included[word];
-            while bits != 0 {
-                let id = self.base_vertices + (word as u32) * 32 + bits.trailing_zeros();
-                bits &= bits - 1;
-                if !self.leaving(id) {
-                    self.offer_children(s, id, true, view, policy, t, &mut stats);
-                }
+        let mut next = 0;
+        while let Some(id) = self.member_from(next) {
+            next = id - self.base_vertices + 1;
+            if !self.leaving(id) {
+                self.offer_children(s, id, true, view, policy, t, &mut stats);
             }
         }
         while let Some((_, id)) = self.heap.heap_pop() {
@@ -765,18 +776,14 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
             !(if d.visible { d.error.max(0.0) } else { 0.0 }).to_bits()
         };
         self.heap.clear();
-        let words = (self.wavelets as usize).div_ceil(32).min(WORDS);
-        for word in 0..words {
-            let mut bits = self.included[word];
-            while bits != 0 {
-                let id = self.base_vertices + (word as u32) * 32 + bits.trailing_zeros();
-                bits &= bits - 1;
-                let Some(p) = s.point(id) else { continue };
-                if !self.any_child_in(s, p, s.level(p), false)
-                    && self.heap.heap_push((priority(id), id)).is_err()
-                {
-                    stats.queue_overflow = true;
-                }
+        let mut next = 0;
+        while let Some(id) = self.member_from(next) {
+            next = id - self.base_vertices + 1;
+            let Some(p) = s.point(id) else { continue };
+            if !self.any_child_in(s, p, s.level(p), false)
+                && self.heap.heap_push((priority(id), id)).is_err()
+            {
+                stats.queue_overflow = true;
             }
         }
         while self.triangles > max_triangles || self.vertices > max_vertices {
@@ -1007,19 +1014,15 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         closed: bool,
         scratch: &mut [[u32; 2]],
     ) -> Result<(), WaveletDefect> {
-        let words = (self.wavelets as usize).div_ceil(32).min(WORDS);
-        for word in 0..words {
-            let mut bits = self.included[word];
-            while bits != 0 {
-                let id = self.base_vertices + (word as u32) * 32 + bits.trailing_zeros();
-                bits &= bits - 1;
-                let p = s
-                    .point(id)
-                    .ok_or(WaveletDefect("a member is not a wavelet"))?;
-                let parents = s.parents(p, s.level(p));
-                if parents.iter().any(|&q| q != NIL && !self.includes(q)) {
-                    return Err(WaveletDefect("a member's parent is not a member"));
-                }
+        let mut next = 0;
+        while let Some(id) = self.member_from(next) {
+            next = id - self.base_vertices + 1;
+            let p = s
+                .point(id)
+                .ok_or(WaveletDefect("a member is not a wavelet"))?;
+            let parents = s.parents(p, s.level(p));
+            if parents.iter().any(|&q| q != NIL && !self.includes(q)) {
+                return Err(WaveletDefect("a member's parent is not a member"));
             }
         }
         for id in self.base_vertices..self.base_vertices + self.wavelets {
