@@ -44,6 +44,30 @@ fn tick(v: f64) -> String {
     }
 }
 
+/// Draws the lines of `path` two pixels wide in `rgb`.
+pub fn stroke(
+    pixmap: &mut tiny_skia::Pixmap,
+    path: tiny_skia::PathBuilder,
+    rgb: (u8, u8, u8),
+    anti_alias: bool,
+) {
+    let Some(path) = path.finish() else { return };
+    let mut paint = tiny_skia::Paint::default();
+    paint.set_color_rgba8(rgb.0, rgb.1, rgb.2, 255);
+    paint.anti_alias = anti_alias;
+    let stroke = tiny_skia::Stroke {
+        width: 2.0,
+        ..Default::default()
+    };
+    pixmap.stroke_path(
+        &path,
+        &paint,
+        &stroke,
+        tiny_skia::Transform::identity(),
+        None,
+    );
+}
+
 /// Two panels, one above the other, over the same frames, as a PNG.
 pub fn panels(panels: &[Panel<'_>; 2]) -> Result<Vec<u8>, String> {
     let (w, h) = (820u32, 470u32);
@@ -99,22 +123,7 @@ pub fn panels(panels: &[Panel<'_>; 2]) -> Result<Vec<u8>, String> {
                     pb.line_to(x, y);
                 }
             }
-            if let Some(path) = pb.finish() {
-                let mut paint = tiny_skia::Paint::default();
-                paint.set_color_rgba8(rgb.0, rgb.1, rgb.2, 255);
-                paint.anti_alias = true;
-                let stroke = tiny_skia::Stroke {
-                    width: 2.0,
-                    ..Default::default()
-                };
-                pixmap.stroke_path(
-                    &path,
-                    &paint,
-                    &stroke,
-                    tiny_skia::Transform::identity(),
-                    None,
-                );
-            }
+            stroke(&mut pixmap, pb, *rgb, true);
         }
     }
     pixmap.encode_png().map_err(|e| e.to_string())

@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use vdlod::{Camera, Style};
+use vdlod::{Camera, CutMesh, Style};
 use vdlod_core::cut::{Cut, SlotIndex};
 use vdlod_core::format::HierarchyView;
 use vdlod_raster::{
@@ -136,14 +136,7 @@ impl Frame {
     where
         I: SlotIndex + VertexIndex,
     {
-        let mut scratch = self.take_scratch(cut.vertex_count());
-        let result = {
-            let mut target = self.target()?;
-            target.clear(BACKGROUND);
-            vdlod::draw(&mut target, cut, h, camera, style, &mut scratch).map_err(FrameError::from)
-        };
-        self.scratch = scratch;
-        result
+        self.draw_styled(&CutMesh::new(cut, h, style.vertex_colors), camera, style)
     }
 
     /// Clears to [`BACKGROUND`] and draws any engine's `mesh` as `camera` sees it (see

@@ -3,7 +3,7 @@
 //! With no arguments it flies a view-dependent cut of the bundled Stanford bunny around the
 //! merge-tree paper's orbit and writes frames, statistics, a plot and a comparison into `./out/`.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand, ValueEnum};
@@ -532,12 +532,22 @@ fn info(file: PathBuf) -> Result<(), String> {
 
 fn sphere(args: SphereArgs) -> Result<(), String> {
     let mesh = SemiRegular::sphere(args.levels).map_err(|e| e.to_string())?;
-    let bytes = mesh.to_bytes().map_err(|e| e.to_string())?;
-    let s = SemiRegularView::parse(&bytes).map_err(|e| format!("{}: {e}", args.out.display()))?;
-    wavelet::write_file(&args.out, &bytes)?;
-    say!("{}: {}", args.out.display(), wavelet::summarize(&s));
-    if let Some(obj) = args.obj {
-        wavelet::write_obj(&mesh, &obj)?;
+    write_semi_regular(&mesh, "sphere", &args.out, args.obj.as_deref())
+}
+
+/// Writes `mesh` (made from `source`) to `out`, and its finest level to `obj`, saying so.
+fn write_semi_regular(
+    mesh: &SemiRegular,
+    source: &str,
+    out: &Path,
+    obj: Option<&Path>,
+) -> Result<(), String> {
+    let bytes = mesh.to_bytes().map_err(|e| format!("{source}: {e}"))?;
+    let s = SemiRegularView::parse(&bytes).map_err(|e| format!("{}: {e}", out.display()))?;
+    wavelet::write_file(out, &bytes)?;
+    say!("{}: {}", out.display(), wavelet::summarize(&s));
+    if let Some(obj) = obj {
+        wavelet::write_obj(mesh, obj)?;
         say!("{}: the finest level as OBJ", obj.display());
     }
     Ok(())
@@ -560,17 +570,8 @@ fn subdivide(args: SubdivideArgs) -> Result<(), String> {
     };
     let semi = SemiRegular::subdivide(&base.positions, &base.triangles, args.levels, scheme)
         .map_err(|e| format!("{}: {e}", args.mesh.display()))?;
-    let bytes = semi
-        .to_bytes()
-        .map_err(|e| format!("{}: {e}", args.mesh.display()))?;
-    let s = SemiRegularView::parse(&bytes).map_err(|e| format!("{}: {e}", args.out.display()))?;
-    wavelet::write_file(&args.out, &bytes)?;
-    say!("{}: {}", args.out.display(), wavelet::summarize(&s));
-    if let Some(obj) = args.obj {
-        wavelet::write_obj(&semi, &obj)?;
-        say!("{}: the finest level as OBJ", obj.display());
-    }
-    Ok(())
+    let source = args.mesh.display().to_string();
+    write_semi_regular(&semi, &source, &args.out, args.obj.as_deref())
 }
 
 fn reproduce(args: ReproduceArgs) -> Result<(), String> {

@@ -147,22 +147,7 @@ fn with_frustum(
         pb.line_to(a.0, a.1);
         pb.line_to(b.0, b.1);
     }
-    if let Some(path) = pb.finish() {
-        let mut paint = tiny_skia::Paint::default();
-        paint.set_color_rgba8(255, 210, 60, 255);
-        paint.anti_alias = false;
-        let stroke = tiny_skia::Stroke {
-            width: 2.0,
-            ..tiny_skia::Stroke::default()
-        };
-        pixmap.stroke_path(
-            &path,
-            &paint,
-            &stroke,
-            tiny_skia::Transform::identity(),
-            None,
-        );
-    }
+    chart::stroke(&mut pixmap, pb, (255, 210, 60), false);
     pixmap.encode_png().map_err(|e| e.to_string())
 }
 
@@ -568,6 +553,46 @@ fn write_csv(path: &Path, frames: &[SessionFrame]) -> Result<(), String> {
     std::fs::write(path, csv).map_err(|e| format!("{}: cannot write: {e}", path.display()))
 }
 
+/// One of the experiments' meshes, ready to fly: its file (spheroid bounds), its full-detail
+/// mesh and the session's cameras over it.
+struct Flight {
+    mesh: SemiRegular,
+    bytes: Vec<u8>,
+    full: IndexedMesh,
+    cameras: Vec<Camera>,
+}
+
+impl Flight {
+    fn new(mesh: SemiRegular) -> Result<Flight, String> {
+        let bytes = mesh.to_bytes().map_err(|e| e.to_string())?;
+        let full = finest_mesh(&mesh);
+        let b = full.bounds();
+        let cameras = session(b.center(), b.radius(), 90, 512, 512);
+        Ok(Flight {
+            mesh,
+            bytes,
+            full,
+            cameras,
+        })
+    }
+
+    /// The file, parsed.
+    fn view(&self) -> Result<SemiRegularView<'_>, String> {
+        SemiRegularView::parse(&self.bytes).map_err(|e| e.to_string())
+    }
+}
+
+/// The meshes of `fig9` and `engines`: the 8,192-face sphere and the subdivided cow.
+fn experiment_meshes() -> Result<[(&'static str, Flight); 2], String> {
+    Ok([
+        (
+            "sphere",
+            Flight::new(SemiRegular::sphere(5).map_err(|e| e.to_string())?)?,
+        ),
+        ("cow_loop4", Flight::new(cow_loop()?)?),
+    ])
+}
+
 /// The paper's Fig. 9: the session over the 8,192-face sphere and over the cow subdivided to
 /// 51,200 faces from a 200-face base (our stand-in for the fish), at a 0.5 px silhouette and 3.5
 /// px interior tolerance (7x, as the paper sets it), with faces and milliseconds per frame;
@@ -582,16 +607,10 @@ pub fn fig9(out: &Path) -> Result<Vec<String>, String> {
         },
     };
     let mut lines = Vec::new();
-    for (name, mesh) in [
-        ("sphere", SemiRegular::sphere(5).map_err(|e| e.to_string())?),
-        ("cow_loop4", cow_loop()?),
-    ] {
-        let bytes = mesh.to_bytes().map_err(|e| e.to_string())?;
-        let s = SemiRegularView::parse(&bytes).map_err(|e| e.to_string())?;
-        let full = finest_mesh(&mesh);
-        let b = full.bounds();
-        let cameras = session(b.center(), b.radius(), 90, 512, 512);
-        let frames = fly_wavelets(&s, &full, &cameras, &policy)?;
+    for (name, flight) in experiment_meshes()? {
+        let s = flight.view()?;
+        let (full, cameras) = (&flight.full, &flight.cameras);
+        let frames = fly_wavelets(&s, full, cameras, &policy)?;
         write_csv(&out.join(format!("{name}.csv")), &frames)?;
         let faces: Vec<f64> = frames.iter().map(|f| f.faces as f64).collect();
         let full_faces = vec![full.triangles.len() as f64; frames.len()];
@@ -636,7 +655,7 @@ pub fn fig9(out: &Path) -> Result<Vec<String>, String> {
                     interior: 10.0,
                 },
             };
-            let one = fly_wavelets(&s, &full, &cameras[..1], &coarse)?;
+            let one = fly_wavelets(&s, full, &cameras[..1], &coarse)?;
             let _ = write!(
                 line,
                 " adaptive_2_10px_faces={} uniform3_faces={} paper_adaptive_faces=3943 paper_uniform3_faces=12736",
@@ -654,33 +673,29 @@ pub fn fig9(out: &Path) -> Result<Vec<String>, String> {
 /// `fig10.png` into `out`.
 pub fn fig10(out: &Path) -> Result<Vec<String>, String> {
     std::fs::create_dir_all(out).map_err(|e| format!("{}: {e}", out.display()))?;
-    let mesh = cow_loop()?;
-    let full = finest_mesh(&mesh);
-    let b = full.bounds();
-    let cameras = session(b.center(), b.radius(), 90, 512, 512);
+    let flight = Flight::new(cow_loop()?)?;
+    let (full, cameras) = (&flight.full, &flight.cameras);
     let error = ScreenError {
         silhouette: 0.5,
         interior: 3.5,
     };
-    let spheroid = mesh
-        .to_bytes_with(Bound::Spheroid)
-        .map_err(|e| e.to_string())?;
-    let hoppe = mesh
+    let hoppe = flight
+        .mesh
         .to_bytes_with(Bound::Hoppe)
         .map_err(|e| e.to_string())?;
-    let s = SemiRegularView::parse(&spheroid).map_err(|e| e.to_string())?;
+    let s = flight.view()?;
     let h = SemiRegularView::parse(&hoppe).map_err(|e| e.to_string())?;
     let runs = [
         (
             "spheroid",
-            fly_wavelets(&s, &full, &cameras, &QRefine { error })?,
+            fly_wavelets(&s, full, cameras, &QRefine { error })?,
         ),
         (
             "hoppe",
             fly_wavelets(
                 &h,
-                &full,
-                &cameras,
+                full,
+                cameras,
                 &(Frustum, (BackFace, HoppeError { error })),
             )?,
         ),
@@ -733,16 +748,10 @@ pub fn fig10(out: &Path) -> Result<Vec<String>, String> {
 pub fn engines(out: &Path) -> Result<Vec<String>, String> {
     std::fs::create_dir_all(out).map_err(|e| format!("{}: {e}", out.display()))?;
     let mut lines = Vec::new();
-    for (name, mesh) in [
-        ("sphere", SemiRegular::sphere(5).map_err(|e| e.to_string())?),
-        ("cow_loop4", cow_loop()?),
-    ] {
-        let bytes = mesh.to_bytes().map_err(|e| e.to_string())?;
-        let s = SemiRegularView::parse(&bytes).map_err(|e| e.to_string())?;
-        let full = finest_mesh(&mesh);
-        let b = full.bounds();
-        let cameras = session(b.center(), b.radius(), 90, 512, 512);
-        let wavelet = fly_wavelets(&s, &full, &cameras, &QRefine::new(1.0))?;
+    for (name, flight) in experiment_meshes()? {
+        let s = flight.view()?;
+        let (mesh, full, cameras) = (&flight.mesh, &flight.full, &flight.cameras);
+        let wavelet = fly_wavelets(&s, full, cameras, &QRefine::new(1.0))?;
         let input = InputMesh {
             positions: &full.positions,
             colors: None,
@@ -761,7 +770,7 @@ pub fn engines(out: &Path) -> Result<Vec<String>, String> {
             budgets: wavelet.iter().map(|f| f.faces).collect(),
             frame: 0,
         };
-        let forest = fly(&mut engine, &full, &cameras)?;
+        let forest = fly(&mut engine, full, cameras)?;
         let mut csv = String::from("frame,wavelet_faces,forest_faces,wavelet_psnr_db,forest_psnr_db,wavelet_adapt_ms,forest_adapt_ms\n");
         for (i, (w, f)) in wavelet.iter().zip(&forest).enumerate() {
             let _ = writeln!(
@@ -777,7 +786,7 @@ pub fn engines(out: &Path) -> Result<Vec<String>, String> {
             (
                 "wavelet",
                 &wavelet,
-                bytes.len(),
+                flight.bytes.len(),
                 WaveletCut::<1024, 5000, 2500, 625>::BYTES,
             ),
             (
