@@ -1,5 +1,6 @@
 //! Builder tests on generated meshes (the fixtures are tested from the workspace's `tests/`).
 
+use crate::wavelet::build::{OCTAHEDRON_FACES, OCTAHEDRON_VERTICES};
 use alloc::vec::Vec;
 
 use super::*;
@@ -77,24 +78,8 @@ pub(crate) fn grid(n: u32) -> (Vec<[f32; 3]>, Vec<[u32; 3]>) {
 
 /// A unit sphere: an octahedron subdivided `levels` times (4-to-1), vertices pushed outwards.
 pub(crate) fn sphere(levels: u32) -> (Vec<[f32; 3]>, Vec<[u32; 3]>) {
-    let mut p: Vec<[f32; 3]> = alloc::vec![
-        [1.0, 0.0, 0.0],
-        [-1.0, 0.0, 0.0],
-        [0.0, 1.0, 0.0],
-        [0.0, -1.0, 0.0],
-        [0.0, 0.0, 1.0],
-        [0.0, 0.0, -1.0],
-    ];
-    let mut t: Vec<[u32; 3]> = alloc::vec![
-        [0, 2, 4],
-        [2, 1, 4],
-        [1, 3, 4],
-        [3, 0, 4],
-        [2, 0, 5],
-        [1, 2, 5],
-        [3, 1, 5],
-        [0, 3, 5]
-    ];
+    let mut p: Vec<[f32; 3]> = OCTAHEDRON_VERTICES.to_vec();
+    let mut t: Vec<[u32; 3]> = OCTAHEDRON_FACES.to_vec();
     for _ in 0..levels {
         let mut mids: Vec<((u32, u32), u32)> = Vec::new();
         let mut mid = |a: u32, b: u32, p: &mut Vec<[f32; 3]>| {
