@@ -44,7 +44,7 @@ fn random_view(rng: &mut Rng) -> View {
 
 /// A budget of at most `most` triangles (from `least`) every `every`-th frame, none otherwise.
 fn sometimes(frame: u32, every: u32, least: u32, most: f32, rng: &mut Rng) -> Budget {
-    if frame % every == 0 {
+    if frame.is_multiple_of(every) {
         Budget {
             max_triangles: least + (rng.next() * most) as u32,
             ..Budget::default()
