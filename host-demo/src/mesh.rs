@@ -1,15 +1,18 @@
-//! Loading triangle meshes from OBJ files into plain indexed arrays.
+//! Triangle meshes as plain indexed arrays, loaded from files.
 //!
-//! OBJ text is parsed by `tobj`; this module turns its output into one [`IndexedMesh`] (all objects
-//! of the file merged, polygons fan-triangulated, positions indexed by position only so that
-//! connectivity survives for the hierarchy builder), checks it, and computes vertex normals from the
-//! geometry. Every problem becomes a [`MeshError`] naming the file, never a panic.
+//! [`load`] reads any format [`crate::input`] knows, turns the Z axis up if asked, repairs the
+//! mesh ([`crate::repair`]) or, when strict, rejects what the builder would, and computes vertex
+//! normals from the geometry. Every problem becomes a [`MeshError`] naming the file and its
+//! format, never a panic.
 
 use std::fmt;
-use std::io::BufRead;
 use std::path::Path;
 
 use glam::Vec3;
+use vdlod_core::build::BuildError;
+
+use crate::input::{self, Detected, Format, ReadError};
+use crate::repair::Repairs;
 
 /// The Stanford bunny (37,706 vertices, 75,408 triangles), bundled so the demo runs anywhere.
 pub const BUNNY_OBJ: &[u8] = include_bytes!("../../fixtures/bunny.obj");
@@ -124,34 +127,68 @@ impl IndexedMesh {
     }
 }
 
+/// Which way is up in a mesh file. The demo's cameras orbit around +Y.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Up {
+    /// +Y is up (OBJ's usual convention): coordinates are used as they are.
+    #[default]
+    Y,
+    /// +Z is up (CAD and many scanners): turned a quarter about X so +Z becomes +Y.
+    Z,
+}
+
+/// How [`load`] reads a mesh.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LoadOptions {
+    /// Repair the mesh ([`crate::repair`]); when false, reject what the builder would reject.
+    pub repair: bool,
+    /// The file's up axis.
+    pub up: Up,
+}
+
+impl Default for LoadOptions {
+    fn default() -> Self {
+        LoadOptions {
+            repair: true,
+            up: Up::Y,
+        }
+    }
+}
+
 /// What is wrong with a mesh file.
 #[derive(Debug)]
 pub enum MeshProblem {
     /// The file could not be read.
     Io(std::io::Error),
-    /// `tobj` rejected the text.
-    Malformed(tobj::LoadError),
+    /// Neither the content nor the extension says which format the file is.
+    UnknownFormat,
+    /// The file is one of vdlod's own, which hold no mesh to read.
+    NotAMesh(&'static str),
+    /// The reader stopped.
+    Read(ReadError),
     /// The file has no vertices.
     NoVertices,
     /// The file has vertices but no faces with three or more corners.
     NoTriangles,
-    /// A vertex has a NaN or infinite coordinate.
-    NonFinite {
-        /// Zero-based vertex number in the file.
-        vertex: usize,
-    },
-    /// More vertices than 32-bit indices can address.
+    /// More vertices than the builder can address.
     TooLarge,
+    /// Without repair: the mesh is not one the builder accepts.
+    Invalid(BuildError),
 }
 
 impl fmt::Display for MeshProblem {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             MeshProblem::Io(e) => write!(f, "cannot read: {e}"),
-            MeshProblem::Malformed(tobj::LoadError::FaceVertexOutOfBounds) => {
-                write!(f, "malformed OBJ: a face uses a vertex index out of range")
-            }
-            MeshProblem::Malformed(e) => write!(f, "malformed OBJ: {e}"),
+            MeshProblem::UnknownFormat => write!(
+                f,
+                "not a mesh format vdlod reads (OBJ, OFF, PLY, STL; found by content or extension)"
+            ),
+            MeshProblem::NotAMesh(what) => write!(
+                f,
+                "this is {what}, not a mesh; `orbit` and `render` take .vdh files, `info` takes both"
+            ),
+            MeshProblem::Read(e) => write!(f, "{e}"),
             MeshProblem::NoVertices => write!(f, "no vertices"),
             MeshProblem::NoTriangles => {
                 write!(
@@ -159,42 +196,145 @@ impl fmt::Display for MeshProblem {
                     "no triangles (only points, lines or faces of fewer than 3 vertices)"
                 )
             }
-            MeshProblem::NonFinite { vertex } => {
-                write!(f, "vertex {} has a NaN or infinite coordinate", vertex + 1)
-            }
-            MeshProblem::TooLarge => write!(f, "more than 2^32 vertices"),
+            MeshProblem::TooLarge => write!(f, "more than 2^31 vertices"),
+            MeshProblem::Invalid(e) => write!(f, "{e} (--strict: not repaired)"),
         }
     }
 }
 
-/// A [`MeshProblem`] and the file it is about.
+/// A [`MeshProblem`], the file it is about and, once known, its format.
 #[derive(Debug)]
 pub struct MeshError {
     /// The file as the user named it.
     pub file: String,
+    /// The file's format, when it was found.
+    pub format: Option<Format>,
     /// What is wrong.
     pub problem: MeshProblem,
 }
 
 impl fmt::Display for MeshError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}: {}", self.file, self.problem)
+        match self.format {
+            Some(format) => write!(f, "{}: {format}: {}", self.file, self.problem),
+            None => write!(f, "{}: {}", self.file, self.problem),
+        }
     }
 }
 
 impl std::error::Error for MeshError {}
 
-/// Loads an OBJ file.
-pub fn load_obj(path: &Path) -> Result<IndexedMesh, MeshError> {
+/// A mesh read from a file, and how.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Loaded {
+    /// The mesh, ready for the builder.
+    pub mesh: IndexedMesh,
+    /// The file's format.
+    pub format: Format,
+    /// What repair changed (`None` when repair was off).
+    pub repairs: Option<Repairs>,
+}
+
+/// Loads a mesh file of any format vdlod reads.
+pub fn load(path: &Path, options: &LoadOptions) -> Result<Loaded, MeshError> {
     let file = path.display().to_string();
     let bytes = std::fs::read(path).map_err(|e| MeshError {
         file: file.clone(),
+        format: None,
         problem: MeshProblem::Io(e),
     })?;
+    load_bytes(&file, &bytes, options)
+}
+
+/// Loads mesh bytes held in memory; `name` is used in messages, and its extension when the
+/// content does not tell the format.
+///
+/// ```
+/// use vdlod_demo::mesh::{load_bytes, LoadOptions};
+/// // An OFF square whose second triangle is listed the wrong way round.
+/// let off = b"OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 3 2\n";
+/// let loaded = load_bytes("square.off", off, &LoadOptions::default()).unwrap();
+/// assert_eq!(loaded.mesh.triangles, vec![[0, 1, 2], [0, 2, 3]]);
+/// assert_eq!(loaded.repairs.unwrap().to_string(), "1 triangles flipped");
+/// let strict = LoadOptions { repair: false, ..LoadOptions::default() };
+/// let e = load_bytes("square.off", off, &strict).unwrap_err();
+/// assert_eq!(
+///     e.to_string(),
+///     "square.off: OFF: the two triangles on edge 0-2 are oriented inconsistently (--strict: not repaired)"
+/// );
+/// ```
+pub fn load_bytes(name: &str, bytes: &[u8], options: &LoadOptions) -> Result<Loaded, MeshError> {
+    let format = match input::detect(name, bytes) {
+        Detected::Mesh(format) => format,
+        Detected::Vdlod(what) => return Err(error(name, None, MeshProblem::NotAMesh(what))),
+        Detected::Unknown => return Err(error(name, None, MeshProblem::UnknownFormat)),
+    };
+    let err = |problem| error(name, Some(format), problem);
+    let mut soup = input::read(format, bytes).map_err(|e| err(MeshProblem::Read(e)))?;
+    if soup.triangles.is_empty() {
+        return Err(err(if soup.positions.is_empty() {
+            MeshProblem::NoVertices
+        } else {
+            MeshProblem::NoTriangles
+        }));
+    }
+    if soup.positions.len() >= 1 << 31 {
+        return Err(err(MeshProblem::TooLarge));
+    }
+    if options.up == Up::Z {
+        for p in &mut soup.positions {
+            *p = [p[0], p[2], -p[1]];
+        }
+    }
+    let vertices = soup.positions.len();
+    soup.drop_unused();
+    let unused = vertices - soup.positions.len();
+    let repairs = if options.repair {
+        let (repaired, mut repairs) = crate::repair::repair(soup);
+        repairs.unused += unused;
+        soup = repaired;
+        Some(repairs)
+    } else {
+        let input = vdlod_core::build::InputMesh {
+            positions: &soup.positions,
+            colors: soup.colors.as_deref(),
+            triangles: &soup.triangles,
+        };
+        vdlod_core::build::validate(&input).map_err(|e| err(MeshProblem::Invalid(e)))?;
+        None
+    };
+    if soup.triangles.is_empty() {
+        return Err(err(MeshProblem::NoTriangles));
+    }
+    let normals = vertex_normals(&soup.positions, &soup.triangles);
+    Ok(Loaded {
+        mesh: IndexedMesh {
+            positions: soup.positions,
+            normals,
+            colors: soup.colors,
+            triangles: soup.triangles,
+        },
+        format,
+        repairs,
+    })
+}
+
+fn error(name: &str, format: Option<Format>, problem: MeshProblem) -> MeshError {
+    MeshError {
+        file: name.to_string(),
+        format,
+        problem,
+    }
+}
+
+/// Loads an OBJ file as it is: no repair and no validation (the builder validates).
+pub fn load_obj(path: &Path) -> Result<IndexedMesh, MeshError> {
+    let file = path.display().to_string();
+    let bytes = std::fs::read(path).map_err(|e| error(&file, None, MeshProblem::Io(e)))?;
     load_obj_bytes(&file, &bytes)
 }
 
-/// Loads OBJ text held in memory; `name` is used in error messages.
+/// Loads OBJ text held in memory as it is; `name` is used in error messages.
 ///
 /// ```
 /// let obj = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
@@ -203,81 +343,26 @@ pub fn load_obj(path: &Path) -> Result<IndexedMesh, MeshError> {
 /// assert_eq!(mesh.normals[0], [0.0, 0.0, 1.0]);
 /// ```
 pub fn load_obj_bytes(name: &str, bytes: &[u8]) -> Result<IndexedMesh, MeshError> {
-    let err = |problem| MeshError {
-        file: name.to_string(),
-        problem,
-    };
-    let options = tobj::LoadOptions {
-        triangulate: true,
-        single_index: false,
-        ignore_points: true,
-        ignore_lines: true,
-    };
-    let text = without_polylines(bytes);
-    let mut reader: &mut dyn BufRead = &mut &text[..];
-    let (models, _materials) = tobj::load_obj_buf(&mut reader, &options, |_| {
-        Err(tobj::LoadError::OpenFileFailed)
-    })
-    .map_err(|e| err(MeshProblem::Malformed(e)))?;
-
-    let mut mesh = IndexedMesh::default();
-    let mut colors = Vec::new();
-    let mut any_colors = false;
-    for model in &models {
-        let m = &model.mesh;
-        let base = mesh.positions.len();
-        let count = m.positions.len() / 3;
-        for (i, p) in m.positions.chunks_exact(3).enumerate() {
-            let p = [p[0], p[1], p[2]];
-            if !p.iter().all(|c| c.is_finite()) {
-                return Err(err(MeshProblem::NonFinite { vertex: base + i }));
-            }
-            mesh.positions.push(p);
-        }
-        if m.vertex_color.len() == m.positions.len() && !m.vertex_color.is_empty() {
-            any_colors = true;
-            let channel = |v: f32| (v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
-            colors.extend(
-                m.vertex_color
-                    .chunks_exact(3)
-                    .map(|c| [channel(c[0]), channel(c[1]), channel(c[2])]),
-            );
-        } else {
-            colors.extend(std::iter::repeat_n([255u8; 3], count));
-        }
-        let base = u32::try_from(base).map_err(|_| err(MeshProblem::TooLarge))?;
-        for t in m.indices.chunks_exact(3) {
-            let mut tri = [0u32; 3];
-            for (out, &i) in tri.iter_mut().zip(t) {
-                if i as usize >= count {
-                    return Err(err(MeshProblem::Malformed(
-                        tobj::LoadError::FaceVertexOutOfBounds,
-                    )));
-                }
-                *out = base + i;
-            }
-            mesh.triangles.push(tri);
-        }
-    }
-    if mesh.triangles.is_empty() {
-        // tobj keeps only the vertices that faces use; look at the text to tell the two apart.
-        let declares_vertices = bytes
-            .split(|&b| b == b'\n')
-            .any(|line| line.trim_ascii_start().starts_with(b"v "));
-        return Err(err(if declares_vertices {
-            MeshProblem::NoTriangles
-        } else {
+    let err = |problem| error(name, Some(Format::Obj), problem);
+    let mut soup = input::read(Format::Obj, bytes).map_err(|e| err(MeshProblem::Read(e)))?;
+    if soup.triangles.is_empty() {
+        return Err(err(if soup.positions.is_empty() {
             MeshProblem::NoVertices
+        } else {
+            MeshProblem::NoTriangles
         }));
     }
-    if u32::try_from(mesh.positions.len()).is_err() {
+    soup.drop_unused();
+    if soup.positions.len() >= 1 << 31 {
         return Err(err(MeshProblem::TooLarge));
     }
-    if any_colors {
-        mesh.colors = Some(colors);
-    }
-    mesh.normals = vertex_normals(&mesh.positions, &mesh.triangles);
-    Ok(mesh)
+    let normals = vertex_normals(&soup.positions, &soup.triangles);
+    Ok(IndexedMesh {
+        positions: soup.positions,
+        normals,
+        colors: soup.colors,
+        triangles: soup.triangles,
+    })
 }
 
 impl IndexedMesh {
@@ -361,28 +446,6 @@ impl IndexedMesh {
             triangles,
         }
     }
-}
-
-/// Whether an OBJ line is a polyline (`l v1 v2 ...`).
-fn is_polyline(line: &[u8]) -> bool {
-    let line = line.trim_ascii_start();
-    line.first() == Some(&b'l') && line.get(1).is_none_or(|c| c.is_ascii_whitespace())
-}
-
-/// The text with polyline statements removed: tobj reads `l a b c` as a triangle, but a polyline
-/// has no surface.
-fn without_polylines(bytes: &[u8]) -> std::borrow::Cow<'_, [u8]> {
-    if !bytes.split(|&b| b == b'\n').any(is_polyline) {
-        return std::borrow::Cow::Borrowed(bytes);
-    }
-    let mut out = Vec::with_capacity(bytes.len());
-    for line in bytes.split(|&b| b == b'\n') {
-        if !is_polyline(line) {
-            out.extend_from_slice(line);
-        }
-        out.push(b'\n');
-    }
-    std::borrow::Cow::Owned(out)
 }
 
 /// Interleaves the low 10 bits of three coordinates.

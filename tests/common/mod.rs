@@ -1,6 +1,8 @@
 //! Helpers shared by the workspace tests.
 #![allow(dead_code)]
 
+pub mod fly;
+
 use vdlod_core::build::rotate_to_min;
 use vdlod_demo::mesh::{load_obj, IndexedMesh};
 

@@ -1,0 +1,578 @@
+//! Turning a triangle soup into a mesh the hierarchy builder accepts.
+//!
+//! [`repair`] promises a result that passes [`vdlod_core::build::validate`]: every edge in one
+//! or two triangles, those two oriented consistently, every vertex's triangles one fan. It gets
+//! there by changing as little as it can, in this order:
+//!
+//! 1. weld border vertices (on an edge of a single triangle) closer than [`WELD_TOLERANCE`] times
+//!    the bounding-box diagonal, each to the first vertex of its cluster, so a chain of near
+//!    points does not collapse into one. This closes the cracks of an STL soup or of an OBJ whose
+//!    groups repeat their seam vertices, and never touches a surface that is already whole: two
+//!    closed surfaces that happen to share a point stay two surfaces;
+//! 2. drop triangles that then repeat a vertex, and triangles with the same three vertices as an
+//!    earlier one (in either orientation). Triangles with three distinct but collinear corners
+//!    stay: dropping one would open a crack, and the builder handles zero area;
+//! 3. join two triangles across an edge only when that edge has exactly two triangles; orient each
+//!    connected part consistently by walking across joined edges (keeping the orientation most
+//!    of its triangles had), and cut the edge where a walk meets itself reversed (a Möbius band);
+//! 4. give each fan of triangles around a vertex its own copy of the vertex, so surfaces that touch
+//!    at a point or along a non-manifold edge come apart into a manifold with borders;
+//! 5. turn each closed part outward (positive enclosed volume).
+//!
+//! Vertices no kept triangle uses are dropped. Everything is deterministic: ties go to the
+//! earlier triangle or vertex of the input.
+
+use std::collections::HashMap;
+use std::fmt;
+
+use crate::input::Soup;
+
+/// Vertices closer than this fraction of the bounding-box diagonal are welded.
+pub const WELD_TOLERANCE: f64 = 1e-6;
+
+/// What [`repair`] changed, counted.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Repairs {
+    /// Vertices welded into an earlier one.
+    pub welded: usize,
+    /// Triangles dropped because two of their corners are one vertex.
+    pub degenerate: usize,
+    /// Triangles dropped because an earlier one has the same vertices.
+    pub duplicate: usize,
+    /// Triangles whose orientation was reversed.
+    pub flipped: usize,
+    /// Edges cut apart: non-manifold ones, and where orientation could not agree.
+    pub cut_edges: usize,
+    /// Vertex copies added so each fan has its own vertex.
+    pub split: usize,
+    /// Vertices dropped because no kept triangle uses them.
+    pub unused: usize,
+}
+
+impl Repairs {
+    /// Whether nothing was changed.
+    pub fn is_empty(&self) -> bool {
+        *self == Repairs::default()
+    }
+}
+
+impl fmt::Display for Repairs {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let items = [
+            (self.welded, "vertices welded"),
+            (self.degenerate, "degenerate triangles dropped"),
+            (self.duplicate, "repeated triangles dropped"),
+            (self.flipped, "triangles flipped"),
+            (self.cut_edges, "non-manifold or unorientable edges cut"),
+            (self.split, "vertices split"),
+            (self.unused, "unused vertices dropped"),
+        ];
+        let said: Vec<String> = items
+            .iter()
+            .filter(|(n, _)| *n > 0)
+            .map(|(n, what)| format!("{n} {what}"))
+            .collect();
+        if said.is_empty() {
+            f.write_str("nothing to repair")
+        } else {
+            f.write_str(&said.join(", "))
+        }
+    }
+}
+
+/// Repairs `soup` (see the module documentation); returns the mesh and what changed.
+///
+/// ```
+/// use vdlod_demo::input::Soup;
+/// // Two triangles of a square, the second listed clockwise and with its own copy of a corner.
+/// let soup = Soup {
+///     positions: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]],
+///     colors: None,
+///     triangles: vec![[0, 1, 2], [0, 3, 2]],
+/// };
+/// let (mesh, repairs) = vdlod_demo::repair::repair(soup);
+/// assert_eq!(repairs.flipped, 1);
+/// assert_eq!(mesh.triangles, vec![[0, 1, 2], [0, 2, 3]]);
+/// ```
+pub fn repair(soup: Soup) -> (Soup, Repairs) {
+    let mut repairs = Repairs::default();
+    let border = on_border(soup.positions.len(), &soup.triangles);
+    let (representative, welded) = weld(&soup.positions, &border);
+    repairs.welded = welded;
+    let mut triangles = Vec::with_capacity(soup.triangles.len());
+    for t in &soup.triangles {
+        let t = t.map(|i| representative[i as usize]);
+        if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
+            repairs.degenerate += 1;
+        } else {
+            triangles.push(t);
+        }
+    }
+    let before = triangles.len();
+    drop_repeated(&mut triangles);
+    repairs.duplicate = before - triangles.len();
+
+    let edges = EdgeGroups::new(&triangles);
+    let mut joined = edges.joinable();
+    repairs.cut_edges = edges.non_manifold;
+    let flips = orient(&triangles, &edges, &mut joined, &mut repairs.cut_edges);
+    for (t, &flip) in triangles.iter_mut().zip(&flips) {
+        if flip {
+            t.swap(1, 2);
+        }
+    }
+
+    // Split fans; cut more edges if two fans still share an output edge.
+    let (mut out, mut copies) = split_fans(&triangles, &edges, &joined);
+    loop {
+        let bad = bad_output_edges(&out);
+        if bad.is_empty() {
+            break;
+        }
+        let before = joined.iter().filter(|&&j| j).count();
+        for &(t, corner) in &bad {
+            // Cut the joined edges of `t` at `corner`, in the input numbering.
+            let v = triangles[t][corner];
+            for k in 0..3 {
+                let (a, b) = (triangles[t][k], triangles[t][(k + 1) % 3]);
+                if a == v || b == v {
+                    if let Some(g) = edges.group_of(t, k) {
+                        joined[g] = false;
+                    }
+                }
+            }
+        }
+        let cut = before - joined.iter().filter(|&&j| j).count();
+        if cut == 0 {
+            break;
+        }
+        repairs.cut_edges += cut;
+        (out, copies) = split_fans(&triangles, &edges, &joined);
+    }
+    let used = copies
+        .iter()
+        .collect::<std::collections::BTreeSet<_>>()
+        .len();
+    repairs.split = copies.len() - used;
+    repairs.unused = soup.positions.len() - welded - used;
+
+    let mut positions: Vec<[f32; 3]> = copies.iter().map(|&v| soup.positions[v as usize]).collect();
+    let colors = soup
+        .colors
+        .as_ref()
+        .map(|c| copies.iter().map(|&v| c[v as usize]).collect());
+    let outward = turn_outward(&positions, &mut out);
+    repairs.flipped = flips.iter().zip(&outward).filter(|(a, b)| *a != *b).count();
+    positions.shrink_to_fit();
+    (
+        Soup {
+            positions,
+            colors,
+            triangles: out,
+        },
+        repairs,
+    )
+}
+
+/// Whether each vertex is on a border: an edge that only one triangle has (or no triangle at
+/// all, for an unused vertex).
+fn on_border(vertices: usize, triangles: &[[u32; 3]]) -> Vec<bool> {
+    let mut edges: Vec<(u32, u32)> = triangles
+        .iter()
+        .flat_map(|t| (0..3).map(move |k| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]))))
+        .collect();
+    edges.sort_unstable();
+    let mut border = vec![true; vertices];
+    for &i in triangles.iter().flatten() {
+        border[i as usize] = false;
+    }
+    let mut i = 0;
+    while i < edges.len() {
+        let mut j = i + 1;
+        while j < edges.len() && edges[j] == edges[i] {
+            j += 1;
+        }
+        if j - i == 1 {
+            border[edges[i].0 as usize] = true;
+            border[edges[i].1 as usize] = true;
+        }
+        i = j;
+    }
+    border
+}
+
+/// The vertex each vertex welds to, and how many were welded; only `border` vertices weld.
+fn weld(positions: &[[f32; 3]], border: &[bool]) -> (Vec<u32>, usize) {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in positions {
+        for a in 0..3 {
+            lo[a] = lo[a].min(p[a] as f64);
+            hi[a] = hi[a].max(p[a] as f64);
+        }
+    }
+    let diagonal = (0..3).map(|a| (hi[a] - lo[a]).powi(2)).sum::<f64>().sqrt();
+    let tolerance = diagonal * WELD_TOLERANCE;
+    let mut representative = Vec::with_capacity(positions.len());
+    let mut welded = 0;
+    if !(tolerance > 0.0 && tolerance.is_finite()) {
+        // A single point (or nothing): exact matches only.
+        let mut seen: HashMap<[u32; 3], u32> = HashMap::new();
+        for (i, p) in positions.iter().enumerate() {
+            if !border[i] {
+                representative.push(i as u32);
+                continue;
+            }
+            let key = p.map(|c| (c + 0.0).to_bits());
+            let r = *seen.entry(key).or_insert(i as u32);
+            welded += usize::from(r != i as u32);
+            representative.push(r);
+        }
+        return (representative, welded);
+    }
+    let cell = |p: &[f32; 3]| -> [i64; 3] {
+        std::array::from_fn(|a| ((p[a] as f64 - lo[a]) / tolerance).floor() as i64)
+    };
+    let mut grid: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
+    for (i, p) in positions.iter().enumerate() {
+        if !border[i] {
+            representative.push(i as u32);
+            continue;
+        }
+        let c = cell(p);
+        let mut best: Option<u32> = None;
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                for dz in -1..=1 {
+                    let Some(list) = grid.get(&[c[0] + dx, c[1] + dy, c[2] + dz]) else {
+                        continue;
+                    };
+                    for &r in list {
+                        let q = positions[r as usize];
+                        let d2: f64 = (0..3).map(|a| (p[a] as f64 - q[a] as f64).powi(2)).sum();
+                        if d2 <= tolerance * tolerance && best.is_none_or(|b| r < b) {
+                            best = Some(r);
+                        }
+                    }
+                }
+            }
+        }
+        match best {
+            Some(r) => {
+                welded += 1;
+                representative.push(r);
+            }
+            None => {
+                grid.entry(c).or_default().push(i as u32);
+                representative.push(i as u32);
+            }
+        }
+    }
+    (representative, welded)
+}
+
+/// Drops triangles with the same vertices as an earlier one, keeping the order.
+fn drop_repeated(triangles: &mut Vec<[u32; 3]>) {
+    let mut keyed: Vec<([u32; 3], usize)> = triangles
+        .iter()
+        .enumerate()
+        .map(|(i, t)| {
+            let mut k = *t;
+            k.sort_unstable();
+            (k, i)
+        })
+        .collect();
+    keyed.sort_unstable();
+    let mut keep = vec![true; triangles.len()];
+    for w in keyed.windows(2) {
+        if w[0].0 == w[1].0 {
+            keep[w[1].1] = false;
+        }
+    }
+    let mut i = 0;
+    triangles.retain(|_| {
+        i += 1;
+        keep[i - 1]
+    });
+}
+
+/// The triangles' edges grouped by their two vertices.
+struct EdgeGroups {
+    /// `(triangle, slot)` pairs, grouped: slot `k` is the edge from corner `k` to `k + 1`.
+    sides: Vec<(usize, usize)>,
+    /// Start of each group in `sides` (and one past the end).
+    starts: Vec<usize>,
+    /// The group of each triangle's three edges.
+    group: Vec<[u32; 3]>,
+    /// Groups with more than two triangles.
+    non_manifold: usize,
+}
+
+impl EdgeGroups {
+    fn new(triangles: &[[u32; 3]]) -> EdgeGroups {
+        let mut keyed: Vec<((u32, u32), usize, usize)> = Vec::with_capacity(triangles.len() * 3);
+        for (t, tri) in triangles.iter().enumerate() {
+            for k in 0..3 {
+                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                keyed.push(((a.min(b), a.max(b)), t, k));
+            }
+        }
+        keyed.sort_unstable();
+        let mut sides = Vec::with_capacity(keyed.len());
+        let mut starts = Vec::new();
+        let mut group = vec![[0u32; 3]; triangles.len()];
+        let mut non_manifold = 0;
+        for (i, &(key, t, k)) in keyed.iter().enumerate() {
+            if i == 0 || keyed[i - 1].0 != key {
+                if let Some(&s) = starts.last() {
+                    non_manifold += usize::from(sides.len() - s > 2);
+                }
+                starts.push(sides.len());
+            }
+            group[t][k] = (starts.len() - 1) as u32;
+            sides.push((t, k));
+        }
+        if let Some(&s) = starts.last() {
+            non_manifold += usize::from(sides.len() - s > 2);
+        }
+        starts.push(sides.len());
+        EdgeGroups {
+            sides,
+            starts,
+            group,
+            non_manifold,
+        }
+    }
+
+    fn members(&self, g: usize) -> &[(usize, usize)] {
+        &self.sides[self.starts[g]..self.starts[g + 1]]
+    }
+
+    /// Groups of exactly two triangles: the edges that may join them.
+    fn joinable(&self) -> Vec<bool> {
+        (0..self.starts.len() - 1)
+            .map(|g| self.members(g).len() == 2)
+            .collect()
+    }
+
+    fn group_of(&self, t: usize, k: usize) -> Option<usize> {
+        self.group.get(t).map(|g| g[k] as usize)
+    }
+
+    /// The other triangle across a joined edge.
+    fn across(&self, g: usize, t: usize) -> (usize, usize) {
+        let m = self.members(g);
+        if m[0].0 == t {
+            m[1]
+        } else {
+            m[0]
+        }
+    }
+}
+
+/// Whether each triangle must be flipped so that joined neighbours agree; cuts the joined edges
+/// where they cannot.
+fn orient(
+    triangles: &[[u32; 3]],
+    edges: &EdgeGroups,
+    joined: &mut [bool],
+    cut: &mut usize,
+) -> Vec<bool> {
+    let n = triangles.len();
+    let mut flip = vec![false; n];
+    let mut seen = vec![false; n];
+    let mut part = Vec::new();
+    let forward = |t: usize, k: usize| triangles[t][k] < triangles[t][(k + 1) % 3];
+    for root in 0..n {
+        if seen[root] {
+            continue;
+        }
+        seen[root] = true;
+        part.clear();
+        part.push(root);
+        let mut next = 0;
+        while next < part.len() {
+            let t = part[next];
+            next += 1;
+            for k in 0..3 {
+                let g = edges.group[t][k] as usize;
+                if !joined[g] {
+                    continue;
+                }
+                let (u, j) = edges.across(g, t);
+                // Consistent when the shared edge runs opposite ways after flipping.
+                let want = forward(t, k) ^ flip[t] ^ forward(u, j) ^ true;
+                if !seen[u] {
+                    seen[u] = true;
+                    flip[u] = want;
+                    part.push(u);
+                } else if flip[u] != want {
+                    joined[g] = false;
+                    *cut += 1;
+                }
+            }
+        }
+        // Keep the orientation most of the part had.
+        let flipped = part.iter().filter(|&&t| flip[t]).count();
+        if 2 * flipped > part.len() {
+            for &t in &part {
+                flip[t] = !flip[t];
+            }
+        }
+    }
+    flip
+}
+
+/// Union-find over triangle corners.
+struct Corners(Vec<u32>);
+
+impl Corners {
+    fn find(&mut self, mut c: usize) -> usize {
+        while self.0[c] as usize != c {
+            let up = self.0[c] as usize;
+            self.0[c] = self.0[up];
+            c = up;
+        }
+        c
+    }
+
+    fn union(&mut self, a: usize, b: usize) {
+        let (a, b) = (self.find(a), self.find(b));
+        if a != b {
+            let (lo, hi) = (a.min(b), a.max(b));
+            self.0[hi] = lo as u32;
+        }
+    }
+}
+
+/// Triangles over vertex copies (one per fan of joined triangles around each vertex), and the
+/// input vertex of each copy.
+fn split_fans(
+    triangles: &[[u32; 3]],
+    edges: &EdgeGroups,
+    joined: &[bool],
+) -> (Vec<[u32; 3]>, Vec<u32>) {
+    let mut corners = Corners((0..3 * triangles.len() as u32).collect());
+    let corner_of =
+        |t: usize, v: u32| 3 * t + triangles[t].iter().position(|&x| x == v).unwrap_or(0);
+    for (g, &is_joined) in joined.iter().enumerate() {
+        if !is_joined {
+            continue;
+        }
+        let m = edges.members(g);
+        let ((t, k), (u, _)) = (m[0], m[1]);
+        for v in [triangles[t][k], triangles[t][(k + 1) % 3]] {
+            corners.union(corner_of(t, v), corner_of(u, v));
+        }
+    }
+    let mut copy_of_class: HashMap<usize, u32> = HashMap::new();
+    let mut copies = Vec::new();
+    let out: Vec<[u32; 3]> = triangles
+        .iter()
+        .enumerate()
+        .map(|(t, tri)| {
+            std::array::from_fn(|k| {
+                let class = corners.find(3 * t + k);
+                *copy_of_class.entry(class).or_insert_with(|| {
+                    copies.push(tri[k]);
+                    (copies.len() - 1) as u32
+                })
+            })
+        })
+        .collect();
+    // Number the copies in the order of the vertices they copy, so that a mesh with nothing to
+    // split keeps its numbering.
+    let mut order: Vec<u32> = (0..copies.len() as u32).collect();
+    order.sort_by_key(|&c| copies[c as usize]);
+    let mut new_id = vec![0u32; copies.len()];
+    for (id, &c) in order.iter().enumerate() {
+        new_id[c as usize] = id as u32;
+    }
+    let copies = order.iter().map(|&c| copies[c as usize]).collect();
+    let out = out.iter().map(|t| t.map(|c| new_id[c as usize])).collect();
+    (out, copies)
+}
+
+/// `(triangle, corner)` pairs at the ends of output edges that are still not manifold (more than
+/// two triangles, or two running the same way).
+fn bad_output_edges(triangles: &[[u32; 3]]) -> Vec<(usize, usize)> {
+    let mut keyed: Vec<((u32, u32), bool, usize, usize)> = Vec::with_capacity(triangles.len() * 3);
+    for (t, tri) in triangles.iter().enumerate() {
+        for k in 0..3 {
+            let (a, b) = (tri[k], tri[(k + 1) % 3]);
+            keyed.push(((a.min(b), a.max(b)), a < b, t, k));
+        }
+    }
+    keyed.sort_unstable();
+    let mut bad = Vec::new();
+    let mut i = 0;
+    while i < keyed.len() {
+        let mut j = i + 1;
+        while j < keyed.len() && keyed[j].0 == keyed[i].0 {
+            j += 1;
+        }
+        let ok = j - i == 1 || (j - i == 2 && keyed[i].1 != keyed[i + 1].1);
+        if !ok {
+            for &(_, _, t, k) in &keyed[i..j] {
+                bad.push((t, k));
+                bad.push((t, (k + 1) % 3));
+            }
+        }
+        i = j;
+    }
+    bad
+}
+
+/// Flips every closed connected part whose enclosed volume is negative; returns, per triangle,
+/// whether it was flipped.
+fn turn_outward(positions: &[[f32; 3]], triangles: &mut [[u32; 3]]) -> Vec<bool> {
+    let n = triangles.len();
+    let edges = EdgeGroups::new(triangles);
+    let mut stack = Vec::new();
+    let mut flipped = vec![false; n];
+    let mut seen = vec![false; n];
+    for root in 0..n {
+        if seen[root] {
+            continue;
+        }
+        seen[root] = true;
+        stack.clear();
+        stack.push(root);
+        let mut members = Vec::new();
+        let mut closed = true;
+        while let Some(t) = stack.pop() {
+            members.push(t);
+            for k in 0..3 {
+                let g = edges.group[t][k] as usize;
+                if edges.members(g).len() != 2 {
+                    closed = false;
+                    continue;
+                }
+                let (u, _) = edges.across(g, t);
+                if !seen[u] {
+                    seen[u] = true;
+                    stack.push(u);
+                }
+            }
+        }
+        if !closed {
+            continue;
+        }
+        let p = |i: u32| positions[i as usize].map(f64::from);
+        let volume: f64 = members
+            .iter()
+            .map(|&t| {
+                let [a, b, c] = triangles[t].map(p);
+                a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+                    + a[2] * (b[0] * c[1] - b[1] * c[0])
+            })
+            .sum();
+        if volume < 0.0 {
+            for &t in &members {
+                triangles[t].swap(1, 2);
+                flipped[t] = true;
+            }
+        }
+    }
+    flipped
+}
