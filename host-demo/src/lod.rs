@@ -380,19 +380,11 @@ pub fn write_obj<const V: usize, const F: usize, const Q: usize, I: SlotIndex>(
     cut: &Cut<V, F, Q, I>,
     h: &HierarchyView<'_>,
 ) -> std::io::Result<()> {
-    let mut s = String::with_capacity(cut.vertex_count() * 40 + cut.triangles().len() * 24);
-    for p in (0..cut.vertex_count()).map(|i| cut.vertex(h, i).position) {
-        let _ = writeln!(s, "v {} {} {}", p[0], p[1], p[2]);
-    }
-    for t in cut.triangles() {
-        let _ = writeln!(
-            s,
-            "f {} {} {}",
-            t[0].index() + 1,
-            t[1].index() + 1,
-            t[2].index() + 1
-        );
-    }
+    let positions: Vec<[f32; 3]> = (0..cut.vertex_count())
+        .map(|i| cut.vertex(h, i).position)
+        .collect();
+    let triangles = cut.triangles().iter().map(|t| t.map(|i| i.index() as u32));
+    let s = crate::mesh::obj_text(&positions, None, triangles);
     std::fs::write(path, s)
 }
 

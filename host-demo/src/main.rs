@@ -14,7 +14,7 @@ use vdlod_core::wavelet::build::{Scheme, SemiRegular};
 use vdlod_core::wavelet::SemiRegularView;
 use vdlod_demo::hierarchy;
 use vdlod_demo::lod::{self, OrbitOptions, PolicyChoice};
-use vdlod_demo::mesh::{load_obj, load_obj_bytes, IndexedMesh, MeshError, BUNNY_NAME, BUNNY_OBJ};
+use vdlod_demo::mesh::{self, load_obj_bytes, IndexedMesh, LoadOptions, Up, BUNNY_NAME, BUNNY_OBJ};
 use vdlod_demo::render::{render_orbit, RenderOptions};
 use vdlod_demo::wavelet;
 use vdlod_raster::Shading;
@@ -54,6 +54,39 @@ macro_rules! say {
     };
 }
 
+/// The mesh file's up axis.
+#[derive(Clone, Copy, Default, ValueEnum)]
+enum UpArg {
+    /// +Y is up.
+    #[default]
+    Y,
+    /// +Z is up (CAD, many scanners): turned a quarter about X so +Z becomes +Y.
+    Z,
+}
+
+/// How a mesh file is read.
+#[derive(clap::Args, Clone, Copy, Default)]
+struct InputArgs {
+    /// Reject a mesh the builder would reject, with the reason, instead of repairing it.
+    #[arg(long)]
+    strict: bool,
+    /// The mesh file's up axis.
+    #[arg(long, value_enum, default_value = "y")]
+    up: UpArg,
+}
+
+impl InputArgs {
+    fn options(self) -> LoadOptions {
+        LoadOptions {
+            repair: !self.strict,
+            up: match self.up {
+                UpArg::Y => Up::Y,
+                UpArg::Z => Up::Z,
+            },
+        }
+    }
+}
+
 #[derive(Parser)]
 #[command(
     name = "vdlod-demo",
@@ -74,6 +107,8 @@ enum Command {
     Render(RenderArgs),
     /// Build a mesh's vertex hierarchy and write it as a .vdh file.
     Build(BuildArgs),
+    /// Read a mesh (OBJ, OFF, PLY or STL), repair it and write it as OBJ.
+    Repair(RepairArgs),
     /// Validate a .vdh hierarchy or .vdw semi-regular file and print its figures.
     Info {
         /// The file.
@@ -112,9 +147,23 @@ enum SchemeArg {
 }
 
 #[derive(clap::Args)]
-struct SubdivideArgs {
-    /// OBJ file: a manifold triangle mesh, consistently oriented.
+struct RepairArgs {
+    /// Mesh file (OBJ, OFF, PLY or STL).
     mesh: PathBuf,
+    /// Output OBJ file.
+    #[arg(long, short)]
+    out: PathBuf,
+    /// The mesh file's up axis.
+    #[arg(long, value_enum, default_value = "y")]
+    up: UpArg,
+}
+
+#[derive(clap::Args)]
+struct SubdivideArgs {
+    /// Mesh file (OBJ, OFF, PLY or STL).
+    mesh: PathBuf,
+    #[command(flatten)]
+    input: InputArgs,
     /// Subdivision levels.
     #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=8))]
     levels: u32,
@@ -170,8 +219,10 @@ enum CostArg {
 
 #[derive(clap::Args)]
 struct BuildArgs {
-    /// OBJ file to build from.
+    /// Mesh file to build from (OBJ, OFF, PLY or STL).
     mesh: PathBuf,
+    #[command(flatten)]
+    input: InputArgs,
     /// Output file.
     #[arg(long, short)]
     out: PathBuf,
@@ -198,8 +249,11 @@ enum PolicyArg {
 
 #[derive(clap::Args)]
 struct OrbitArgs {
-    /// OBJ mesh (its hierarchy is built first) or .vdh hierarchy (default: the bundled bunny).
+    /// Mesh file (OBJ, OFF, PLY or STL; its hierarchy is built first) or .vdh hierarchy
+    /// (default: the bundled bunny).
     mesh: Option<PathBuf>,
+    #[command(flatten)]
+    input: InputArgs,
     /// Output directory.
     #[arg(long, short, default_value = "out")]
     out: PathBuf,
@@ -263,6 +317,7 @@ impl Default for OrbitArgs {
     fn default() -> Self {
         OrbitArgs {
             mesh: None,
+            input: InputArgs::default(),
             out: PathBuf::from("out"),
             budget: None,
             target: None,
@@ -294,8 +349,11 @@ enum ShadingArg {
 
 #[derive(clap::Args)]
 struct RenderArgs {
-    /// OBJ file to render (default: the bundled Stanford bunny).
+    /// Mesh file (OBJ, OFF, PLY or STL) or .vdh hierarchy to render at full detail (default: the
+    /// bundled Stanford bunny).
     mesh: Option<PathBuf>,
+    #[command(flatten)]
+    input: InputArgs,
     /// Directory for frame_NNNN.png.
     #[arg(long, short, default_value = "out")]
     out: PathBuf,
@@ -320,6 +378,7 @@ impl Default for RenderArgs {
     fn default() -> Self {
         RenderArgs {
             mesh: None,
+            input: InputArgs::default(),
             out: PathBuf::from("out"),
             frames: 36,
             width: 640,
@@ -330,18 +389,37 @@ impl Default for RenderArgs {
     }
 }
 
-fn load(mesh: Option<&PathBuf>) -> Result<(String, IndexedMesh), MeshError> {
-    match mesh {
-        Some(path) => Ok((path.display().to_string(), load_obj(path)?)),
-        None => Ok((
-            BUNNY_NAME.to_string(),
-            load_obj_bytes(BUNNY_NAME, BUNNY_OBJ)?,
-        )),
+/// Loads a mesh file (or the bundled bunny), saying what was repaired.
+fn load(mesh: Option<&PathBuf>, input: InputArgs) -> Result<(String, IndexedMesh), String> {
+    let Some(path) = mesh else {
+        let bunny = load_obj_bytes(BUNNY_NAME, BUNNY_OBJ).map_err(|e| e.to_string())?;
+        return Ok((BUNNY_NAME.to_string(), bunny));
+    };
+    let name = path.display().to_string();
+    let loaded = mesh::load(path, &input.options()).map_err(|e| e.to_string())?;
+    if let Some(repairs) = loaded.repairs.filter(|r| !r.is_empty()) {
+        say!("{name}: {}: repaired: {repairs}", loaded.format);
     }
+    Ok((name, loaded.mesh))
+}
+
+/// Whether the file is a vdlod hierarchy (by its first bytes, whatever its name).
+fn is_hierarchy(path: &Path) -> bool {
+    use std::io::Read as _;
+    let mut magic = [0u8; 4];
+    std::fs::File::open(path)
+        .and_then(|mut f| f.read_exact(&mut magic))
+        .is_ok_and(|()| magic == vdlod_core::format::MAGIC)
 }
 
 fn render(args: RenderArgs) -> Result<(), String> {
-    let (name, mut mesh) = load(args.mesh.as_ref()).map_err(|e| e.to_string())?;
+    let (name, mut mesh) = match args.mesh.as_ref() {
+        Some(path) if is_hierarchy(path) => {
+            let (name, _, full) = load_hierarchy(path)?;
+            (name, full)
+        }
+        mesh => load(mesh, args.input)?,
+    };
     mesh.reorder_for_locality();
     let opts = RenderOptions {
         width: args.width,
@@ -383,16 +461,23 @@ fn render(args: RenderArgs) -> Result<(), String> {
     Ok(())
 }
 
-/// The hierarchy bytes and the full-detail mesh of an OBJ or .vdh argument.
-fn load_lod(mesh: Option<&PathBuf>) -> Result<(String, Vec<u8>, IndexedMesh), String> {
-    let is_vdh = mesh.is_some_and(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("vdh")));
-    if let (true, Some(path)) = (is_vdh, mesh) {
-        let bytes = hierarchy::read(path)?;
-        let view = HierarchyView::parse(&bytes).map_err(|e| format!("{}: {e}", path.display()))?;
-        let full = lod::full_detail(&view).map_err(|e| format!("{}: {e}", path.display()))?;
-        return Ok((path.display().to_string(), bytes, full));
+/// The bytes and the full-detail mesh of a .vdh file.
+fn load_hierarchy(path: &Path) -> Result<(String, Vec<u8>, IndexedMesh), String> {
+    let bytes = hierarchy::read(path)?;
+    let view = HierarchyView::parse(&bytes).map_err(|e| format!("{}: {e}", path.display()))?;
+    let full = lod::full_detail(&view).map_err(|e| format!("{}: {e}", path.display()))?;
+    Ok((path.display().to_string(), bytes, full))
+}
+
+/// The hierarchy bytes and the full-detail mesh of a mesh or .vdh argument.
+fn load_lod(
+    mesh: Option<&PathBuf>,
+    input: InputArgs,
+) -> Result<(String, Vec<u8>, IndexedMesh), String> {
+    if let Some(path) = mesh.filter(|p| is_hierarchy(p)) {
+        return load_hierarchy(path);
     }
-    let (name, mut full) = load(mesh).map_err(|e| e.to_string())?;
+    let (name, mut full) = load(mesh, input)?;
     let show = std::io::IsTerminal::is_terminal(&std::io::stderr());
     let (_, bytes, seconds) = hierarchy::build_with_progress(&full, &BuildOptions::default(), show)
         .map_err(|e| format!("{name}: {e}"))?;
@@ -402,7 +487,7 @@ fn load_lod(mesh: Option<&PathBuf>) -> Result<(String, Vec<u8>, IndexedMesh), St
 }
 
 fn orbit_command(args: OrbitArgs) -> Result<(), String> {
-    let (name, bytes, full) = load_lod(args.mesh.as_ref())?;
+    let (name, bytes, full) = load_lod(args.mesh.as_ref(), args.input)?;
     let mut budget = Budget::default();
     if let Some(b) = args.budget {
         budget.max_triangles = b;
@@ -485,7 +570,7 @@ fn orbit_command(args: OrbitArgs) -> Result<(), String> {
 }
 
 fn build_command(args: BuildArgs) -> Result<(), String> {
-    let mesh = load_obj(&args.mesh).map_err(|e| e.to_string())?;
+    let (_, mesh) = load(Some(&args.mesh), args.input)?;
     let opts = BuildOptions {
         cost: match args.cost {
             CostArg::Qem => Cost::Quadric,
@@ -512,6 +597,33 @@ fn build_command(args: BuildArgs) -> Result<(), String> {
         })?;
     say!("{}: {}", args.out.display(), hierarchy::summarize(&view));
     say!("built in {seconds:.3} s");
+    Ok(())
+}
+
+fn repair(args: RepairArgs) -> Result<(), String> {
+    let options = InputArgs {
+        strict: false,
+        up: args.up,
+    }
+    .options();
+    let loaded = mesh::load(&args.mesh, &options).map_err(|e| e.to_string())?;
+    let m = &loaded.mesh;
+    say!(
+        "{}: {}, {} vertices, {} triangles after repair: {}",
+        args.mesh.display(),
+        loaded.format,
+        m.positions.len(),
+        m.triangles.len(),
+        loaded.repairs.unwrap_or_default()
+    );
+    let text = mesh::obj_text(
+        &m.positions,
+        m.colors.as_deref(),
+        m.triangles.iter().copied(),
+    );
+    std::fs::write(&args.out, text)
+        .map_err(|e| format!("{}: cannot write: {e}", args.out.display()))?;
+    say!("wrote {}", args.out.display());
     Ok(())
 }
 
@@ -554,7 +666,7 @@ fn write_semi_regular(
 }
 
 fn subdivide(args: SubdivideArgs) -> Result<(), String> {
-    let mesh = load_obj(&args.mesh).map_err(|e| e.to_string())?;
+    let (_, mesh) = load(Some(&args.mesh), args.input)?;
     let base = if args.base > 0 {
         wavelet::simplified_base(&mesh, args.base)
             .map_err(|e| format!("{}: {e}", args.mesh.display()))?
@@ -609,6 +721,7 @@ fn main() -> ExitCode {
         Some(Command::Orbit(args)) => orbit_command(args),
         Some(Command::Render(args)) => render(args),
         Some(Command::Build(args)) => build_command(args),
+        Some(Command::Repair(args)) => repair(args),
         Some(Command::Info { file }) => info(file),
         Some(Command::Sphere(args)) => sphere(args),
         Some(Command::Subdivide(args)) => subdivide(args),

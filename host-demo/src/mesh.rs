@@ -255,7 +255,7 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<Loaded, MeshError> {
 /// let off = b"OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 3 2\n";
 /// let loaded = load_bytes("square.off", off, &LoadOptions::default()).unwrap();
 /// assert_eq!(loaded.mesh.triangles, vec![[0, 1, 2], [0, 2, 3]]);
-/// assert_eq!(loaded.repairs.unwrap().to_string(), "1 triangles flipped");
+/// assert_eq!(loaded.repairs.unwrap().to_string(), "1 triangle flipped");
 /// let strict = LoadOptions { repair: false, ..LoadOptions::default() };
 /// let e = load_bytes("square.off", off, &strict).unwrap_err();
 /// assert_eq!(
@@ -446,6 +446,34 @@ impl IndexedMesh {
             triangles,
         }
     }
+}
+
+/// OBJ text of a mesh: `v x y z` lines (`v x y z r g b` with colours, as fractions of 1) and
+/// 1-based `f` lines. Coordinates are written so they read back to the same bits.
+///
+/// ```
+/// let text = vdlod_demo::mesh::obj_text(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.5, 0.0]], None, [[0, 1, 2]]);
+/// assert_eq!(text, "v 0 0 0\nv 1 0 0\nv 0 0.5 0\nf 1 2 3\n");
+/// ```
+pub fn obj_text(
+    positions: &[[f32; 3]],
+    colors: Option<&[[u8; 3]]>,
+    triangles: impl IntoIterator<Item = [u32; 3]>,
+) -> String {
+    use std::fmt::Write as _;
+    let mut s = String::with_capacity(positions.len() * 40);
+    for (i, p) in positions.iter().enumerate() {
+        let _ = write!(s, "v {} {} {}", p[0], p[1], p[2]);
+        if let Some(c) = colors.and_then(|c| c.get(i)) {
+            let f = |v: u8| v as f32 / 255.0;
+            let _ = write!(s, " {} {} {}", f(c[0]), f(c[1]), f(c[2]));
+        }
+        s.push('\n');
+    }
+    for t in triangles {
+        let _ = writeln!(s, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1);
+    }
+    s
 }
 
 /// Interleaves the low 10 bits of three coordinates.

@@ -59,18 +59,33 @@ impl Repairs {
 impl fmt::Display for Repairs {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let items = [
-            (self.welded, "vertices welded"),
-            (self.degenerate, "degenerate triangles dropped"),
-            (self.duplicate, "repeated triangles dropped"),
-            (self.flipped, "triangles flipped"),
-            (self.cut_edges, "non-manifold or unorientable edges cut"),
-            (self.split, "vertices split"),
-            (self.unused, "unused vertices dropped"),
+            (self.welded, "vertex", "vertices", "welded"),
+            (
+                self.degenerate,
+                "degenerate triangle",
+                "degenerate triangles",
+                "dropped",
+            ),
+            (
+                self.duplicate,
+                "repeated triangle",
+                "repeated triangles",
+                "dropped",
+            ),
+            (self.flipped, "triangle", "triangles", "flipped"),
+            (
+                self.cut_edges,
+                "non-manifold or unorientable edge",
+                "non-manifold or unorientable edges",
+                "cut",
+            ),
+            (self.split, "vertex", "vertices", "split"),
+            (self.unused, "unused vertex", "unused vertices", "dropped"),
         ];
         let said: Vec<String> = items
             .iter()
-            .filter(|(n, _)| *n > 0)
-            .map(|(n, what)| format!("{n} {what}"))
+            .filter(|item| item.0 > 0)
+            .map(|&(n, one, many, done)| format!("{n} {} {done}", if n == 1 { one } else { many }))
             .collect();
         if said.is_empty() {
             f.write_str("nothing to repair")
@@ -97,7 +112,11 @@ impl fmt::Display for Repairs {
 pub fn repair(soup: Soup) -> (Soup, Repairs) {
     let mut repairs = Repairs::default();
     let border = on_border(soup.positions.len(), &soup.triangles);
-    let (representative, welded) = weld(&soup.positions, &border);
+    let near = weld(&soup.positions, &border);
+    let representative = zipping(&near, &soup.triangles);
+    let welded = (0..representative.len())
+        .filter(|&i| representative[i] != i as u32)
+        .count();
     repairs.welded = welded;
     let mut triangles = Vec::with_capacity(soup.triangles.len());
     for t in &soup.triangles {
@@ -121,6 +140,9 @@ pub fn repair(soup: Soup) -> (Soup, Repairs) {
             t.swap(1, 2);
         }
     }
+    // Flipping moved edges between slots; the groups (sorted by their two vertices) keep their
+    // numbers, so `joined` still applies.
+    let edges = EdgeGroups::new(&triangles);
 
     // Split fans; cut more edges if two fans still share an output edge.
     let (mut out, mut copies) = split_fans(&triangles, &edges, &joined);
@@ -201,8 +223,54 @@ fn on_border(vertices: usize, triangles: &[[u32; 3]]) -> Vec<bool> {
     border
 }
 
-/// The vertex each vertex welds to, and how many were welded; only `border` vertices weld.
-fn weld(positions: &[[f32; 3]], border: &[bool]) -> (Vec<u32>, usize) {
+/// `near` restricted to the welds that close a crack: a vertex is welded only when one of its
+/// border edges then coincides with another border edge. Border vertices that merely lie close
+/// together (the two lips of a slit, a hole's rim pinched to a point) stay apart.
+fn zipping(near: &[u32], triangles: &[[u32; 3]]) -> Vec<u32> {
+    let mut edges: Vec<((u32, u32), (u32, u32))> = triangles
+        .iter()
+        .flat_map(|t| (0..3).map(move |k| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]))))
+        .map(|e| (e, e))
+        .collect();
+    edges.sort_unstable();
+    // Border edges: those of a single triangle, keyed by their welded ends.
+    let mut border: Vec<((u32, u32), (u32, u32))> = Vec::new();
+    let mut i = 0;
+    while i < edges.len() {
+        let mut j = i + 1;
+        while j < edges.len() && edges[j].0 == edges[i].0 {
+            j += 1;
+        }
+        if j - i == 1 {
+            let (a, b) = edges[i].1;
+            let (x, y) = (near[a as usize], near[b as usize]);
+            border.push(((x.min(y), x.max(y)), (a, b)));
+        }
+        i = j;
+    }
+    border.sort_unstable();
+    let mut zips = vec![false; near.len()];
+    let mut i = 0;
+    while i < border.len() {
+        let mut j = i + 1;
+        while j < border.len() && border[j].0 == border[i].0 {
+            j += 1;
+        }
+        if j - i > 1 {
+            for &(_, (a, b)) in &border[i..j] {
+                zips[a as usize] = true;
+                zips[b as usize] = true;
+            }
+        }
+        i = j;
+    }
+    (0..near.len())
+        .map(|v| if zips[v] { near[v] } else { v as u32 })
+        .collect()
+}
+
+/// The vertex each vertex is near enough to weld to; only `border` vertices weld.
+fn weld(positions: &[[f32; 3]], border: &[bool]) -> Vec<u32> {
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
     for p in positions {
@@ -214,7 +282,6 @@ fn weld(positions: &[[f32; 3]], border: &[bool]) -> (Vec<u32>, usize) {
     let diagonal = (0..3).map(|a| (hi[a] - lo[a]).powi(2)).sum::<f64>().sqrt();
     let tolerance = diagonal * WELD_TOLERANCE;
     let mut representative = Vec::with_capacity(positions.len());
-    let mut welded = 0;
     if !(tolerance > 0.0 && tolerance.is_finite()) {
         // A single point (or nothing): exact matches only.
         let mut seen: HashMap<[u32; 3], u32> = HashMap::new();
@@ -224,11 +291,9 @@ fn weld(positions: &[[f32; 3]], border: &[bool]) -> (Vec<u32>, usize) {
                 continue;
             }
             let key = p.map(|c| (c + 0.0).to_bits());
-            let r = *seen.entry(key).or_insert(i as u32);
-            welded += usize::from(r != i as u32);
-            representative.push(r);
+            representative.push(*seen.entry(key).or_insert(i as u32));
         }
-        return (representative, welded);
+        return representative;
     }
     let cell = |p: &[f32; 3]| -> [i64; 3] {
         std::array::from_fn(|a| ((p[a] as f64 - lo[a]) / tolerance).floor() as i64)
@@ -258,17 +323,14 @@ fn weld(positions: &[[f32; 3]], border: &[bool]) -> (Vec<u32>, usize) {
             }
         }
         match best {
-            Some(r) => {
-                welded += 1;
-                representative.push(r);
-            }
+            Some(r) => representative.push(r),
             None => {
                 grid.entry(c).or_default().push(i as u32);
                 representative.push(i as u32);
             }
         }
     }
-    (representative, welded)
+    representative
 }
 
 /// Drops triangles with the same vertices as an earlier one, keeping the order.

@@ -57,13 +57,7 @@ pub fn write_file(out: &Path, bytes: &[u8]) -> Result<(), String> {
 
 /// Writes a semi-regular mesh's finest level as an OBJ file.
 pub fn write_obj(mesh: &SemiRegular, out: &Path) -> Result<(), String> {
-    let mut text = String::new();
-    for p in &mesh.positions {
-        let _ = writeln!(text, "v {} {} {}", p[0], p[1], p[2]);
-    }
-    for t in mesh.finest_triangles() {
-        let _ = writeln!(text, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1);
-    }
+    let text = crate::mesh::obj_text(&mesh.positions, None, mesh.finest_triangles());
     std::fs::write(out, text).map_err(|e| format!("{}: cannot write: {e}", out.display()))
 }
 

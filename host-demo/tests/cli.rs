@@ -64,7 +64,38 @@ fn missing_file() {
 
 #[test]
 fn malformed_obj() {
-    assert_one_line_error("bad.obj", "v 0 0 zero\nf 1 2 3\n", "malformed OBJ");
+    assert_one_line_error(
+        "bad.obj",
+        "v 0 0 zero\nf 1 2 3\n",
+        "bad.obj: OBJ: line 1: `zero` is not a number",
+    );
+    assert_one_line_error(
+        "bad.ply",
+        "ply\nformat ascii 1.0\nelement vertex 3\nproperty half x\nend_header\n",
+        "bad.ply: PLY: line 4: header: unknown type `half`",
+    );
+    assert_one_line_error(
+        "short.off",
+        "OFF\n3 1 0\n0 0 0\n1 0 0\n",
+        "short.off: OFF: line 5: the file ends while reading the vertices",
+    );
+    let mut stl = vec![0u8; 80];
+    stl.extend(16u32.to_le_bytes());
+    assert_one_line_error(
+        "short.stl",
+        &String::from_utf8(stl).unwrap(),
+        "short.stl: STL: byte 84: the file ends while reading the triangles",
+    );
+    assert_build_error(
+        "x.vdh",
+        "VDLH and more",
+        "x.vdh: this is a vdlod hierarchy (.vdh), not a mesh",
+    );
+    assert_one_line_error(
+        "what.bin",
+        "\u{1}\u{2}",
+        "what.bin: not a mesh format vdlod reads",
+    );
 }
 
 #[test]
@@ -233,17 +264,103 @@ fn info_rejects_corrupted_files_in_one_line() {
 }
 
 #[test]
-fn build_rejects_non_manifold_meshes_in_one_line() {
-    assert_build_error(
-        "fin.obj",
-        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nf 1 2 3\nf 2 1 4\nf 1 2 5\n",
-        "non-manifold",
+fn strict_build_rejects_non_manifold_meshes_in_one_line() {
+    let strict = ["build", "FILE", "--strict", "-o", "x.vdh"];
+    let fin = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nf 1 2 3\nf 2 1 4\nf 1 2 5\n";
+    assert_one_line_failure("fin.obj", fin, &strict, "non-manifold");
+    let dup = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 2 3 1\n";
+    assert_one_line_failure("dup.obj", dup, &strict, "repeats triangle 0");
+}
+
+#[test]
+fn repair_says_what_it_did_and_writes_a_mesh_strict_accepts() {
+    let dir = scratch_dir("cli_repair");
+    // Two squares touching at a corner (a bow tie), one triangle listed twice, one flipped.
+    let text = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv -1 0 0\nv -1 -1 0\nv 0 -1 0\n\
+                f 1 2 3\nf 1 4 3\nf 1 3 4\nf 1 5 6\nf 1 6 7\n";
+    std::fs::write(dir.join("tie.obj"), text).unwrap();
+    let out = demo(&["repair", "tie.obj", "-o", "fixed.obj"], &dir);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
     );
-    assert_build_error(
-        "dup.obj",
-        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 2 3 1\n",
-        "repeats triangle 0",
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains(
+            "tie.obj: OBJ, 8 vertices, 4 triangles after repair: 1 repeated triangle dropped, \
+             1 triangle flipped, 1 vertex split"
+        ),
+        "{stdout}"
     );
+    let out = demo(&["build", "fixed.obj", "--strict", "-o", "x.vdh"], &dir);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // The same file builds without --strict, saying what was repaired.
+    let out = demo(&["build", "tie.obj", "-o", "y.vdh"], &dir);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(String::from_utf8_lossy(&out.stdout).contains("tie.obj: OBJ: repaired: "));
+}
+
+#[test]
+fn every_format_builds_and_renders() {
+    let dir = scratch_dir("cli_formats");
+    // A tetrahedron in each format.
+    let p = ["0 0 0", "1 0 0", "0 1 0", "0 0 1"];
+    let t = [[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]];
+    let off = format!(
+        "OFF\n4 4 0\n{}\n{}\n",
+        p.join("\n"),
+        t.map(|t| format!("3 {} {} {}", t[0], t[1], t[2]))
+            .join("\n")
+    );
+    let ply = format!(
+        "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n\
+         property float z\nelement face 4\nproperty list uchar int vertex_indices\nend_header\n{}\n{}\n",
+        p.join("\n"),
+        t.map(|t| format!("3 {} {} {}", t[0], t[1], t[2])).join("\n")
+    );
+    let facets: String = t
+        .iter()
+        .map(|t| {
+            let v: String = t.iter().map(|&i| format!("vertex {}\n", p[i])).collect();
+            format!("facet normal 0 0 0\nouter loop\n{v}endloop\nendfacet\n")
+        })
+        .collect();
+    let stl = format!("solid t\n{facets}endsolid t\n");
+    for (name, text) in [("t.off", off), ("t.ply", ply), ("t.stl", stl)] {
+        std::fs::write(dir.join(name), text).unwrap();
+        let out = demo(
+            &["build", name, "--strict", "--up", "z", "-o", "t.vdh"],
+            &dir,
+        );
+        assert!(
+            out.status.success(),
+            "{name}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    // `render` takes the hierarchy too, found by its content.
+    std::fs::rename(dir.join("t.vdh"), dir.join("t.bin")).unwrap();
+    let out = demo(
+        &[
+            "render", "t.bin", "--frames", "1", "--width", "16", "--height", "12",
+        ],
+        &dir,
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(dir.join("out/frame_0000.png").exists());
 }
 
 #[test]
@@ -442,8 +559,8 @@ fn subdivide_rejects_a_non_manifold_mesh_in_one_line() {
     assert_one_line_failure(
         "fan.obj",
         fan,
-        &["subdivide", "FILE", "-o", "x.vdw"],
-        "not manifold",
+        &["subdivide", "FILE", "--strict", "-o", "x.vdw"],
+        "non-manifold",
     );
 }
 
