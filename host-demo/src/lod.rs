@@ -405,7 +405,41 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
+/// The limits a frame hit, by name (`budget`, `ops`, `capacity`, `queue`, `blend`,
+/// `over-budget`), joined with `+`; empty when none.
+pub fn limits(stats: &FrameStats) -> String {
+    let names = [
+        (stats.budget_limited, "budget"),
+        (stats.ops_limited, "ops"),
+        (stats.capacity_limited, "capacity"),
+        (stats.queue_overflow, "queue"),
+        (stats.blend_limited, "blend"),
+        (stats.over_budget, "over-budget"),
+    ];
+    let hit: Vec<&str> = names.iter().filter(|n| n.0).map(|n| n.1).collect();
+    hit.join("+")
+}
+
 impl OrbitSummary {
+    /// How many frames hit each limit, as `name N` items (see [`limits`]); empty when none did.
+    pub fn limit_counts(&self) -> String {
+        let count = |f: fn(&FrameStats) -> bool| self.frames.iter().filter(|x| f(&x.stats)).count();
+        let counts = [
+            (count(|s| s.budget_limited), "budget"),
+            (count(|s| s.ops_limited), "ops"),
+            (count(|s| s.capacity_limited), "capacity"),
+            (count(|s| s.queue_overflow), "queue"),
+            (count(|s| s.blend_limited), "blend"),
+            (count(|s| s.over_budget), "over-budget"),
+        ];
+        let hit: Vec<String> = counts
+            .iter()
+            .filter(|c| c.0 > 0)
+            .map(|(n, name)| format!("{name} in {n}"))
+            .collect();
+        hit.join(", ")
+    }
+
     /// Median of a per-frame figure over the frames after the first (the first refines from the
     /// base mesh and is reported on its own).
     pub fn median_after_first(&self, f: impl Fn(&OrbitFrame) -> f64) -> f64 {
@@ -453,6 +487,13 @@ fn fly_orbit<const V: usize, const F: usize, const Q: usize, I: SlotIndex + Vert
     let h = *h;
     let io = |e: std::io::Error| format!("{}: {e}", out_dir.display());
     std::fs::create_dir_all(out_dir).map_err(io)?;
+    // Only what this run writes is cleaned: frames (and meshes) past its last one.
+    let stale: Vec<(&str, u32)> = [("frame_", opts.write_frames), ("mesh_", opts.dump_mesh)]
+        .into_iter()
+        .filter(|s| s.1)
+        .map(|(prefix, _)| (prefix, opts.frames))
+        .collect();
+    crate::render::remove_stale(out_dir, &stale).map_err(io)?;
     cut.set_coloring(if opts.depth_colors {
         Coloring::Depth
     } else {
@@ -476,7 +517,7 @@ fn fly_orbit<const V: usize, const F: usize, const Q: usize, I: SlotIndex + Vert
     let mut reference = Frame::new(opts.width, opts.height).map_err(|e| e.to_string())?;
     let full_mesh = full.as_raster_mesh();
     let mut csv = String::from(
-        "frame,triangles,vsplits,ecols,adapt_us,render_us,full_render_us,psnr_db,vertices,forced,blending,threshold,budget_limited\n",
+        "frame,triangles,vsplits,ecols,adapt_us,render_us,full_render_us,psnr_db,vertices,forced,blending,threshold,budget_limited,ops_limited,capacity_limited,queue_overflow,blend_limited,over_budget\n",
     );
     let mut frames = Vec::with_capacity(opts.frames as usize);
     let mut warned = false;
@@ -553,7 +594,7 @@ fn fly_orbit<const V: usize, const F: usize, const Q: usize, I: SlotIndex + Vert
         }
         let _ = writeln!(
             csv,
-            "{},{},{},{},{:.1},{:.1},{:.1},{:.3},{},{},{},{},{}",
+            "{},{},{},{},{:.1},{:.1},{:.1},{:.3},{},{},{},{},{},{},{},{},{},{}",
             i,
             stats.triangles,
             stats.vsplits,
@@ -567,6 +608,11 @@ fn fly_orbit<const V: usize, const F: usize, const Q: usize, I: SlotIndex + Vert
             stats.blending,
             stats.threshold,
             stats.budget_limited as u8,
+            stats.ops_limited as u8,
+            stats.capacity_limited as u8,
+            stats.queue_overflow as u8,
+            stats.blend_limited as u8,
+            stats.over_budget as u8,
         );
         report(&f);
         frames.push(f);

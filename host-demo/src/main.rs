@@ -532,8 +532,9 @@ fn orbit_command(args: OrbitArgs) -> Result<(), String> {
         args.out.display()
     );
     let summary = lod::run_orbit(&bytes, &full, &opts, &args.out, |f| {
+        let limits = lod::limits(&f.stats);
         say!(
-                "frame {:04}  triangles {:>7}  splits {:>5}  collapses {:>5}  adapt {:>8.1} us  render {:>7.2} ms  full {:>7.2} ms  PSNR {:>6.2} dB",
+                "frame {:04}  triangles {:>7}  splits {:>5}  collapses {:>5}  adapt {:>8.1} us  render {:>7.2} ms  full {:>7.2} ms  PSNR {:>6.2} dB{}{}",
                 f.index,
                 f.stats.triangles,
                 f.stats.vsplits,
@@ -541,7 +542,9 @@ fn orbit_command(args: OrbitArgs) -> Result<(), String> {
                 f.adapt_us,
                 f.render_us / 1e3,
                 f.full_render_us / 1e3,
-                f.psnr_db
+                f.psnr_db,
+                if limits.is_empty() { "" } else { "  limits: " },
+                limits
             )
     })?;
     let first = summary.frames[0];
@@ -551,16 +554,24 @@ fn orbit_command(args: OrbitArgs) -> Result<(), String> {
         first.stats.vsplits,
         first.adapt_us
     );
-    say!(
-        "other frames, median: adapt {:.1} us, {:.0} triangles, {:.1} splits + {:.1} collapses; adapt + render {:.2} ms vs full detail {:.2} ms; PSNR mean {:.2} dB",
-        summary.median_after_first(|f| f.adapt_us),
-        summary.median_after_first(|f| f.stats.triangles as f64),
-        summary.mean_after_first(|f| f.stats.vsplits as f64),
-        summary.mean_after_first(|f| f.stats.ecols as f64),
-        summary.median_after_first(|f| (f.adapt_us + f.render_us) / 1e3),
-        summary.median_after_first(|f| f.full_render_us / 1e3),
-        summary.mean_after_first(|f| f.psnr_db.min(99.0)),
-    );
+    if summary.frames.len() > 1 {
+        say!(
+            "other frames, median: adapt {:.1} us, {:.0} triangles, {:.1} splits + {:.1} collapses; adapt + render {:.2} ms vs full detail {:.2} ms; PSNR mean {:.2} dB",
+            summary.median_after_first(|f| f.adapt_us),
+            summary.median_after_first(|f| f.stats.triangles as f64),
+            summary.mean_after_first(|f| f.stats.vsplits as f64),
+            summary.mean_after_first(|f| f.stats.ecols as f64),
+            summary.median_after_first(|f| (f.adapt_us + f.render_us) / 1e3),
+            summary.median_after_first(|f| f.full_render_us / 1e3),
+            summary.mean_after_first(|f| f.psnr_db.min(99.0)),
+        );
+    } else {
+        say!("one frame only: no figures over the following frames");
+    }
+    let counts = summary.limit_counts();
+    if !counts.is_empty() {
+        say!("limits hit (frames): {counts}; see the limit columns of stats.csv");
+    }
     say!(
         "wrote {}/stats.csv, plot.png, side_by_side.png (frame {})",
         args.out.display(),

@@ -85,6 +85,27 @@ pub fn render_orbit_frame(
     })
 }
 
+/// Removes the numbered outputs an earlier, longer run left in `dir`: each `PREFIXNNNN.EXT` (a
+/// prefix of `stale`, four or more digits, any extension) whose number is at least the prefix's
+/// count of files this run writes. Nothing else is touched.
+pub fn remove_stale(dir: &Path, stale: &[(&str, u32)]) -> std::io::Result<()> {
+    for entry in std::fs::read_dir(dir)? {
+        let name = entry?.file_name();
+        let Some(name) = name.to_str() else { continue };
+        for &(prefix, kept) in stale {
+            let Some((digits, _ext)) = name.strip_prefix(prefix).and_then(|r| r.split_once('.'))
+            else {
+                continue;
+            };
+            let numbered = digits.len() >= 4 && digits.bytes().all(|b| b.is_ascii_digit());
+            if numbered && digits.parse::<u64>().is_ok_and(|n| n >= kept as u64) {
+                std::fs::remove_file(dir.join(name))?;
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Renders the whole orbit into `out_dir/frame_NNNN.png`, calling `report` after each frame.
 pub fn render_orbit(
     mesh: &IndexedMesh,
@@ -93,6 +114,7 @@ pub fn render_orbit(
     mut report: impl FnMut(&FrameReport),
 ) -> Result<Vec<FrameReport>, FrameError> {
     std::fs::create_dir_all(out_dir).map_err(FrameError::Io)?;
+    remove_stale(out_dir, &[("frame_", opts.frames)]).map_err(FrameError::Io)?;
     let mut frame = Frame::new(opts.width, opts.height)?;
     let mut reports = Vec::with_capacity(opts.frames as usize);
     for i in 0..opts.frames {

@@ -641,3 +641,56 @@ fn a_closed_standard_output_is_a_normal_end_and_a_full_one_an_error_line() {
         assert!(stderr.contains("standard output"), "{stderr}");
     }
 }
+
+#[test]
+fn a_shorter_run_leaves_no_stale_frames_and_names_its_limits() {
+    let dir = scratch_dir("cli_stale");
+    let cow = fixture("cow.obj");
+    let cow = cow.to_str().unwrap();
+    let small = ["--width", "32", "--height", "24", "-o", "o"];
+    let run = |extra: &[&str]| {
+        let mut args = vec!["orbit", cow];
+        args.extend_from_slice(extra);
+        args.extend_from_slice(&small);
+        let out = demo(&args, &dir);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8_lossy(&out.stdout).into_owned()
+    };
+    run(&["--frames", "5", "--dump-mesh"]);
+    std::fs::write(dir.join("o/frame_notes.txt"), "mine").unwrap();
+    let stdout = run(&["--frames", "2", "--max-ops", "5"]);
+    let mut left: Vec<String> = std::fs::read_dir(dir.join("o"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .filter(|n| n.starts_with("frame_") || n.starts_with("mesh_"))
+        .collect();
+    left.sort();
+    // Meshes are not written this time, so they are not this run's to clean.
+    assert_eq!(
+        left,
+        [
+            "frame_0000.png",
+            "frame_0001.png",
+            "frame_notes.txt",
+            "mesh_0000.obj",
+            "mesh_0001.obj",
+            "mesh_0002.obj",
+            "mesh_0003.obj",
+            "mesh_0004.obj"
+        ]
+    );
+    assert!(stdout.contains("limits: ops"), "{stdout}");
+    assert!(stdout.contains("limits hit (frames): ops in 2"), "{stdout}");
+    let csv = std::fs::read_to_string(dir.join("o/stats.csv")).unwrap();
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let ops = header.iter().position(|&c| c == "ops_limited").unwrap();
+    let first: Vec<&str> = csv.lines().nth(1).unwrap().split(',').collect();
+    assert_eq!(first[ops], "1");
+    let one = run(&["--frames", "1"]);
+    assert!(one.contains("one frame only"), "{one}");
+    assert!(!one.contains("-0.0"), "{one}");
+}
