@@ -419,7 +419,7 @@ mod tests {
              element face 1\r\nproperty uchar flags\r\nproperty list uchar uint vertex_indices\r\nend_header\r\n"
         )
         .into_bytes();
-        let corners = [
+        let corners: [[f64; 3]; 4] = [
             [0.0, 0.0, 0.0],
             [1.0, 0.0, 0.0],
             [1.0, 1.0, 0.0],
@@ -427,7 +427,7 @@ mod tests {
         ];
         let colors = [[255u8, 0, 0], [0, 255, 0], [0, 0, 255], [9, 9, 9]];
         for (p, c) in corners.iter().zip(colors) {
-            let (x, y, z, nx) = (p[0] as f64, p[1] as f32, p[2] as i32, 0.5f32);
+            let (x, y, z, nx) = (p[0], p[1] as f32, p[2] as i32, 0.5f32);
             if big {
                 out.extend(
                     x.to_be_bytes()
