@@ -10,10 +10,11 @@
 //! and the line (text) or byte offset (binary) where reading stopped.
 //!
 //! The readers are ours rather than crates': `tobj` reads each `g`/`o` group as a separate vertex
-//! set (so a closed mesh with one group line became non-manifold), refuses a file with one
-//! non-UTF-8 byte without a line number, and PLY and STL crates size their arrays from the header's
-//! counts. Here nothing is allocated from a count before the bytes that hold it are there, so a
-//! hostile header costs no memory.
+//! set (so a closed mesh with one group line became non-manifold) and refuses a file with one
+//! non-UTF-8 byte without a line number; `stl_io` takes a binary STL whose header starts with
+//! `solid ` for ASCII; `ply-rs` pushes a record per claimed element even when an element has no
+//! properties to read. Here nothing is allocated from a count before the bytes that hold it are
+//! there, so a hostile header costs no memory.
 
 mod obj;
 mod off;
