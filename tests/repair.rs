@@ -223,3 +223,29 @@ fn z_up_turns_a_quarter_about_x() {
     // The triangle faced -Y; now it faces +Z... turned with the model, not mirrored.
     assert_eq!(mesh.normals[0], [0.0, 0.0, 1.0]);
 }
+
+#[test]
+fn groups_materials_and_latin1_do_not_change_the_cow() {
+    // As modellers write it: the faces split over groups and objects (tobj read each group as a
+    // separate vertex set, so this cow used to be refused as non-manifold), an empty `usemtl`, a
+    // Latin-1 comment, CRLF line ends and tabs.
+    let text = String::from_utf8_lossy(vdlod_demo::mesh::COW_OBJ).into_owned();
+    let mut messy: Vec<u8> = b"# vache \xe0 l'envers\r\nmtllib cow.mtl\r\ng body\r\n".to_vec();
+    let mut faces = 0;
+    for line in text.lines() {
+        if line.starts_with("f ") {
+            faces += 1;
+            if faces % 1000 == 0 {
+                messy.extend_from_slice(b"o part\r\nusemtl\r\ng legs\r\ns 1\r\n");
+            }
+        }
+        messy.extend_from_slice(line.replacen(' ', "\t", 1).as_bytes());
+        messy.extend_from_slice(b"\r\n");
+    }
+    let strict = LoadOptions {
+        repair: false,
+        ..LoadOptions::default()
+    };
+    let loaded = load_bytes("messy_cow.obj", &messy, &strict).unwrap();
+    assert!(loaded.mesh == cow(), "the cow changed");
+}

@@ -13,4 +13,5 @@ pub mod lod;
 pub mod mesh;
 pub mod render;
 pub mod repair;
+pub mod terrain;
 pub mod wavelet;

@@ -114,8 +114,10 @@ pub struct OrbitOptions {
     /// Fly the peer orbit (20 degrees up) instead of the merge-tree paper's (level).
     pub peer_orbit: bool,
     /// Draw the written frames from an observer a quarter turn ahead and a quarter farther (the cut
-    /// still adapts to the orbit camera), to show where the detail went.
+    /// still adapts to the orbit camera), to show where the detail went; with a `path`, from above.
     pub observer: bool,
+    /// Fly these cameras, one per frame, instead of an orbit (`frames` should be their number).
+    pub path: Option<Vec<Camera>>,
 }
 
 impl Default for OrbitOptions {
@@ -137,6 +139,7 @@ impl Default for OrbitOptions {
             write_frames: true,
             peer_orbit: false,
             observer: false,
+            path: None,
         }
     }
 }
@@ -167,6 +170,23 @@ pub fn observer(orbit: &Orbit, i: u32) -> Camera {
         near: (orbit.distance * 1.25 - 1.5 * orbit.radius).max(orbit.radius * 0.01),
         far: orbit.distance * 1.25 + 1.5 * orbit.radius,
         ..ahead
+    }
+}
+
+/// A camera high above `bounds`, looking down at its centre at 60 degrees: where a path's
+/// observer watches from.
+pub fn overview(bounds: &Bounds, width: usize, height: usize) -> Camera {
+    let (center, radius) = (bounds.center(), bounds.radius().max(f32::MIN_POSITIVE));
+    let eye = center + glam::Vec3::new(0.0, 1.9, 1.1) * radius;
+    Camera {
+        eye,
+        target: center,
+        up: glam::Vec3::Y,
+        fov_y: 50f32.to_radians(),
+        near: radius * 0.5,
+        far: radius * 4.0,
+        width,
+        height,
     }
 }
 
@@ -522,8 +542,12 @@ fn fly_orbit<const V: usize, const F: usize, const Q: usize, I: SlotIndex + Vert
     let mut frames = Vec::with_capacity(opts.frames as usize);
     let mut warned = false;
     let compared = opts.frames / 2;
+    let camera_of = |i: u32| match &opts.path {
+        Some(path) if !path.is_empty() => path[i as usize % path.len()],
+        _ => orbit.camera(i),
+    };
     for i in 0..opts.frames {
-        let camera = orbit.camera(i);
+        let camera = camera_of(i);
         let view = camera.view_scaled(opts.frustum);
         let start = Instant::now();
         let stats = cut.adapt(&h, &view, &policy, &opts.budget);
@@ -571,7 +595,9 @@ fn fly_orbit<const V: usize, const F: usize, const Q: usize, I: SlotIndex + Vert
             std::fs::write(out_dir.join("side_by_side.png"), png).map_err(io)?;
         }
         if picture {
-            let seen_from = if opts.observer {
+            let seen_from = if opts.observer && opts.path.is_some() {
+                overview(&bounds, opts.width, opts.height)
+            } else if opts.observer {
                 observer(&orbit, i)
             } else {
                 camera

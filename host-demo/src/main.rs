@@ -12,10 +12,13 @@ use vdlod_core::build::{BuildOptions, Cost};
 use vdlod_core::format::HierarchyView;
 use vdlod_core::wavelet::build::{Scheme, SemiRegular};
 use vdlod_core::wavelet::SemiRegularView;
+use vdlod_demo::camera::{path_cameras, Camera};
 use vdlod_demo::hierarchy;
 use vdlod_demo::lod::{self, OrbitOptions, PolicyChoice};
+use vdlod_demo::mesh::Bounds;
 use vdlod_demo::mesh::{self, load_obj_bytes, IndexedMesh, LoadOptions, Up, BUNNY_NAME, BUNNY_OBJ};
 use vdlod_demo::render::{render_orbit, RenderOptions};
+use vdlod_demo::terrain::{self, FlyOver, Terrain};
 use vdlod_demo::wavelet;
 use vdlod_raster::Shading;
 
@@ -33,6 +36,15 @@ fn positive(text: &str) -> Result<f32, String> {
     match text.parse::<f32>() {
         Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
         Ok(_) => Err("must be a finite number above 0".into()),
+        Err(e) => Err(e.to_string()),
+    }
+}
+
+/// A terrain's vertical scale: above 0, at most 10.
+fn vertical_scale(text: &str) -> Result<f32, String> {
+    match text.parse::<f32>() {
+        Ok(v) if v.is_finite() && v > 0.0 && v <= 10.0 => Ok(v),
+        Ok(_) => Err("must be a finite number above 0 and at most 10".into()),
         Err(e) => Err(e.to_string()),
     }
 }
@@ -103,6 +115,9 @@ enum Command {
     /// Fly the merge-tree paper's orbit with a view-dependent cut: frames, stats.csv, plot.png,
     /// side_by_side.png (adapted | full detail | difference).
     Orbit(OrbitArgs),
+    /// Fly low over a terrain (a heightmap and colormap, or a procedural island) with a
+    /// view-dependent cut; writes what `orbit` writes.
+    Terrain(TerrainArgs),
     /// Fly the merge-tree paper's orbit around a mesh at full detail and write PNG frames.
     Render(RenderArgs),
     /// Build a mesh's vertex hierarchy and write it as a .vdh file.
@@ -247,16 +262,9 @@ enum PolicyArg {
     Importance,
 }
 
+/// How a flight adapts, draws and reports: shared by `orbit` and `terrain`.
 #[derive(clap::Args)]
-struct OrbitArgs {
-    /// Mesh file (OBJ, OFF, PLY or STL; its hierarchy is built first) or .vdh hierarchy
-    /// (default: the bundled bunny).
-    mesh: Option<PathBuf>,
-    #[command(flatten)]
-    input: InputArgs,
-    /// Output directory.
-    #[arg(long, short, default_value = "out")]
-    out: PathBuf,
+struct FlightArgs {
     /// Triangle budget: the cut never has more (at least 1).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     budget: Option<u32>,
@@ -283,7 +291,7 @@ struct OrbitArgs {
     /// (the merge-tree paper's Table 1 uses 0.4, 0.2, 0.1; above 0).
     #[arg(long, default_value_t = 1.0, allow_negative_numbers = true, value_parser = positive)]
     frustum: f32,
-    /// Frames in one revolution.
+    /// Frames in one revolution (with --path, the file's rows set the frames).
     #[arg(long, default_value_t = 72, value_parser = clap::value_parser!(u32).range(1..=100_000))]
     frames: u32,
     /// Frame width in pixels (1 to 4096).
@@ -304,21 +312,20 @@ struct OrbitArgs {
     /// Also write each frame's active mesh as mesh_NNNN.obj.
     #[arg(long)]
     dump_mesh: bool,
-    /// Fly the peer orbit (20 degrees up) of ../shared/peers instead of the level one.
-    #[arg(long)]
-    peer_orbit: bool,
-    /// Draw the frames from an observer a quarter turn ahead and a quarter farther away, to see where
-    /// the cut put its detail (the statistics still compare the orbit camera's view).
+    /// Draw the frames from an observer (on an orbit, a quarter turn ahead and a quarter farther
+    /// away; on a path, from above), to see where the cut put its detail (the statistics still
+    /// compare the flying camera's view).
     #[arg(long)]
     observer: bool,
+    /// A camera path file to fly instead: CSV, one frame per line,
+    /// eye_x,eye_y,eye_z,target_x,target_y,target_z,up_x,up_y,up_z,fov_y_degrees.
+    #[arg(long)]
+    path: Option<PathBuf>,
 }
 
-impl Default for OrbitArgs {
+impl Default for FlightArgs {
     fn default() -> Self {
-        OrbitArgs {
-            mesh: None,
-            input: InputArgs::default(),
-            out: PathBuf::from("out"),
+        FlightArgs {
             budget: None,
             target: None,
             max_ops: None,
@@ -334,10 +341,117 @@ impl Default for OrbitArgs {
             depth_colors: false,
             wireframe: false,
             dump_mesh: false,
-            peer_orbit: false,
             observer: false,
+            path: None,
         }
     }
+}
+
+impl FlightArgs {
+    /// The options of a flight, with `path`'s cameras when there is one.
+    fn options(&self, path: Option<Vec<Camera>>, peer_orbit: bool) -> OrbitOptions {
+        let mut budget = Budget::default();
+        if let Some(b) = self.budget {
+            budget.max_triangles = b;
+        }
+        if let Some(t) = self.target {
+            budget.target_triangles = t;
+        }
+        if let Some(m) = self.max_ops {
+            budget.max_ops = m;
+        }
+        OrbitOptions {
+            width: self.width,
+            height: self.height,
+            frames: path.as_ref().map_or(self.frames, |p| p.len() as u32),
+            frustum: self.frustum,
+            policy: match self.policy {
+                PolicyArg::Screen => PolicyChoice::Screen {
+                    silhouette: self.tolerance,
+                    interior: self.interior.unwrap_or(self.tolerance),
+                },
+                PolicyArg::MergeTree => PolicyChoice::MergeTree,
+                PolicyArg::Importance => PolicyChoice::Importance {
+                    threshold: self.threshold,
+                },
+            },
+            budget,
+            geomorph_frames: self.geomorph,
+            depth_colors: self.depth_colors,
+            wireframe: self.wireframe,
+            dump_mesh: self.dump_mesh,
+            write_frames: true,
+            peer_orbit,
+            observer: self.observer,
+            path,
+        }
+    }
+
+    /// The cameras of `--path` over a scene in `bounds`, if given.
+    fn path(&self, bounds: &Bounds) -> Result<Option<Vec<Camera>>, String> {
+        let Some(file) = &self.path else {
+            return Ok(None);
+        };
+        let text = std::fs::read_to_string(file)
+            .map_err(|e| format!("{}: cannot read: {e}", file.display()))?;
+        path_cameras(&text, bounds, self.width, self.height)
+            .map(Some)
+            .map_err(|e| format!("{}: {e}", file.display()))
+    }
+}
+
+#[derive(clap::Args)]
+struct OrbitArgs {
+    /// Mesh file (OBJ, OFF, PLY or STL; its hierarchy is built first) or .vdh hierarchy
+    /// (default: the bundled bunny).
+    mesh: Option<PathBuf>,
+    #[command(flatten)]
+    input: InputArgs,
+    /// Output directory.
+    #[arg(long, short, default_value = "out")]
+    out: PathBuf,
+    /// Fly the peer orbit (20 degrees up) of ../shared/peers instead of the level one.
+    #[arg(long)]
+    peer_orbit: bool,
+    #[command(flatten)]
+    flight: FlightArgs,
+}
+
+impl Default for OrbitArgs {
+    fn default() -> Self {
+        OrbitArgs {
+            mesh: None,
+            input: InputArgs::default(),
+            out: PathBuf::from("out"),
+            peer_orbit: false,
+            flight: FlightArgs::default(),
+        }
+    }
+}
+
+#[derive(clap::Args)]
+struct TerrainArgs {
+    /// Heightmap: a grey PNG, 8 or 16 bits, any size from 2 x 2 to 2049 x 2049 (default: a
+    /// procedural island).
+    #[arg(long)]
+    heightmap: Option<PathBuf>,
+    /// Colormap: a PNG of the heightmap's size.
+    #[arg(long, requires = "heightmap")]
+    colormap: Option<PathBuf>,
+    /// Height of a white pixel, as a fraction of the heightmap's width (above 0, at most 10).
+    #[arg(long, default_value_t = terrain::DEFAULT_VERTICAL_SCALE, allow_negative_numbers = true, value_parser = vertical_scale)]
+    vertical_scale: f32,
+    /// Samples per side of the procedural terrain (2 to 2049).
+    #[arg(long, default_value_t = 257, value_parser = clap::value_parser!(u32).range(2..=2049), conflicts_with = "heightmap")]
+    size: u32,
+    /// Seed of the procedural terrain.
+    #[arg(long, default_value_t = 1, conflicts_with = "heightmap")]
+    seed: u32,
+    /// Output directory.
+    #[arg(long, short, default_value = "out/terrain")]
+    out: PathBuf,
+    #[command(flatten)]
+    flight: FlightArgs,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -488,40 +602,61 @@ fn load_lod(
 
 fn orbit_command(args: OrbitArgs) -> Result<(), String> {
     let (name, bytes, full) = load_lod(args.mesh.as_ref(), args.input)?;
-    let mut budget = Budget::default();
-    if let Some(b) = args.budget {
-        budget.max_triangles = b;
-    }
-    if let Some(t) = args.target {
-        budget.target_triangles = t;
-    }
-    if let Some(m) = args.max_ops {
-        budget.max_ops = m;
-    }
-    let opts = OrbitOptions {
-        width: args.width,
-        height: args.height,
-        frames: args.frames,
-        frustum: args.frustum,
-        policy: match args.policy {
-            PolicyArg::Screen => PolicyChoice::Screen {
-                silhouette: args.tolerance,
-                interior: args.interior.unwrap_or(args.tolerance),
-            },
-            PolicyArg::MergeTree => PolicyChoice::MergeTree,
-            PolicyArg::Importance => PolicyChoice::Importance {
-                threshold: args.threshold,
-            },
-        },
-        budget,
-        geomorph_frames: args.geomorph,
-        depth_colors: args.depth_colors,
-        wireframe: args.wireframe,
-        dump_mesh: args.dump_mesh,
-        write_frames: true,
-        peer_orbit: args.peer_orbit,
-        observer: args.observer,
+    let path = args.flight.path(&full.bounds())?;
+    let opts = args.flight.options(path, args.peer_orbit);
+    fly(&name, &bytes, &full, &opts, &args.out)
+}
+
+fn terrain_command(args: TerrainArgs) -> Result<(), String> {
+    let (name, land) = match &args.heightmap {
+        Some(file) => {
+            let read = |p: &Path| {
+                std::fs::read(p).map_err(|e| format!("{}: cannot read: {e}", p.display()))
+            };
+            let heights = read(file)?;
+            let colors = args.colormap.as_deref().map(read).transpose()?;
+            let land = Terrain::from_png(&heights, colors.as_deref(), args.vertical_scale)
+                .map_err(|e| format!("{}: {e}", file.display()))?;
+            (file.display().to_string(), land)
+        }
+        None => (
+            format!(
+                "procedural terrain (size {}, seed {})",
+                args.size, args.seed
+            ),
+            Terrain::procedural(args.size as usize, args.seed, args.vertical_scale),
+        ),
     };
+    let mut full = land.mesh();
+    let show = std::io::IsTerminal::is_terminal(&std::io::stderr());
+    let (_, bytes, seconds) = hierarchy::build_with_progress(&full, &BuildOptions::default(), show)
+        .map_err(|e| format!("{name}: {e}"))?;
+    say!(
+        "{name}: {} x {} samples, hierarchy built in {seconds:.2} s",
+        land.width,
+        land.depth
+    );
+    full.reorder_for_locality();
+    let path = match args.flight.path(&full.bounds())? {
+        Some(path) => path,
+        None => {
+            let f = &args.flight;
+            let fly_over = FlyOver::new(&land, f.frames, f.width, f.height);
+            (0..f.frames).map(|i| fly_over.camera(i)).collect()
+        }
+    };
+    let opts = args.flight.options(Some(path), false);
+    fly(&name, &bytes, &full, &opts, &args.out)
+}
+
+/// Flies `opts` over the hierarchy `bytes` of `full`, printing a line per frame and a summary.
+fn fly(
+    name: &str,
+    bytes: &[u8],
+    full: &IndexedMesh,
+    opts: &OrbitOptions,
+    out: &Path,
+) -> Result<(), String> {
     say!(
         "{name}: {} vertices, {} triangles at full detail; {} frames at {}x{} into {}",
         full.positions.len(),
@@ -529,9 +664,9 @@ fn orbit_command(args: OrbitArgs) -> Result<(), String> {
         opts.frames,
         opts.width,
         opts.height,
-        args.out.display()
+        out.display()
     );
-    let summary = lod::run_orbit(&bytes, &full, &opts, &args.out, |f| {
+    let summary = lod::run_orbit(bytes, full, opts, out, |f| {
         let limits = lod::limits(&f.stats);
         say!(
                 "frame {:04}  triangles {:>7}  splits {:>5}  collapses {:>5}  adapt {:>8.1} us  render {:>7.2} ms  full {:>7.2} ms  PSNR {:>6.2} dB{}{}",
@@ -574,7 +709,7 @@ fn orbit_command(args: OrbitArgs) -> Result<(), String> {
     }
     say!(
         "wrote {}/stats.csv, plot.png, side_by_side.png (frame {})",
-        args.out.display(),
+        out.display(),
         summary.compared
     );
     Ok(())
@@ -730,6 +865,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Some(Command::Orbit(args)) => orbit_command(args),
+        Some(Command::Terrain(args)) => terrain_command(args),
         Some(Command::Render(args)) => render(args),
         Some(Command::Build(args)) => build_command(args),
         Some(Command::Repair(args)) => repair(args),

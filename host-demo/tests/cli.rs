@@ -694,3 +694,76 @@ fn a_shorter_run_leaves_no_stale_frames_and_names_its_limits() {
     assert!(one.contains("one frame only"), "{one}");
     assert!(!one.contains("-0.0"), "{one}");
 }
+
+#[test]
+fn terrain_flies_the_procedural_island_and_a_path_file() {
+    let dir = scratch_dir("cli_terrain");
+    let small = ["--width", "48", "--height", "32", "--frames", "3"];
+    let mut args = vec!["terrain", "--size", "33", "-o", "t"];
+    args.extend_from_slice(&small);
+    let out = demo(&args, &dir);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("procedural terrain (size 33, seed 1): 33 x 33 samples"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("1089 vertices, 2048 triangles at full detail; 3 frames"),
+        "{stdout}"
+    );
+    for f in [
+        "t/frame_0002.png",
+        "t/stats.csv",
+        "t/plot.png",
+        "t/side_by_side.png",
+    ] {
+        assert!(dir.join(f).exists(), "{f}");
+    }
+    // A path file: two frames looking down from above, with a header and a comment.
+    std::fs::write(
+        dir.join("path.csv"),
+        "eye_x,eye_y,eye_z,target_x,target_y,target_z,up_x,up_y,up_z,fov_y_degrees\n\
+         16,40,16, 16,0,16, 0,0,-1, 50\n# second frame\n16,30,40, 16,0,16, 0,1,0, 50\n",
+    )
+    .unwrap();
+    let out = demo(
+        &[
+            "terrain", "--size", "33", "--path", "path.csv", "-o", "p", "--width", "32",
+            "--height", "24",
+        ],
+        &dir,
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(String::from_utf8_lossy(&out.stdout).contains("2 frames"));
+    assert!(dir.join("p/frame_0001.png").exists() && !dir.join("p/frame_0002.png").exists());
+    // A bad row is named by its line.
+    std::fs::write(dir.join("bad.csv"), "16,40,16,16,0,16,0,0,-1,50\n1,2,3\n").unwrap();
+    assert_one_line_failure(
+        "bad.csv",
+        "16,40,16,16,0,16,0,0,-1,50\n1,2,3\n",
+        &["terrain", "--size", "9", "--path", "FILE"],
+        "bad.csv: line 2: 3 values where 10 are needed",
+    );
+    // A heightmap that is not a PNG, and a bad scale.
+    assert_one_line_failure(
+        "h.png",
+        "not a png",
+        &["terrain", "--heightmap", "FILE"],
+        "h.png: heightmap: not a PNG we read",
+    );
+    for scale in ["-1", "0", "11", "nan"] {
+        let out = demo(&["terrain", "--vertical-scale", scale], &dir);
+        assert!(!out.status.success(), "{scale}");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(stderr.contains("at most 10"), "{scale}: {stderr}");
+    }
+}
