@@ -177,7 +177,7 @@ pub fn observer(orbit: &Orbit, i: u32) -> Camera {
 /// observer watches from.
 pub fn overview(bounds: &Bounds, width: usize, height: usize) -> Camera {
     let (center, radius) = (bounds.center(), bounds.radius().max(f32::MIN_POSITIVE));
-    let eye = center + glam::Vec3::new(0.0, 1.9, 1.1) * radius;
+    let eye = center + glam::Vec3::new(0.0, 1.3, 0.9) * radius;
     Camera {
         eye,
         target: center,
