@@ -319,8 +319,12 @@ struct FlightArgs {
     observer: bool,
     /// A camera path file to fly instead: CSV, one frame per line,
     /// eye_x,eye_y,eye_z,target_x,target_y,target_z,up_x,up_y,up_z,fov_y_degrees.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "session")]
     path: Option<PathBuf>,
+    /// Fly the wavelet paper's session instead: two thirds of the frames turning around the
+    /// scene at three radii, the rest zooming in to a close-up of its surface.
+    #[arg(long)]
+    session: bool,
 }
 
 impl Default for FlightArgs {
@@ -343,6 +347,7 @@ impl Default for FlightArgs {
             dump_mesh: false,
             observer: false,
             path: None,
+            session: false,
         }
     }
 }
@@ -387,8 +392,18 @@ impl FlightArgs {
         }
     }
 
-    /// The cameras of `--path` over a scene in `bounds`, if given.
+    /// The cameras of `--path` or `--session` over a scene in `bounds`, if given.
     fn path(&self, bounds: &Bounds) -> Result<Option<Vec<Camera>>, String> {
+        if self.session {
+            let (c, r) = (bounds.center(), bounds.radius());
+            return Ok(Some(wavelet::session(
+                c,
+                r,
+                self.frames,
+                self.width,
+                self.height,
+            )));
+        }
         let Some(file) = &self.path else {
             return Ok(None);
         };

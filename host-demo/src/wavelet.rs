@@ -337,7 +337,7 @@ pub fn session(center: Vec3, radius: f32, frames: u32, width: usize, height: usi
     let turn = (frames * 2 / 3).max(1);
     let direction = |i: u32| {
         let a = std::f32::consts::TAU * i.min(turn - 1) as f32 / turn as f32;
-        Vec3::new(a.sin(), 0.35, a.cos()).normalize()
+        Vec3::new(libm::sinf(a), 0.35, libm::cosf(a)).normalize()
     };
     (0..frames)
         .map(|i| {

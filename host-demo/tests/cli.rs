@@ -745,6 +745,30 @@ fn terrain_flies_the_procedural_island_and_a_path_file() {
     );
     assert!(String::from_utf8_lossy(&out.stdout).contains("2 frames"));
     assert!(dir.join("p/frame_0001.png").exists() && !dir.join("p/frame_0002.png").exists());
+    // The wavelet paper's session, over the island.
+    let out = demo(
+        &[
+            "terrain",
+            "--size",
+            "17",
+            "--session",
+            "--frames",
+            "6",
+            "-o",
+            "s",
+            "--width",
+            "32",
+            "--height",
+            "24",
+        ],
+        &dir,
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(dir.join("s/frame_0005.png").exists());
     // A bad row is named by its line.
     std::fs::write(dir.join("bad.csv"), "16,40,16,16,0,16,0,0,-1,50\n1,2,3\n").unwrap();
     assert_one_line_failure(
