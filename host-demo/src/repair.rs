@@ -111,9 +111,12 @@ impl fmt::Display for Repairs {
 /// ```
 pub fn repair(soup: Soup) -> (Soup, Repairs) {
     let mut repairs = Repairs::default();
-    let border = on_border(soup.positions.len(), &soup.triangles);
-    let near = weld(&soup.positions, &border);
-    let representative = zipping(&near, &soup.triangles);
+    let border = border_edges(&soup.triangles);
+    let near = weld(
+        &soup.positions,
+        &on_border(soup.positions.len(), &soup.triangles, &border),
+    );
+    let representative = zipping(&near, &border);
     let welded = (0..representative.len())
         .filter(|&i| representative[i] != i as u32)
         .count();
@@ -196,73 +199,55 @@ pub fn repair(soup: Soup) -> (Soup, Repairs) {
     )
 }
 
-/// Whether each vertex is on a border: an edge that only one triangle has (or no triangle at
-/// all, for an unused vertex).
-fn on_border(vertices: usize, triangles: &[[u32; 3]]) -> Vec<bool> {
+/// The edges that only one triangle has, as (low, high) vertex pairs, sorted.
+fn border_edges(triangles: &[[u32; 3]]) -> Vec<(u32, u32)> {
     let mut edges: Vec<(u32, u32)> = triangles
         .iter()
         .flat_map(|t| (0..3).map(move |k| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]))))
         .collect();
     edges.sort_unstable();
-    let mut border = vec![true; vertices];
+    edges
+        .chunk_by(|a, b| a == b)
+        .filter(|run| run.len() == 1)
+        .map(|run| run[0])
+        .collect()
+}
+
+/// Whether each vertex is on a border (an end of a border edge) or unused.
+fn on_border(vertices: usize, triangles: &[[u32; 3]], border: &[(u32, u32)]) -> Vec<bool> {
+    let mut on = vec![true; vertices];
     for &i in triangles.iter().flatten() {
-        border[i as usize] = false;
+        on[i as usize] = false;
     }
-    let mut i = 0;
-    while i < edges.len() {
-        let mut j = i + 1;
-        while j < edges.len() && edges[j] == edges[i] {
-            j += 1;
-        }
-        if j - i == 1 {
-            border[edges[i].0 as usize] = true;
-            border[edges[i].1 as usize] = true;
-        }
-        i = j;
+    for &(a, b) in border {
+        on[a as usize] = true;
+        on[b as usize] = true;
     }
-    border
+    on
 }
 
 /// `near` restricted to the welds that close a crack: a vertex is welded only when one of its
-/// border edges then coincides with another border edge. Border vertices that merely lie close
+/// `border` edges then coincides with another border edge. Border vertices that merely lie close
 /// together (the two lips of a slit, a hole's rim pinched to a point) stay apart.
-fn zipping(near: &[u32], triangles: &[[u32; 3]]) -> Vec<u32> {
-    let mut edges: Vec<((u32, u32), (u32, u32))> = triangles
+fn zipping(near: &[u32], border: &[(u32, u32)]) -> Vec<u32> {
+    // Border edges keyed by their welded ends.
+    let mut welded: Vec<((u32, u32), (u32, u32))> = border
         .iter()
-        .flat_map(|t| (0..3).map(move |k| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]))))
-        .map(|e| (e, e))
-        .collect();
-    edges.sort_unstable();
-    // Border edges: those of a single triangle, keyed by their welded ends.
-    let mut border: Vec<((u32, u32), (u32, u32))> = Vec::new();
-    let mut i = 0;
-    while i < edges.len() {
-        let mut j = i + 1;
-        while j < edges.len() && edges[j].0 == edges[i].0 {
-            j += 1;
-        }
-        if j - i == 1 {
-            let (a, b) = edges[i].1;
+        .map(|&(a, b)| {
             let (x, y) = (near[a as usize], near[b as usize]);
-            border.push(((x.min(y), x.max(y)), (a, b)));
-        }
-        i = j;
-    }
-    border.sort_unstable();
+            ((x.min(y), x.max(y)), (a, b))
+        })
+        .collect();
+    welded.sort_unstable();
     let mut zips = vec![false; near.len()];
-    let mut i = 0;
-    while i < border.len() {
-        let mut j = i + 1;
-        while j < border.len() && border[j].0 == border[i].0 {
-            j += 1;
+    for run in welded
+        .chunk_by(|p, q| p.0 == q.0)
+        .filter(|run| run.len() > 1)
+    {
+        for &(_, (a, b)) in run {
+            zips[a as usize] = true;
+            zips[b as usize] = true;
         }
-        if j - i > 1 {
-            for &(_, (a, b)) in &border[i..j] {
-                zips[a as usize] = true;
-                zips[b as usize] = true;
-            }
-        }
-        i = j;
     }
     (0..near.len())
         .map(|v| if zips[v] { near[v] } else { v as u32 })
@@ -384,18 +369,14 @@ impl EdgeGroups {
         let mut starts = Vec::new();
         let mut group = vec![[0u32; 3]; triangles.len()];
         let mut non_manifold = 0;
-        for (i, &(key, t, k)) in keyed.iter().enumerate() {
-            if i == 0 || keyed[i - 1].0 != key {
-                if let Some(&s) = starts.last() {
-                    non_manifold += usize::from(sides.len() - s > 2);
-                }
-                starts.push(sides.len());
+        for run in keyed.chunk_by(|p, q| p.0 == q.0) {
+            let g = starts.len() as u32;
+            starts.push(sides.len());
+            non_manifold += usize::from(run.len() > 2);
+            for &(_, t, k) in run {
+                group[t][k] = g;
+                sides.push((t, k));
             }
-            group[t][k] = (starts.len() - 1) as u32;
-            sides.push((t, k));
-        }
-        if let Some(&s) = starts.last() {
-            non_manifold += usize::from(sides.len() - s > 2);
         }
         starts.push(sides.len());
         EdgeGroups {
@@ -567,20 +548,14 @@ fn bad_output_edges(triangles: &[[u32; 3]]) -> Vec<(usize, usize)> {
     }
     keyed.sort_unstable();
     let mut bad = Vec::new();
-    let mut i = 0;
-    while i < keyed.len() {
-        let mut j = i + 1;
-        while j < keyed.len() && keyed[j].0 == keyed[i].0 {
-            j += 1;
-        }
-        let ok = j - i == 1 || (j - i == 2 && keyed[i].1 != keyed[i + 1].1);
-        if !ok {
-            for &(_, _, t, k) in &keyed[i..j] {
+    for run in keyed.chunk_by(|p, q| p.0 == q.0) {
+        let manifold = run.len() == 1 || (run.len() == 2 && run[0].1 != run[1].1);
+        if !manifold {
+            for &(_, _, t, k) in run {
                 bad.push((t, k));
                 bad.push((t, (k + 1) % 3));
             }
         }
-        i = j;
     }
     bad
 }

@@ -11,6 +11,17 @@ fn demo(args: &[&str], cwd: &Path) -> Output {
         .expect("run vdlod-demo")
 }
 
+/// Runs the demo and checks it succeeded, showing its error output when it did not.
+fn succeed(args: &[&str], cwd: &Path) -> Output {
+    let out = demo(args, cwd);
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
 fn scratch_dir(name: &str) -> PathBuf {
     let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(name);
     let _ = std::fs::remove_dir_all(&dir);
@@ -177,7 +188,7 @@ fn renders_a_small_mesh() {
         "v 1 1 1\nv 1 -1 -1\nv -1 1 -1\nv -1 -1 1\nf 1 3 4\nf 1 4 2\nf 1 2 3\nf 2 4 3\n",
     )
     .unwrap();
-    let out = demo(
+    let out = succeed(
         &[
             "render",
             "tetra.obj",
@@ -191,11 +202,6 @@ fn renders_a_small_mesh() {
             "30",
         ],
         &dir,
-    );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
     );
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(stdout.contains("frame 0001  triangles"), "{stdout}");
@@ -215,7 +221,7 @@ fn fixture(name: &str) -> PathBuf {
 fn build_and_info_agree_on_an_open_mesh() {
     let dir = scratch_dir("cli_build");
     let head = fixture("head.obj");
-    let out = demo(
+    let out = succeed(
         &[
             "build",
             head.to_str().unwrap(),
@@ -224,11 +230,6 @@ fn build_and_info_agree_on_an_open_mesh() {
             "--balanced",
         ],
         &dir,
-    );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
     );
     let built = String::from_utf8_lossy(&out.stdout).into_owned();
     assert!(built.contains("vertices 1487, faces 2918"), "{built}");
@@ -279,12 +280,7 @@ fn repair_says_what_it_did_and_writes_a_mesh_strict_accepts() {
     let text = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv -1 0 0\nv -1 -1 0\nv 0 -1 0\n\
                 f 1 2 3\nf 1 4 3\nf 1 3 4\nf 1 5 6\nf 1 6 7\n";
     std::fs::write(dir.join("tie.obj"), text).unwrap();
-    let out = demo(&["repair", "tie.obj", "-o", "fixed.obj"], &dir);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out = succeed(&["repair", "tie.obj", "-o", "fixed.obj"], &dir);
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(
         stdout.contains(
@@ -293,19 +289,9 @@ fn repair_says_what_it_did_and_writes_a_mesh_strict_accepts() {
         ),
         "{stdout}"
     );
-    let out = demo(&["build", "fixed.obj", "--strict", "-o", "x.vdh"], &dir);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out = succeed(&["build", "fixed.obj", "--strict", "-o", "x.vdh"], &dir);
     // The same file builds without --strict, saying what was repaired.
-    let out = demo(&["build", "tie.obj", "-o", "y.vdh"], &dir);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out = succeed(&["build", "tie.obj", "-o", "y.vdh"], &dir);
     assert!(String::from_utf8_lossy(&out.stdout).contains("tie.obj: OBJ: repaired: "));
 }
 
@@ -337,28 +323,18 @@ fn every_format_builds_and_renders() {
     let stl = format!("solid t\n{facets}endsolid t\n");
     for (name, text) in [("t.off", off), ("t.ply", ply), ("t.stl", stl)] {
         std::fs::write(dir.join(name), text).unwrap();
-        let out = demo(
+        let out = succeed(
             &["build", name, "--strict", "--up", "z", "-o", "t.vdh"],
             &dir,
-        );
-        assert!(
-            out.status.success(),
-            "{name}: {}",
-            String::from_utf8_lossy(&out.stderr)
         );
     }
     // `render` takes the hierarchy too, found by its content.
     std::fs::rename(dir.join("t.vdh"), dir.join("t.bin")).unwrap();
-    let out = demo(
+    let out = succeed(
         &[
             "render", "t.bin", "--frames", "1", "--width", "16", "--height", "12",
         ],
         &dir,
-    );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
     );
     assert!(dir.join("out/frame_0000.png").exists());
 }
@@ -370,7 +346,7 @@ fn orbit_writes_frames_statistics_plot_comparison_and_meshes() {
     let out = demo(&["build", cow.to_str().unwrap(), "-o", "cow.vdh"], &dir);
     assert!(out.status.success());
     for input in [cow.to_str().unwrap(), "cow.vdh"] {
-        let out = demo(
+        let out = succeed(
             &[
                 "orbit",
                 input,
@@ -387,11 +363,6 @@ fn orbit_writes_frames_statistics_plot_comparison_and_meshes() {
                 "--dump-mesh",
             ],
             &dir,
-        );
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
         );
         let csv = std::fs::read_to_string(dir.join("o/stats.csv")).unwrap();
         let mut lines = csv.lines();
@@ -509,14 +480,9 @@ fn orbit_warns_once_when_the_base_mesh_exceeds_the_budget() {
 #[test]
 fn sphere_info_and_subdivide_write_semi_regular_files() {
     let dir = scratch_dir("cli_semi_regular");
-    let out = demo(
+    let out = succeed(
         &["sphere", "--levels", "3", "-o", "s.vdw", "--obj", "s.obj"],
         &dir,
-    );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
     );
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(
@@ -541,14 +507,9 @@ fn sphere_info_and_subdivide_write_semi_regular_files() {
         "{stderr}"
     );
     // Subdividing an OBJ (the sphere's own finest level, as a base of 512 faces).
-    let sub = demo(
+    let sub = succeed(
         &["subdivide", "s.obj", "--levels", "1", "-o", "t.vdw"],
         &dir,
-    );
-    assert!(
-        sub.status.success(),
-        "{}",
-        String::from_utf8_lossy(&sub.stderr)
     );
     assert!(String::from_utf8_lossy(&sub.stdout).contains("2048 faces at full detail"));
 }
@@ -572,12 +533,7 @@ fn reproduce_fig11_writes_pictures_csv_and_summary_lines() {
     for name in ["fig11", "fig9", "fig10", "engines", "Azuma"] {
         assert!(text.contains(name), "{name} missing from: {text}");
     }
-    let out = demo(&["reproduce", "fig11", "-o", "out"], &dir);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out = succeed(&["reproduce", "fig11", "-o", "out"], &dir);
     let stdout = String::from_utf8_lossy(&out.stdout);
     let lines: Vec<&str> = stdout
         .lines()
@@ -652,12 +608,7 @@ fn a_shorter_run_leaves_no_stale_frames_and_names_its_limits() {
         let mut args = vec!["orbit", cow];
         args.extend_from_slice(extra);
         args.extend_from_slice(&small);
-        let out = demo(&args, &dir);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        let out = succeed(&args, &dir);
         String::from_utf8_lossy(&out.stdout).into_owned()
     };
     run(&["--frames", "5", "--dump-mesh"]);
@@ -701,12 +652,7 @@ fn terrain_flies_the_procedural_island_and_a_path_file() {
     let small = ["--width", "48", "--height", "32", "--frames", "3"];
     let mut args = vec!["terrain", "--size", "33", "-o", "t"];
     args.extend_from_slice(&small);
-    let out = demo(&args, &dir);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out = succeed(&args, &dir);
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(
         stdout.contains("procedural terrain (size 33, seed 1): 33 x 33 samples"),
@@ -731,22 +677,17 @@ fn terrain_flies_the_procedural_island_and_a_path_file() {
          16,40,16, 16,0,16, 0,0,-1, 50\n# second frame\n16,30,40, 16,0,16, 0,1,0, 50\n",
     )
     .unwrap();
-    let out = demo(
+    let out = succeed(
         &[
             "terrain", "--size", "33", "--path", "path.csv", "-o", "p", "--width", "32",
             "--height", "24",
         ],
         &dir,
     );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     assert!(String::from_utf8_lossy(&out.stdout).contains("2 frames"));
     assert!(dir.join("p/frame_0001.png").exists() && !dir.join("p/frame_0002.png").exists());
     // The wavelet paper's session, over the island.
-    let out = demo(
+    let out = succeed(
         &[
             "terrain",
             "--size",
@@ -762,11 +703,6 @@ fn terrain_flies_the_procedural_island_and_a_path_file() {
             "24",
         ],
         &dir,
-    );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
     );
     assert!(dir.join("s/frame_0005.png").exists());
     // A bad row is named by its line.
