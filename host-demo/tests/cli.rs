@@ -289,7 +289,7 @@ fn repair_says_what_it_did_and_writes_a_mesh_strict_accepts() {
         ),
         "{stdout}"
     );
-    let out = succeed(&["build", "fixed.obj", "--strict", "-o", "x.vdh"], &dir);
+    succeed(&["build", "fixed.obj", "--strict", "-o", "x.vdh"], &dir);
     // The same file builds without --strict, saying what was repaired.
     let out = succeed(&["build", "tie.obj", "-o", "y.vdh"], &dir);
     assert!(String::from_utf8_lossy(&out.stdout).contains("tie.obj: OBJ: repaired: "));
@@ -323,14 +323,14 @@ fn every_format_builds_and_renders() {
     let stl = format!("solid t\n{facets}endsolid t\n");
     for (name, text) in [("t.off", off), ("t.ply", ply), ("t.stl", stl)] {
         std::fs::write(dir.join(name), text).unwrap();
-        let out = succeed(
+        succeed(
             &["build", name, "--strict", "--up", "z", "-o", "t.vdh"],
             &dir,
         );
     }
     // `render` takes the hierarchy too, found by its content.
     std::fs::rename(dir.join("t.vdh"), dir.join("t.bin")).unwrap();
-    let out = succeed(
+    succeed(
         &[
             "render", "t.bin", "--frames", "1", "--width", "16", "--height", "12",
         ],
@@ -346,7 +346,7 @@ fn orbit_writes_frames_statistics_plot_comparison_and_meshes() {
     let out = demo(&["build", cow.to_str().unwrap(), "-o", "cow.vdh"], &dir);
     assert!(out.status.success());
     for input in [cow.to_str().unwrap(), "cow.vdh"] {
-        let out = succeed(
+        succeed(
             &[
                 "orbit",
                 input,
@@ -687,7 +687,7 @@ fn terrain_flies_the_procedural_island_and_a_path_file() {
     assert!(String::from_utf8_lossy(&out.stdout).contains("2 frames"));
     assert!(dir.join("p/frame_0001.png").exists() && !dir.join("p/frame_0002.png").exists());
     // The wavelet paper's session, over the island.
-    let out = succeed(
+    succeed(
         &[
             "terrain",
             "--size",
