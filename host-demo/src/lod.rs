@@ -425,36 +425,43 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
-/// The limits a frame hit, by name (`budget`, `ops`, `capacity`, `queue`, `blend`,
-/// `over-budget`), joined with `+`; empty when none.
-pub fn limits(stats: &FrameStats) -> String {
-    let names = [
+/// Each limit of [`FrameStats`] with its name: `budget`, `ops`, `capacity`, `queue`, `blend`,
+/// `over-budget`.
+fn limit_flags(stats: &FrameStats) -> [(bool, &'static str); 6] {
+    [
         (stats.budget_limited, "budget"),
         (stats.ops_limited, "ops"),
         (stats.capacity_limited, "capacity"),
         (stats.queue_overflow, "queue"),
         (stats.blend_limited, "blend"),
         (stats.over_budget, "over-budget"),
-    ];
-    let hit: Vec<&str> = names.iter().filter(|n| n.0).map(|n| n.1).collect();
+    ]
+}
+
+/// The limits a frame hit, by name, joined with `+`; empty when none.
+pub fn limits(stats: &FrameStats) -> String {
+    let hit: Vec<&str> = limit_flags(stats)
+        .iter()
+        .filter(|n| n.0)
+        .map(|n| n.1)
+        .collect();
     hit.join("+")
 }
 
 impl OrbitSummary {
-    /// How many frames hit each limit, as `name N` items (see [`limits`]); empty when none did.
+    /// How many frames hit each limit, as `name in N` items (see [`limits`]); empty when none did.
     pub fn limit_counts(&self) -> String {
-        let count = |f: fn(&FrameStats) -> bool| self.frames.iter().filter(|x| f(&x.stats)).count();
-        let counts = [
-            (count(|s| s.budget_limited), "budget"),
-            (count(|s| s.ops_limited), "ops"),
-            (count(|s| s.capacity_limited), "capacity"),
-            (count(|s| s.queue_overflow), "queue"),
-            (count(|s| s.blend_limited), "blend"),
-            (count(|s| s.over_budget), "over-budget"),
-        ];
+        let mut counts = [0usize; 6];
+        for f in &self.frames {
+            for (count, (hit, _)) in counts.iter_mut().zip(limit_flags(&f.stats)) {
+                *count += usize::from(hit);
+            }
+        }
+        let names = limit_flags(&FrameStats::default()).map(|(_, name)| name);
         let hit: Vec<String> = counts
             .iter()
-            .filter(|c| c.0 > 0)
+            .zip(names)
+            .filter(|(n, _)| **n > 0)
             .map(|(n, name)| format!("{name} in {n}"))
             .collect();
         hit.join(", ")

@@ -11,7 +11,7 @@ use std::path::Path;
 use glam::Vec3;
 use vdlod_core::build::BuildError;
 
-use crate::input::{self, Detected, Format, ReadError};
+use crate::input::{self, Detected, Format, ReadError, Soup};
 use crate::repair::Repairs;
 
 /// The Stanford bunny (37,706 vertices, 75,408 triangles), bundled so the demo runs anywhere.
@@ -270,17 +270,7 @@ pub fn load_bytes(name: &str, bytes: &[u8], options: &LoadOptions) -> Result<Loa
         Detected::Unknown => return Err(error(name, None, MeshProblem::UnknownFormat)),
     };
     let err = |problem| error(name, Some(format), problem);
-    let mut soup = input::read(format, bytes).map_err(|e| err(MeshProblem::Read(e)))?;
-    if soup.triangles.is_empty() {
-        return Err(err(if soup.positions.is_empty() {
-            MeshProblem::NoVertices
-        } else {
-            MeshProblem::NoTriangles
-        }));
-    }
-    if soup.positions.len() >= 1 << 31 {
-        return Err(err(MeshProblem::TooLarge));
-    }
+    let mut soup = read_soup(name, format, bytes)?;
     if options.up == Up::Z {
         for p in &mut soup.positions {
             *p = [p[0], p[2], -p[1]];
@@ -306,17 +296,41 @@ pub fn load_bytes(name: &str, bytes: &[u8], options: &LoadOptions) -> Result<Loa
     if soup.triangles.is_empty() {
         return Err(err(MeshProblem::NoTriangles));
     }
-    let normals = vertex_normals(&soup.positions, &soup.triangles);
     Ok(Loaded {
-        mesh: IndexedMesh {
+        mesh: soup.into(),
+        format,
+        repairs,
+    })
+}
+
+/// Reads `bytes` as `format`: a soup with at least one triangle and addressable vertices.
+fn read_soup(name: &str, format: Format, bytes: &[u8]) -> Result<Soup, MeshError> {
+    let err = |problem| error(name, Some(format), problem);
+    let soup = input::read(format, bytes).map_err(|e| err(MeshProblem::Read(e)))?;
+    if soup.triangles.is_empty() {
+        return Err(err(if soup.positions.is_empty() {
+            MeshProblem::NoVertices
+        } else {
+            MeshProblem::NoTriangles
+        }));
+    }
+    if soup.positions.len() >= 1 << 31 {
+        return Err(err(MeshProblem::TooLarge));
+    }
+    Ok(soup)
+}
+
+impl From<Soup> for IndexedMesh {
+    /// The soup as it is, with vertex normals computed.
+    fn from(soup: Soup) -> IndexedMesh {
+        let normals = vertex_normals(&soup.positions, &soup.triangles);
+        IndexedMesh {
             positions: soup.positions,
             normals,
             colors: soup.colors,
             triangles: soup.triangles,
-        },
-        format,
-        repairs,
-    })
+        }
+    }
 }
 
 fn error(name: &str, format: Option<Format>, problem: MeshProblem) -> MeshError {
@@ -343,26 +357,9 @@ pub fn load_obj(path: &Path) -> Result<IndexedMesh, MeshError> {
 /// assert_eq!(mesh.normals[0], [0.0, 0.0, 1.0]);
 /// ```
 pub fn load_obj_bytes(name: &str, bytes: &[u8]) -> Result<IndexedMesh, MeshError> {
-    let err = |problem| error(name, Some(Format::Obj), problem);
-    let mut soup = input::read(Format::Obj, bytes).map_err(|e| err(MeshProblem::Read(e)))?;
-    if soup.triangles.is_empty() {
-        return Err(err(if soup.positions.is_empty() {
-            MeshProblem::NoVertices
-        } else {
-            MeshProblem::NoTriangles
-        }));
-    }
+    let mut soup = read_soup(name, Format::Obj, bytes)?;
     soup.drop_unused();
-    if soup.positions.len() >= 1 << 31 {
-        return Err(err(MeshProblem::TooLarge));
-    }
-    let normals = vertex_normals(&soup.positions, &soup.triangles);
-    Ok(IndexedMesh {
-        positions: soup.positions,
-        normals,
-        colors: soup.colors,
-        triangles: soup.triangles,
-    })
+    Ok(soup.into())
 }
 
 impl IndexedMesh {

@@ -201,15 +201,15 @@ pub fn repair(soup: Soup) -> (Soup, Repairs) {
 
 /// The edges that only one triangle has, as (low, high) vertex pairs, sorted.
 fn border_edges(triangles: &[[u32; 3]]) -> Vec<(u32, u32)> {
-    let mut edges: Vec<(u32, u32)> = triangles
-        .iter()
-        .flat_map(|t| (0..3).map(move |k| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]))))
-        .collect();
-    edges.sort_unstable();
-    edges
-        .chunk_by(|a, b| a == b)
-        .filter(|run| run.len() == 1)
-        .map(|run| run[0])
+    let edges = EdgeGroups::new(triangles);
+    (0..edges.count())
+        .filter_map(|g| match edges.members(g) {
+            &[(t, k)] => {
+                let (a, b) = (triangles[t][k], triangles[t][(k + 1) % 3]);
+                Some((a.min(b), a.max(b)))
+            }
+            _ => None,
+        })
         .collect()
 }
 
@@ -387,13 +387,18 @@ impl EdgeGroups {
         }
     }
 
+    /// How many edges (groups) there are.
+    fn count(&self) -> usize {
+        self.starts.len() - 1
+    }
+
     fn members(&self, g: usize) -> &[(usize, usize)] {
         &self.sides[self.starts[g]..self.starts[g + 1]]
     }
 
     /// Groups of exactly two triangles: the edges that may join them.
     fn joinable(&self) -> Vec<bool> {
-        (0..self.starts.len() - 1)
+        (0..self.count())
             .map(|g| self.members(g).len() == 2)
             .collect()
     }
@@ -539,19 +544,14 @@ fn split_fans(
 /// `(triangle, corner)` pairs at the ends of output edges that are still not manifold (more than
 /// two triangles, or two running the same way).
 fn bad_output_edges(triangles: &[[u32; 3]]) -> Vec<(usize, usize)> {
-    let mut keyed: Vec<((u32, u32), bool, usize, usize)> = Vec::with_capacity(triangles.len() * 3);
-    for (t, tri) in triangles.iter().enumerate() {
-        for k in 0..3 {
-            let (a, b) = (tri[k], tri[(k + 1) % 3]);
-            keyed.push(((a.min(b), a.max(b)), a < b, t, k));
-        }
-    }
-    keyed.sort_unstable();
+    let edges = EdgeGroups::new(triangles);
+    let forward = |(t, k): (usize, usize)| triangles[t][k] < triangles[t][(k + 1) % 3];
     let mut bad = Vec::new();
-    for run in keyed.chunk_by(|p, q| p.0 == q.0) {
-        let manifold = run.len() == 1 || (run.len() == 2 && run[0].1 != run[1].1);
+    for g in 0..edges.count() {
+        let run = edges.members(g);
+        let manifold = run.len() == 1 || (run.len() == 2 && forward(run[0]) != forward(run[1]));
         if !manifold {
-            for &(_, _, t, k) in run {
+            for &(t, k) in run {
                 bad.push((t, k));
                 bad.push((t, (k + 1) % 3));
             }

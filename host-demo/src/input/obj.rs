@@ -65,8 +65,14 @@ pub(crate) fn read(bytes: &[u8]) -> Result<Soup, ReadError> {
         match t.next() {
             Some(b"v") => {
                 let p: [f32; 3] = text::numbers(&mut t, line)?;
-                let rest: Vec<&[u8]> = t.collect();
-                if rest.len() >= 3 {
+                // `v x y z r g b`: three more values are a colour (a fourth alone is `w`).
+                let mut rest: [&[u8]; 3] = [b""; 3];
+                let mut extra = 0;
+                for (slot, token) in rest.iter_mut().zip(t) {
+                    *slot = token;
+                    extra += 1;
+                }
+                if extra == 3 {
                     let mut c = [255u8; 3];
                     for (out, token) in c.iter_mut().zip(&rest) {
                         let v =
