@@ -264,7 +264,8 @@ fn weld(positions: &[[f32; 3]], border: &[bool]) -> Vec<u32> {
             hi[a] = hi[a].max(p[a] as f64);
         }
     }
-    let diagonal = (0..3).map(|a| (hi[a] - lo[a]).powi(2)).sum::<f64>().sqrt();
+    let square = |x: f64| x * x;
+    let diagonal = libm::sqrt((0..3).map(|a| square(hi[a] - lo[a])).sum::<f64>());
     let tolerance = diagonal * WELD_TOLERANCE;
     let mut representative = Vec::with_capacity(positions.len());
     if !(tolerance > 0.0 && tolerance.is_finite()) {
@@ -281,7 +282,7 @@ fn weld(positions: &[[f32; 3]], border: &[bool]) -> Vec<u32> {
         return representative;
     }
     let cell = |p: &[f32; 3]| -> [i64; 3] {
-        std::array::from_fn(|a| ((p[a] as f64 - lo[a]) / tolerance).floor() as i64)
+        std::array::from_fn(|a| libm::floor((p[a] as f64 - lo[a]) / tolerance) as i64)
     };
     let mut grid: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
     for (i, p) in positions.iter().enumerate() {
@@ -299,7 +300,7 @@ fn weld(positions: &[[f32; 3]], border: &[bool]) -> Vec<u32> {
                     };
                     for &r in list {
                         let q = positions[r as usize];
-                        let d2: f64 = (0..3).map(|a| (p[a] as f64 - q[a] as f64).powi(2)).sum();
+                        let d2: f64 = (0..3).map(|a| square(p[a] as f64 - q[a] as f64)).sum();
                         if d2 <= tolerance * tolerance && best.is_none_or(|b| r < b) {
                             best = Some(r);
                         }
