@@ -305,7 +305,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                         error: 0.0,
                     }
                 } else {
-                    policy.demand(&bounds[k], view)
+                    self.judged(h, base + k, policy.demand(&bounds[k], view), view, policy)
                 };
             }
             // The parent of a pair matters unless the first child is to be split or both were
@@ -392,7 +392,15 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             // clears the mark lists the pair again (`list_unblocked`).
             return;
         }
-        let e = pair_error(policy.demand(parent_bounds, view));
+        let d = policy.demand(parent_bounds, view);
+        let e = pair_error(self.judged_pair(
+            h,
+            (i, j),
+            (parent_bounds.center, parent_bounds.radius),
+            d,
+            view,
+            policy,
+        ));
         if e > t {
             // The parent is wanted: a collapse under way blends back.
             if (self.v.flags[i] | self.v.flags[j]) & COLLAPSING != 0 {
@@ -469,6 +477,16 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             if blending && (fa | fb) & BLENDING != 0 {
                 continue;
             }
+            if !blending && policy.judges_triangles() {
+                // Collapses before this one may have made the triangles it would leave larger:
+                // judge them as they are now, so no collapse makes what the next frame splits.
+                let pb = h.bounds(p);
+                let d = policy.demand(&pb, view);
+                let d = self.judged_pair(h, (a, b), (pb.center, pb.radius), d, view, policy);
+                if pair_error(d) > frame.threshold {
+                    continue;
+                }
+            }
             let seen = e >= 0.0 && (fa | fb) & WAS_VISIBLE != 0;
             let split = h.split(p);
             let legal = self.collapse_legal_at(h, p, &split, a as u32, b as u32, &mut fans);
@@ -521,7 +539,10 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             m as usize
         };
         let p = h.parent(self.v.node[first]);
-        let error = pair_error(policy.demand(&h.bounds(p), view));
+        let b = h.bounds(p);
+        let d = policy.demand(&b, view);
+        let pair = (first, self.v.mate(first) as usize);
+        let error = pair_error(self.judged_pair(h, pair, (b.center, b.radius), d, view, policy));
         if error <= frame.threshold {
             self.list_pair(error, p, first, &mut frame.stats);
         }
@@ -572,7 +593,11 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         self.pairs.clear();
         for i in 0..self.v.len() {
             if let Some(p) = self.pair_parent(h, i) {
-                let e = pair_error(policy.demand(&h.bounds(p), view));
+                let b = h.bounds(p);
+                let d = policy.demand(&b, view);
+                let pair = (i, self.v.mate(i) as usize);
+                let e =
+                    pair_error(self.judged_pair(h, pair, (b.center, b.radius), d, view, policy));
                 if !self.list_pair(e, p, i, stats) {
                     break;
                 }
@@ -645,6 +670,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                         continue;
                     };
                     let d = policy.demand(&h.bounds(c), view);
+                    let d = self.judged(h, cs as usize, d, view, policy);
                     let flags = &mut self.v.flags[cs as usize];
                     *flags = (*flags & !VISIBLE) | d.visible as u8;
                     if d.error > t

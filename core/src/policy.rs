@@ -18,7 +18,7 @@
 //! | [`BackFace`] | normal cones, Hoppe's `oriented_away` (wavelet paper §3.3.2) |
 //! | [`ScreenError`] | the spheroid's projected radius in pixels, equations 4 and 5 of the wavelet paper, with separate silhouette and interior tolerances (§3.3.3) |
 //! | [`MergeTree`] | the merge-tree paper's `shouldRefine`: near the camera and in the frustum |
-//! | [`Importance`] | the importance paper's `area / (distance tan(FOV)) max(-cos θ, sin θ)` against a threshold |
+//! | [`Importance`] | the importance paper's per-triangle `area / (distance tan(FOV)) max(-cos θ, sin θ)` against a threshold, in units of the model's size |
 //!
 //! ```
 //! use vdlod_core::policy::{BackFace, Bounds, Frustum, Policy, ScreenError, View};
@@ -274,6 +274,26 @@ pub trait Policy {
         let _ = (center, s2, view);
         f32::INFINITY
     }
+
+    /// Whether the policy also judges triangles ([`Policy::triangle`]); `false` (the default)
+    /// lets the cut skip the walk around each vertex that judging them costs.
+    #[inline]
+    fn judges_triangles(&self) -> bool {
+        false
+    }
+
+    /// The demand an active triangle with these corners (counter-clockwise seen from the
+    /// front) puts on each of its corners, over tolerance when `> 1`: the importance paper
+    /// decides per triangle, and an important triangle splits every corner that can split.
+    /// `reach` is the largest bounding radius of the corners' regions: what the corners'
+    /// splits can make lies within `reach` of the triangle (for the frustum test; a coarse
+    /// triangle at a border can lie well inside the surface it stands for). Asked only when
+    /// [`Policy::judges_triangles`]; 0 by default.
+    #[inline]
+    fn triangle(&self, corners: &[[f32; 3]; 3], reach: f32, view: &View) -> f32 {
+        let _ = (corners, reach, view);
+        0.0
+    }
 }
 
 impl<A: Policy, B: Policy> Policy for (A, B) {
@@ -299,6 +319,18 @@ impl<A: Policy, B: Policy> Policy for (A, B) {
             .error_bound(center, s2, view)
             .max(self.1.error_bound(center, s2, view))
     }
+
+    #[inline]
+    fn judges_triangles(&self) -> bool {
+        self.0.judges_triangles() || self.1.judges_triangles()
+    }
+
+    #[inline]
+    fn triangle(&self, corners: &[[f32; 3]; 3], reach: f32, view: &View) -> f32 {
+        self.0
+            .triangle(corners, reach, view)
+            .max(self.1.triangle(corners, reach, view))
+    }
 }
 
 impl<P: Policy + ?Sized> Policy for &P {
@@ -310,6 +342,16 @@ impl<P: Policy + ?Sized> Policy for &P {
     #[inline]
     fn error_bound(&self, center: [f32; 3], s2: f32, view: &View) -> f32 {
         (**self).error_bound(center, s2, view)
+    }
+
+    #[inline]
+    fn judges_triangles(&self) -> bool {
+        (**self).judges_triangles()
+    }
+
+    #[inline]
+    fn triangle(&self, corners: &[[f32; 3]; 3], reach: f32, view: &View) -> f32 {
+        (**self).triangle(corners, reach, view)
     }
 }
 
@@ -540,31 +582,114 @@ impl Policy for MergeTree {
     }
 }
 
-/// The importance paper's view importance (§IV), `area / (distance tan(FOV)) max(-cos θ, sin θ)`
-/// with θ between the normal and the eye-to-vertex direction, over `threshold`. A vertex stands
-/// for the triangles around it: its region's area is taken as `radius^2` (the file stores no
-/// area), so the threshold is in units of the mesh's length.
+/// The importance paper's triangle importance (§IV): a triangle in the frustum is important when
+///
+/// `area / (distance tan(FOV)) max(-cos θ, sin θ) > threshold`
+///
+/// with `distance` from the eye to the triangle's centre, `FOV` the vertical field of view and
+/// `θ` the angle between the triangle's normal and the eye-to-centre direction (largest for
+/// triangles facing the eye or seen edge-on, zero for those facing away); an important triangle
+/// splits each of its corners that can split ([`Policy::triangle`]). The cut asks the question
+/// of every triangle around a vertex, and of the triangles a collapse would make before it
+/// makes them, so a collapse never undoes a split the view still wants.
+///
+/// **Normalised**: lengths are measured in units of the model's size, the diagonal of its
+/// bounding box ([`Importance::for_model`]), so `area / distance` is scale-free and a threshold
+/// means the same on a bunny a few units across and on a terrain of thousands: roughly the
+/// triangle's area as a fraction of the model's squared size, for a camera about one diagonal
+/// away. [`Importance::DEFAULT_THRESHOLD`] is measured to give a sensible mesh on both (the
+/// README's terrain section). The paper's 0.3 was in the units of its own 100-sample terrain,
+/// whose diagonal is about 141 samples: 0.3 there is about 0.002 here.
+///
+/// The vertex engine judges triangles exactly; [`Importance::demand`] wants nothing of a vertex
+/// by itself, so an engine that asks only about vertices (the wavelet engine) refines nothing
+/// with it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Importance {
-    /// Importance above which a split is wanted (the paper found 0.3 pleasing on its meshes).
+    /// Importance above which a triangle splits its corners.
     pub threshold: f32,
+    /// The model's size (its bounding-box diagonal): the unit lengths are measured in.
+    pub size: f32,
+}
+
+impl Importance {
+    /// A threshold that gives a sensible mesh on the terrain and on the bunny (see the type's
+    /// documentation).
+    pub const DEFAULT_THRESHOLD: f32 = 1e-4;
+
+    /// The policy for a model whose bounding box has diagonal `size` (kept above zero).
+    #[must_use]
+    pub fn new(threshold: f32, size: f32) -> Importance {
+        Importance {
+            threshold,
+            size: if size > 0.0 && size.is_finite() {
+                size
+            } else {
+                1.0
+            },
+        }
+    }
+
+    /// The policy for the model `h` holds, sized by its bounding box.
+    #[must_use]
+    pub fn for_model(threshold: f32, h: &crate::format::HierarchyView<'_>) -> Importance {
+        let (min, max) = h.bounding_box();
+        let d = sub(max, min);
+        Importance::new(threshold, libm::sqrtf(dot(d, d)))
+    }
+
+    /// The paper's importance of the triangle with corners `c` seen from `view`, in this
+    /// policy's units: 0 when no point within `reach` of it is in the frustum, or when it faces
+    /// exactly away.
+    #[must_use]
+    pub fn importance(&self, c: &[[f32; 3]; 3], reach: f32, view: &View) -> f32 {
+        let center = [0, 1, 2].map(|k| (c[0][k] + c[1][k] + c[2][k]) * (1.0 / 3.0));
+        let spread = c
+            .iter()
+            .map(|&x| {
+                let r = sub(x, center);
+                dot(r, r)
+            })
+            .fold(0.0f32, f32::max);
+        if !view.sphere_visible(center, libm::sqrtf(spread) + reach.max(0.0)) {
+            return 0.0;
+        }
+        let n = cross(sub(c[1], c[0]), sub(c[2], c[0]));
+        let twice_area = libm::sqrtf(dot(n, n));
+        let r = sub(center, view.eye);
+        let d = libm::sqrtf(dot(r, r));
+        if !(twice_area > 0.0 && d > 0.0) {
+            // Degenerate, or the eye on its centre: only its size can speak.
+            return if twice_area > 0.0 { f32::MAX } else { 0.0 };
+        }
+        let cos = (dot(n, r) / (twice_area * d)).clamp(-1.0, 1.0);
+        let sin = libm::sqrtf(1.0 - cos * cos);
+        let area = 0.5 * twice_area / (self.size * self.size);
+        area / (d / self.size * view.tan_fov) * (-cos).max(sin)
+    }
 }
 
 impl Policy for Importance {
+    /// Wants nothing of a vertex by itself: the demand comes from its triangles.
     #[inline]
-    fn demand(&self, b: &Bounds, view: &View) -> Demand {
-        let r = sub(b.center, view.eye);
-        let d = libm::sqrtf(dot(r, r)).max(f32::MIN_POSITIVE);
-        let cos = (dot(b.axis, r) / d).clamp(-1.0, 1.0);
-        let sin = libm::sqrtf(1.0 - cos * cos);
-        let importance = b.radius * b.radius / (d * view.tan_fov) * (-cos).max(sin);
-        Demand {
-            visible: true,
-            error: if self.threshold > 0.0 {
-                importance / self.threshold
-            } else {
-                f32::MAX
-            },
+    fn demand(&self, _: &Bounds, _: &View) -> Demand {
+        Demand::NONE
+    }
+
+    #[inline]
+    fn judges_triangles(&self) -> bool {
+        true
+    }
+
+    #[inline]
+    fn triangle(&self, corners: &[[f32; 3]; 3], reach: f32, view: &View) -> f32 {
+        let i = self.importance(corners, reach, view);
+        if self.threshold > 0.0 {
+            i / self.threshold
+        } else if i > 0.0 {
+            f32::MAX
+        } else {
+            0.0
         }
     }
 }
@@ -725,20 +850,64 @@ mod tests {
     }
 
     #[test]
-    fn merge_tree_and_importance_prefer_what_is_near() {
+    fn merge_tree_prefers_what_is_near() {
         let v = view();
         let near = bounds([0.0, 0.0, 5.0], [0.0, 0.0, 1.0], 0.0, 0.0);
         let far = bounds([0.0, 0.0, -20.0], [0.0, 0.0, 1.0], 0.0, 0.0);
         let m = MergeTree { near: 10.0 };
         assert!(m.demand(&near, &v).error > 1.0);
         assert!(m.demand(&far, &v).error <= 1.0);
-        let i = Importance { threshold: 1e-3 };
-        assert!(i.demand(&near, &v).error > i.demand(&far, &v).error);
         let both = (Frustum, m);
         assert!(
             !both
                 .demand(&bounds([0.0, 0.0, 50.0], [0.0; 3], 0.0, 0.0), &v)
                 .visible
         );
+    }
+
+    #[test]
+    fn importance_is_the_papers_formula_in_units_of_the_model() {
+        let v = view(); // eye at z = 10 looking down -z, fov 60 degrees
+        let tan = libm::tanf(core::f32::consts::FRAC_PI_3);
+        let facing = [[-1.0, -1.0, 0.0], [1.0, -1.0, 0.0], [0.0, 2.0, 0.0]]; // area 3, centred
+        let i = Importance::new(1e-3, 4.0);
+        // Facing the eye: -cos(theta) = 1; area / size^2 over distance / size times tan(FOV).
+        let want = (3.0 / 16.0) / (10.0 / 4.0 * tan);
+        let got = i.importance(&facing, 0.0, &v);
+        assert!((got - want).abs() < 1e-5 * want, "{got} vs {want}");
+        assert!((i.triangle(&facing, 0.0, &v) - want / 1e-3).abs() < 1e-2 * want / 1e-3);
+        // Seen edge-on: sin(theta) = 1, the same weight; facing away: nothing.
+        let edge_on = [[0.0, -1.0, -1.0], [0.0, -1.0, 1.0], [0.0, 2.0, 0.0]];
+        let twisted = i.importance(&edge_on, 0.0, &v);
+        assert!((twisted - want).abs() < 1e-3 * want, "{twisted}");
+        let away = [facing[0], facing[2], facing[1]];
+        assert_eq!(i.importance(&away, 0.0, &v), 0.0);
+        // Nearer is more important, as 1 / distance.
+        let nearer = facing.map(|c| [c[0], c[1], 5.0]);
+        let n = i.importance(&nearer, 0.0, &v);
+        assert!((n - 2.0 * want).abs() < 1e-3 * want, "{n}");
+        // Outside the frustum: nothing, unless its corners' regions reach in.
+        let aside = facing.map(|c| [c[0] + 30.0, c[1], c[2]]);
+        assert_eq!(i.importance(&aside, 0.0, &v), 0.0);
+        assert!(i.importance(&aside, 30.0, &v) > 0.0);
+        // Scale-free: the model, the eye and the size scaled together give the same number.
+        let s = 1000.0;
+        let big = View::look_at(
+            [0.0, 0.0, 10.0 * s],
+            [0.0; 3],
+            [0.0, 1.0, 0.0],
+            core::f32::consts::FRAC_PI_3,
+            4.0 / 3.0,
+            480.0,
+        );
+        let scaled = facing.map(|c| c.map(|x| x * s));
+        let k = Importance::new(1e-3, 4.0 * s).importance(&scaled, 0.0, &big);
+        assert!((k - want).abs() < 1e-4 * want, "{k}");
+        // The vertex alone wants nothing; the cut asks the triangles.
+        let b = bounds([0.0; 3], [0.0, 0.0, 1.0], 0.0, 0.0);
+        assert_eq!(i.demand(&b, &v), Demand::NONE);
+        assert!(i.judges_triangles() && (Frustum, i).judges_triangles());
+        assert!(!QRefine::new(1.0).judges_triangles());
+        assert_eq!(QRefine::new(1.0).triangle(&facing, 0.0, &v), 0.0);
     }
 }

@@ -280,10 +280,23 @@ impl Policy for DemoPolicy {
             DemoPolicy::Importance(p) => p.error_bound(center, s2, view),
         }
     }
+
+    #[inline]
+    fn judges_triangles(&self) -> bool {
+        matches!(self, DemoPolicy::Importance(_))
+    }
+
+    #[inline]
+    fn triangle(&self, corners: &[[f32; 3]; 3], reach: f32, view: &View) -> f32 {
+        match self {
+            DemoPolicy::Importance(p) => p.triangle(corners, reach, view),
+            _ => 0.0,
+        }
+    }
 }
 
-/// The policy for `choice`.
-pub fn make_policy(choice: PolicyChoice) -> DemoPolicy {
+/// The policy for `choice` on the model `h` holds.
+pub fn make_policy(choice: PolicyChoice, h: &HierarchyView<'_>) -> DemoPolicy {
     match choice {
         PolicyChoice::Screen {
             silhouette,
@@ -298,7 +311,7 @@ pub fn make_policy(choice: PolicyChoice) -> DemoPolicy {
             near: f32::INFINITY,
         }),
         PolicyChoice::Importance { threshold } => {
-            DemoPolicy::Importance((Frustum, Importance { threshold }))
+            DemoPolicy::Importance((Frustum, Importance::for_model(threshold, h)))
         }
     }
 }
@@ -539,7 +552,7 @@ fn fly_orbit<const V: usize, const F: usize, const Q: usize, I: SlotIndex + Vert
     } else {
         merge_tree_orbit(&bounds, opts.frames, opts.width, opts.height)
     };
-    let policy = make_policy(opts.policy);
+    let policy = make_policy(opts.policy, &h);
     let mut frame = Frame::new(opts.width, opts.height).map_err(|e| e.to_string())?;
     let mut reference = Frame::new(opts.width, opts.height).map_err(|e| e.to_string())?;
     let full_mesh = full.as_raster_mesh();

@@ -10,6 +10,7 @@ use clap::{Parser, Subcommand, ValueEnum};
 use vdlod_core::adapt::Budget;
 use vdlod_core::build::{BuildOptions, Cost};
 use vdlod_core::format::HierarchyView;
+use vdlod_core::policy::Importance;
 use vdlod_core::wavelet::build::{Scheme, SemiRegular};
 use vdlod_core::wavelet::SemiRegularView;
 use vdlod_demo::camera::{path_cameras, Camera};
@@ -284,8 +285,9 @@ struct FlightArgs {
     /// Refinement policy.
     #[arg(long, value_enum, default_value = "screen")]
     policy: PolicyArg,
-    /// Importance threshold (with --policy importance; 0 refines everything visible).
-    #[arg(long, default_value_t = 0.3, allow_negative_numbers = true, value_parser = non_negative)]
+    /// Importance threshold (with --policy importance; in units of the model's size, see
+    /// `Importance`; 0 refines everything visible).
+    #[arg(long, default_value_t = Importance::DEFAULT_THRESHOLD, allow_negative_numbers = true, value_parser = non_negative)]
     threshold: f32,
     /// Frustum size: the refinement frustum's width and height relative to the camera's
     /// (the merge-tree paper's Table 1 uses 0.4, 0.2, 0.1; above 0).

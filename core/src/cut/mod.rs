@@ -13,7 +13,7 @@
 //! [`Cut::check`] proves it (Hoppe's `ok()`).
 //!
 //! The rooms: [`slot`] (index widths and the queue arena), `store` (vertex and triangle
-//! records), `fan` (walks around a vertex), `split`, `collapse`, `blend` (geomorph state and the
+//! records), `fan` (walks around a vertex), `judge` (policies that judge triangles), `split`, `collapse`, `blend` (geomorph state and the
 //! vertex output), `check` (the invariants).
 //!
 //! # Memory
@@ -79,6 +79,7 @@ mod blend;
 mod check;
 mod collapse;
 mod fan;
+mod judge;
 pub mod slot;
 mod split;
 mod store;

@@ -325,6 +325,69 @@ mod adapt {
     }
 
     #[test]
+    fn importance_splits_the_corners_of_important_triangles_and_then_holds_still() {
+        use crate::policy::{Importance, Policy};
+        let (p, t) = grid(32);
+        let bytes = build_it(&p, &t, BuildOptions::default()).to_bytes(false);
+        let h = HierarchyView::parse(&bytes).unwrap();
+        // Low over one corner of the grid, looking across it.
+        let view = View::look_at(
+            [0.05, 0.05, 0.35],
+            [0.7, 0.7, 0.0],
+            [0.0, 0.0, 1.0],
+            1.0,
+            4.0 / 3.0,
+            480.0,
+        );
+        let importance = Importance::for_model(8e-4, &h);
+        let policy = (Frustum, importance);
+        let mut cut: Box<Mid> = Cut::boxed();
+        cut.reset(&h).unwrap();
+        let mut rounds = 0;
+        while {
+            let s = cut.adapt(&h, &view, &policy, &Budget::default());
+            s.vsplits + s.ecols > 0
+        } {
+            rounds += 1;
+            assert!(rounds < 10, "the cut does not settle");
+        }
+        cut.check(&h).unwrap();
+        // Every triangle over the threshold has no corner left that could split (the paper's
+        // rule), and the cut is neither the base nor full detail.
+        let mut important = 0;
+        for tri in cut.triangles() {
+            let nodes = tri.map(|s| cut.nodes()[s.index()]);
+            let c = nodes.map(|n| h.bounds(n).center);
+            let reach = nodes
+                .map(|n| h.bounds(n).radius)
+                .into_iter()
+                .fold(0.0, f32::max);
+            if policy.triangle(&c, reach, &view) > 1.0 {
+                important += 1;
+                assert!(nodes.iter().all(|&n| n < h.leaves()), "{nodes:?}");
+            }
+        }
+        assert!(
+            important > 0,
+            "some triangles are at full detail and still important"
+        );
+        let n = cut.triangles().len();
+        assert!(n > 2 * h.base_triangles() as usize && n < t.len(), "{n}");
+        // Detail falls with distance (as 1 / distance, the paper's measure): along the line of
+        // sight, a patch about 0.5 from the eye holds more vertices than one about 1.35 away.
+        let near = |q: [f32; 3], x: f32| (q[0] - x).abs() < 0.1 && (q[1] - x).abs() < 0.1;
+        let ps = positions(&cut, &h);
+        let (a, b) = (
+            ps.iter().filter(|q| near(**q, 0.3)).count(),
+            ps.iter().filter(|q| near(**q, 0.9)).count(),
+        );
+        assert!(2 * a > 3 * b, "{a} near, {b} far");
+        // Judged from the triangles a collapse would make, nothing the view wants is undone.
+        let again = cut.adapt(&h, &view, &policy, &Budget::default());
+        assert_eq!((again.vsplits, again.ecols), (0, 0));
+    }
+
+    #[test]
     fn geomorphs_blend_and_settle() {
         let bytes = sphere_bytes();
         let h = HierarchyView::parse(&bytes).unwrap();

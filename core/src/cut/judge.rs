@@ -1,0 +1,135 @@
+//! What a policy that judges triangles says about a vertex, or about the parent a collapse would
+//! make (the importance paper's test, [`crate::policy::Importance`]).
+//!
+//! A vertex is wanted split when any triangle around it is over tolerance; a pair's parent is
+//! wanted when any triangle the collapse would leave around it is, judged before the collapse
+//! with the parent in the children's place. So a collapse never makes a triangle the next frame
+//! would split again, and a split is never undone while the view still wants it. Policies that
+//! judge only vertices ([`Policy::judges_triangles`] false) pass through untouched. The paper
+//! tests each triangle against the frustum, so a triangle in view speaks for its corners even
+//! when the frustum culled a corner's own bounds.
+
+use super::slot::SlotIndex;
+use super::{Cut, NIL};
+use crate::format::HierarchyView;
+use crate::policy::{Demand, Policy, View};
+
+impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, I> {
+    /// Calls `visit` with each triangle around slot `v`, walking at most as many steps as the
+    /// vertex has triangles (so a fan a crafted file broke ends the walk, not the program).
+    fn for_each_around(&self, v: u32, mut visit: impl FnMut(u32)) {
+        if v as usize >= self.v.len() {
+            return;
+        }
+        let start = self.v.fan(v as usize);
+        let mut left = self.v.degree[v as usize];
+        if start == NIL {
+            return;
+        }
+        let mut f = start;
+        while left > 0 {
+            visit(f);
+            left -= 1;
+            match self.ccw(f, v) {
+                Some(g) if g == start => return,
+                Some(g) if g != NIL => f = g,
+                _ => break,
+            }
+        }
+        // A border: the rest lies clockwise of the start.
+        let mut g = self.cw(start, v).unwrap_or(NIL);
+        while g != NIL && left > 0 {
+            visit(g);
+            left -= 1;
+            g = self.cw(g, v).unwrap_or(NIL);
+        }
+    }
+
+    /// The position of slot `s`'s node, as the file stores it.
+    #[inline]
+    fn node_position(&self, h: &HierarchyView<'_>, s: u32) -> [f32; 3] {
+        h.digest_center(&self.v.digest[s as usize])
+    }
+
+    /// The bounding radius of slot `s`'s node's region.
+    #[inline]
+    fn node_reach(&self, h: &HierarchyView<'_>, s: u32) -> f32 {
+        h.length(self.v.digest[s as usize].radius)
+    }
+
+    /// `d`, the policy's demand for slot `s`'s own bounds, raised by the triangles around it.
+    #[inline]
+    pub(crate) fn judged<P: Policy>(
+        &self,
+        h: &HierarchyView<'_>,
+        s: usize,
+        d: Demand,
+        view: &View,
+        policy: &P,
+    ) -> Demand {
+        if !policy.judges_triangles() {
+            return d;
+        }
+        let mut error = if d.visible { d.error } else { 0.0 };
+        self.for_each_around(s as u32, |f| {
+            let t = self.t.at(f);
+            let c = t.map(|x| self.node_position(h, x));
+            let reach = t.map(|x| self.node_reach(h, x));
+            error = error.max(policy.triangle(&c, reach[0].max(reach[1]).max(reach[2]), view));
+        });
+        // A triangle in view speaks for a vertex whose own bounds the frustum culled.
+        Demand {
+            visible: d.visible || error > 0.0,
+            error,
+        }
+    }
+
+    /// `d`, the policy's demand for the parent of the pair at slots `a` and `b` (at `parent`,
+    /// its region within `parent_reach`), raised by the triangles the pair's collapse would
+    /// leave around the parent.
+    #[inline]
+    pub(crate) fn judged_pair<P: Policy>(
+        &self,
+        h: &HierarchyView<'_>,
+        (a, b): (usize, usize),
+        (parent, parent_reach): ([f32; 3], f32),
+        d: Demand,
+        view: &View,
+        policy: &P,
+    ) -> Demand {
+        if !policy.judges_triangles() {
+            return d;
+        }
+        let (a, b) = (a as u32, b as u32);
+        let mut error = if d.visible { d.error } else { 0.0 };
+        for (x, other) in [(a, b), (b, a)] {
+            self.for_each_around(x, |f| {
+                let t = self.t.at(f);
+                if t.contains(&other) {
+                    return; // the collapse removes it
+                }
+                let c = t.map(|y| {
+                    if y == x {
+                        parent
+                    } else {
+                        self.node_position(h, y)
+                    }
+                });
+                let reach = t.map(|y| {
+                    if y == x {
+                        parent_reach
+                    } else {
+                        self.node_reach(h, y)
+                    }
+                });
+                let reach = reach[0].max(reach[1]).max(reach[2]);
+                error = error.max(policy.triangle(&c, reach, view));
+            });
+        }
+        // A triangle in view speaks for a vertex whose own bounds the frustum culled.
+        Demand {
+            visible: d.visible || error > 0.0,
+            error,
+        }
+    }
+}
