@@ -7,6 +7,7 @@ pub mod camera;
 pub mod chart;
 pub mod frame;
 pub mod hierarchy;
+pub mod importance;
 pub mod input;
 pub mod label;
 pub mod lod;

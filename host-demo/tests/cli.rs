@@ -530,7 +530,15 @@ fn reproduce_fig11_writes_pictures_csv_and_summary_lines() {
     let dir = scratch_dir("cli_reproduce");
     let help = demo(&["reproduce", "--help"], &dir);
     let text = String::from_utf8_lossy(&help.stdout);
-    for name in ["fig11", "fig9", "fig10", "engines", "Azuma"] {
+    for name in [
+        "fig11",
+        "fig9",
+        "fig10",
+        "engines",
+        "terrain",
+        "Azuma",
+        "importance",
+    ] {
         assert!(text.contains(name), "{name} missing from: {text}");
     }
     let out = succeed(&["reproduce", "fig11", "-o", "out"], &dir);
@@ -556,6 +564,68 @@ fn reproduce_fig11_writes_pictures_csv_and_summary_lines() {
         "fig11.csv",
     ] {
         assert!(dir.join("out/fig11").join(file).exists(), "{file}");
+    }
+}
+
+/// The value of `key` in a `key=value` summary line.
+fn field<T: std::str::FromStr>(line: &str, key: &str) -> T {
+    line.split(' ')
+        .find_map(|kv| kv.strip_prefix(key)?.strip_prefix('='))
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("no {key} in {line}"))
+}
+
+#[test]
+fn reproduce_terrain_reduces_refines_and_compares_the_costs() {
+    let dir = scratch_dir("cli_reproduce_terrain");
+    let out = succeed(&["reproduce", "terrain", "-o", "out"], &dir);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let line = |cost: &str, mesh: &str, setting: Option<&str>| -> String {
+        stdout
+            .lines()
+            .find(|l| {
+                l.starts_with("experiment=terrain")
+                    && l.contains(&format!(" cost={cost} "))
+                    && l.contains(&format!(" mesh={mesh} "))
+                    && setting.is_none_or(|s| l.contains(&format!("threshold_setting={s} ")))
+            })
+            .unwrap_or_else(|| panic!("no {cost} {mesh} line in {stdout}"))
+            .to_string()
+    };
+    for (mesh, want) in [("25%", 5000), ("10%", 2000)] {
+        let (color, qem) = (line("color", mesh, None), line("qem", mesh, None));
+        for l in [&color, &qem] {
+            assert_eq!(field::<u32>(l, "full_triangles"), 20_000);
+            let n: u32 = field(l, "triangles");
+            assert!(n == want || n == want + 1, "{l}");
+        }
+        // The colour cost keeps the colormap's edges: seen from above, where colour is all
+        // there is to see, it beats QEM by several dB.
+        let (c, q): (f64, f64) = (field(&color, "psnr_top_db"), field(&qem, "psnr_top_db"));
+        assert!(c > q + 2.0, "{color}\n{qem}");
+    }
+    let refined = "10%+importance";
+    let paper = line("color", refined, Some("paper"));
+    let default = line("color", refined, Some("default"));
+    assert_eq!(field::<f64>(&paper, "threshold_paper_units"), 0.3);
+    let base: u32 = field(&paper, "base_triangles");
+    let (p, d): (u32, u32) = (field(&paper, "triangles"), field(&default, "triangles"));
+    assert!(base == 2000 || base == 2001, "{paper}");
+    assert!(p > base && d > 2 * p, "{paper}\n{default}");
+    // QEM is refined to the colour cut's count.
+    let qem: u32 = field(&line("qem", refined, Some("default")), "triangles");
+    assert!(qem <= d && qem + 10 > d, "{qem} vs {d}");
+    for file in [
+        "figure.png",
+        "colormap.png",
+        "heightmap.png",
+        "original_top.png",
+        "25_perspective.png",
+        "10_top.png",
+        "refined_paper_perspective.png",
+        "refined_default_top.png",
+    ] {
+        assert!(dir.join("out/terrain").join(file).exists(), "{file}");
     }
 }
 

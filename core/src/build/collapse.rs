@@ -11,6 +11,7 @@ use alloc::vec;
 use alloc::vec::Vec;
 use core::cmp::Reverse;
 
+use super::closest::Surface;
 use super::quadric::{place, Quadric};
 use super::vec3::{add, cross, dot, from_f32, len, normalize, scale, sub, Vec3d};
 use super::{BuildOptions, Cost, InputMesh, NONE};
@@ -54,6 +55,8 @@ pub(crate) struct Engine<'o> {
     /// Edges found illegal, by endpoint: retried when a collapse changes that endpoint's ring.
     rejected: Vec<Vec<u32>>,
     pub collapses: Vec<Collapse>,
+    /// The input surface, for [`Cost::Color`]'s `Gerr`.
+    surface: Option<Surface>,
 }
 
 fn face_normal(p: &[Vec3d], f: [u32; 3]) -> Vec3d {
@@ -118,6 +121,8 @@ impl<'o> Engine<'o> {
             deferred: Vec::new(),
             rejected: vec![Vec::new(); n],
             collapses: Vec::new(),
+            surface: (opts.cost == Cost::Color)
+                .then(|| Surface::new(mesh.positions, mesh.triangles)),
         };
         e.alive_count = e.alive.iter().filter(|&&a| a).count();
         // Boundary quadrics keep open borders in place.
@@ -204,13 +209,13 @@ impl<'o> Engine<'o> {
             }
             Cost::ShortestEdge => (scale(add(pa, pb), 0.5), len2),
             Cost::Color => {
-                // The importance paper's Gerr^2 + length^2 + sqrt(length * dcolor), with Gerr the
-                // area-weighted RMS distance of the new vertex to the planes it replaces.
-                let v = place(&q, pa, pb);
-                let area = (self.area[a as usize] + self.area[b as usize]).max(f64::MIN_POSITIVE);
-                let gerr2 = q.error(v) / area;
+                // The importance paper's Gerr^2 + length^2 + sqrt(length * dcolor): the new
+                // vertex at the edge's midpoint (its Fig. 2), Gerr its distance to the closest
+                // point of the input surface.
+                let v = scale(add(pa, pb), 0.5);
+                let gerr = self.surface.as_ref().map_or(0.0, |s| s.distance(v));
                 let dc = len(sub(self.color[a as usize], self.color[b as usize]));
-                (v, gerr2 + len2 + libm::sqrt(libm::sqrt(len2) * dc))
+                (v, gerr * gerr + len2 + libm::sqrt(libm::sqrt(len2) * dc))
             }
         }
     }

@@ -9,7 +9,8 @@
 //!
 //! Costs ([`Cost`]): the quadric error metric with optimal placement (the LOD lecture; default),
 //! the shortest edge (merge-tree paper), and the importance paper's colour-aware
-//! `Gerr^2 + length^2 + sqrt(length * dcolor)`. With [`BuildOptions::balanced`], the merge-tree
+//! `Gerr^2 + length^2 + sqrt(length * dcolor)` (with `Gerr` the exact distance to the input
+//! surface, found through a grid of its triangles). With [`BuildOptions::balanced`], the merge-tree
 //! paper's region-of-influence marking keeps the forest shallow: a triangle touched by a collapse
 //! blocks further collapses around it until no unblocked collapse is left.
 //!
@@ -38,6 +39,7 @@
 //! ```
 
 mod attributes;
+mod closest;
 mod collapse;
 mod input;
 mod quadric;
@@ -60,7 +62,9 @@ pub enum Cost {
     Quadric,
     /// Shortest edge first, merged at its midpoint (merge-tree paper §3.1).
     ShortestEdge,
-    /// The importance paper's colour-aware cost `Gerr^2 + length^2 + sqrt(length * dcolor)`.
+    /// The importance paper's colour-aware cost `Gerr^2 + length^2 + sqrt(length * dcolor)`:
+    /// the merged vertex at the edge's midpoint, `Gerr` its distance to the closest point of
+    /// the input surface, `dcolor` the RGB distance of the two colours (0..1 per channel).
     Color,
 }
 
