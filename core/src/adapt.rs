@@ -689,7 +689,12 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                         self.list_all_pairs(h, view, policy, &mut frame.stats);
                         listed = true;
                     }
-                    let freed = self.trade(h, budget, f32::from_bits(bits), &mut traded, frame);
+                    // A triangle's demand falls when a neighbour splits, so a policy that
+                    // judges triangles trades only for twice the error (else the cut never
+                    // settles under a binding budget).
+                    let margin = if policy.judges_triangles() { 0.5 } else { 1.0 };
+                    let error = f32::from_bits(bits) * margin;
+                    let freed = self.trade(h, budget, error, &mut traded, frame);
                     if freed && self.candidates.heap_push((bits, v)).is_ok() {
                         continue;
                     }

@@ -385,6 +385,19 @@ mod adapt {
         // Judged from the triangles a collapse would make, nothing the view wants is undone.
         let again = cut.adapt(&h, &view, &policy, &Budget::default());
         assert_eq!((again.vsplits, again.ecols), (0, 0));
+        // Under a binding budget the cut settles too (a split's neighbours want less after it,
+        // so trades need a margin): after a few frames, at most 1% of the triangles change.
+        let budget = Budget {
+            max_triangles: (n * 3 / 4) as u32,
+            ..Budget::default()
+        };
+        let mut last = again;
+        for _ in 0..12 {
+            last = cut.adapt(&h, &view, &policy, &budget);
+            assert!(last.triangles <= budget.max_triangles, "{last:?}");
+        }
+        assert!(last.budget_limited, "{last:?}");
+        assert!((last.vsplits + last.ecols) as usize * 100 <= n, "{last:?}");
     }
 
     #[test]
