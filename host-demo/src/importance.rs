@@ -202,14 +202,8 @@ fn sheet(panels: &[Panel], columns: usize) -> Result<Vec<u8>, String> {
     for (k, p) in panels.iter().enumerate() {
         let (x0, y0) = ((k % columns) * WIDTH, (k / columns) * HEIGHT);
         let text = p.caption.as_str();
-        label::draw(
-            &mut pixmap,
-            text,
-            x0 as f32 + 6.0,
-            y0 as f32 + 6.0,
-            2.0,
-            (235, 235, 235),
-        );
+        let (x, y) = (x0 as f32 + 6.0, y0 as f32 + 6.0);
+        label::draw(&mut pixmap, text, x, y, 2.0, (235, 235, 235));
     }
     pixmap.encode_png().map_err(|e| e.to_string())
 }
