@@ -15,4 +15,5 @@ pub mod mesh;
 pub mod render;
 pub mod repair;
 pub mod terrain;
+pub mod terrain_engines;
 pub mod wavelet;

@@ -21,6 +21,7 @@ use vdlod_demo::mesh::Bounds;
 use vdlod_demo::mesh::{self, load_obj_bytes, IndexedMesh, LoadOptions, Up, BUNNY_NAME, BUNNY_OBJ};
 use vdlod_demo::render::{render_orbit, RenderOptions};
 use vdlod_demo::terrain::{self, FlyOver, Terrain};
+use vdlod_demo::terrain_engines;
 use vdlod_demo::wavelet;
 use vdlod_raster::Shading;
 
@@ -216,6 +217,9 @@ enum Experiment {
     /// and 10% with its colour cost and with QEM, then refined with its importance test at its
     /// threshold of 0.3; the figure set and PSNR against full detail.
     Terrain,
+    /// Both engines (wavelets, vertex forest) on one 257 x 257 terrain's fly-over at equal
+    /// triangle counts: PSNR, new triangles per frame, adaptation time, file and cut sizes.
+    TerrainEngines,
 }
 
 #[derive(clap::Args)]
@@ -861,6 +865,13 @@ fn reproduce(args: ReproduceArgs) -> Result<(), String> {
         Experiment::Fig10 => ("fig10", wavelet::fig10(&args.out.join("fig10"))?),
         Experiment::Engines => ("engines", wavelet::engines(&args.out.join("engines"))?),
         Experiment::Terrain => ("terrain", importance::terrain(&args.out.join("terrain"))?),
+        Experiment::TerrainEngines => (
+            "terrain-engines",
+            terrain_engines::terrain_engines(
+                &args.out.join("terrain-engines"),
+                terrain_engines::Setup::REPRODUCE,
+            )?,
+        ),
     };
     for line in lines {
         say!("{line}");

@@ -13,6 +13,8 @@ use std::fmt;
 
 use glam::Vec3;
 
+use vdlod_core::wavelet::build::SemiRegular;
+
 use crate::camera::Camera;
 use crate::mesh::{vertex_normals, IndexedMesh};
 
@@ -318,6 +320,49 @@ impl Terrain {
         }
     }
 
+    /// The grid as a semi-regular mesh for the wavelet engine, when it is square with `2^k + 1`
+    /// samples a side (`k` from 1 to 12, so 3 x 3 to 4097 x 4097): two base triangles split along the same diagonal as
+    /// [`Terrain::mesh`]'s cells, subdivided `k` times, every vertex a sample (with its colour).
+    /// `None` for any other size.
+    ///
+    /// ```
+    /// use vdlod_demo::terrain::{Terrain, DEFAULT_VERTICAL_SCALE};
+    /// let t = Terrain::procedural(17, 7, DEFAULT_VERTICAL_SCALE);
+    /// let s = t.semi_regular().unwrap();
+    /// assert_eq!(s.positions.len(), 17 * 17);
+    /// assert_eq!(s.finest_triangles().len(), t.mesh().triangles.len());
+    /// assert!(Terrain::procedural(18, 7, DEFAULT_VERTICAL_SCALE).semi_regular().is_none());
+    /// ```
+    pub fn semi_regular(&self) -> Option<SemiRegular> {
+        let n = self.width - 1;
+        let levels = n.trailing_zeros();
+        if self.depth != self.width || !n.is_power_of_two() || !(1..=12).contains(&levels) {
+            return None;
+        }
+        let corners = [(0, 0), (n, 0), (0, n), (n, n)];
+        let at = |(c, r): (usize, usize)| [c as f32, self.heights[r * self.width + c], r as f32];
+        let base = corners.map(at);
+        let faces = [[0u32, 2, 1], [1, 2, 3]];
+        let mut samples: Vec<usize> = corners.iter().map(|&(c, r)| r * self.width + c).collect();
+        let mut mesh = SemiRegular::from_fn(&base, &faces, levels, |f, w| {
+            // Weights are in units of 1 / 2^levels = 1 / n of the base triangle.
+            let face = faces[f as usize].map(|v| corners[v as usize]);
+            let (mut c, mut r) = (0, 0);
+            for k in 0..3 {
+                c += w[k].max(0) as usize * face[k].0 / n;
+                r += w[k].max(0) as usize * face[k].1 / n;
+            }
+            samples.push(r * self.width + c);
+            at((c, r))
+        })
+        .ok()?;
+        mesh.colors = self
+            .colors
+            .as_ref()
+            .map(|colors| samples.iter().map(|&i| colors[i]).collect());
+        Some(mesh)
+    }
+
     /// The height at `(x, z)`, bilinear between samples, clamped to the grid.
     pub fn height_at(&self, x: f32, z: f32) -> f32 {
         let (w, d) = (self.width, self.depth);
@@ -582,6 +627,42 @@ mod tests {
             [240, 242, 246],
         ] {
             assert!(colors.contains(&biome), "{biome:?}");
+        }
+    }
+
+    #[test]
+    fn a_square_power_of_two_grid_is_the_same_mesh_in_the_wavelet_engine() {
+        let t = Terrain::procedural(33, 5, DEFAULT_VERTICAL_SCALE);
+        let grid = t.mesh();
+        let s = t.semi_regular().unwrap();
+        // The same triangles over the same samples, by position, and every sample's colour.
+        let key = |p: [f32; 3]| (p[0] as u32, p[2] as u32, p[1].to_bits());
+        let sorted = |positions: &[[f32; 3]], triangles: &[[u32; 3]]| {
+            let mut v: Vec<_> = triangles
+                .iter()
+                .map(|t| {
+                    let k = t.map(|i| key(positions[i as usize]));
+                    // The same cyclic order from its smallest corner.
+                    let m = (0..3).min_by_key(|&i| k[i]).unwrap_or(0);
+                    [k[m], k[(m + 1) % 3], k[(m + 2) % 3]]
+                })
+                .collect();
+            v.sort_unstable();
+            v
+        };
+        assert_eq!(
+            sorted(&s.positions, &s.finest_triangles()),
+            sorted(&grid.positions, &grid.triangles)
+        );
+        let colors = s.colors.as_ref().unwrap();
+        for (p, c) in s.positions.iter().zip(colors) {
+            let i = p[2] as usize * 33 + p[0] as usize;
+            assert_eq!(*c, t.colors.as_ref().unwrap()[i]);
+        }
+        // One level at least: 3 x 3 is the smallest.
+        for size in [2, 3, 32, 34] {
+            let other = Terrain::procedural(size, 5, DEFAULT_VERTICAL_SCALE);
+            assert_eq!(other.semi_regular().is_some(), size == 3, "{size}");
         }
     }
 }

@@ -525,12 +525,14 @@ pub fn fly_wavelets<P: Policy + Copy>(
     fly(&mut engine, full, cameras)
 }
 
-fn median(mut v: Vec<f64>) -> f64 {
+/// The median of `v` (0 when empty).
+pub(crate) fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
     v.get(v.len() / 2).copied().unwrap_or(0.0)
 }
 
-fn mean(v: impl Iterator<Item = f64>) -> f64 {
+/// The mean of `v` (0 when empty).
+pub(crate) fn mean(v: impl Iterator<Item = f64>) -> f64 {
     let (sum, n) = v.fold((0.0, 0usize), |(s, n), x| (s + x, n + 1));
     sum / n.max(1) as f64
 }

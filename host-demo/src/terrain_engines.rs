@@ -1,0 +1,302 @@
+//! Both engines on one terrain (`vdlod-demo reproduce terrain-engines`).
+//!
+//! A square grid of `2^k + 1` samples has subdivision connectivity, so the wavelet engine
+//! (Azuma et al., "View-dependent refinement of multiresolution meshes with subdivision
+//! connectivity", 2003) takes it as it is ([`Terrain::semi_regular`]), while the vertex forest
+//! builds its hierarchy from the same grid. Both fly the same low fly-over: the wavelet engine at
+//! a 1 px tolerance, the forest at 0.1 px under a budget of the wavelet engine's triangle count in
+//! each frame, so they are compared at equal triangles: PSNR against full detail, the share of
+//! triangles that are new in a frame (ROAM's measure of frame-to-frame coherence), adaptation
+//! time, file bytes per height sample and cut bytes per triangle of capacity.
+//!
+//! The colormap reaches the wavelet engine as a colour per vertex (one per sample), not as a
+//! texture over the parametric domain: the wavelet engine has no textures yet.
+
+use std::path::Path;
+use std::time::Instant;
+
+use vdlod::{Camera, Style, WaveletMesh};
+use vdlod_core::adapt::Budget;
+use vdlod_core::build::BuildOptions;
+use vdlod_core::cut::Cut;
+use vdlod_core::format::HierarchyView;
+use vdlod_core::policy::QRefine;
+use vdlod_core::wavelet::SemiRegularView;
+use vdlod_raster::Shading;
+
+use crate::chart::{self, Panel, BLUE, ORANGE};
+use crate::frame::Frame;
+use crate::hierarchy::build_with_progress;
+use crate::lod::psnr;
+use crate::render::style;
+use crate::terrain::{FlyOver, Terrain, DEFAULT_VERTICAL_SCALE};
+use crate::wavelet::{mean, median, DemoWaveletCut};
+
+/// The terrain's seed (the `terrain` command's default).
+const SEED: u32 = 1;
+/// The frames' size.
+const WIDTH: usize = 640;
+const HEIGHT: usize = 480;
+
+/// What to fly.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Setup {
+    /// Samples along each side of the procedural terrain: `2^k + 1`.
+    pub samples: usize,
+    /// Frames of the fly-over's loop.
+    pub frames: u32,
+}
+
+impl Setup {
+    /// The experiment `reproduce terrain-engines` runs: the `terrain` command's default terrain
+    /// (257 x 257), its loop in 720 frames (half a degree of the loop a frame, about 0.7
+    /// samples of flight: a smooth frame rate for a low flight).
+    pub const REPRODUCE: Setup = Setup {
+        samples: 257,
+        frames: 720,
+    };
+}
+
+/// The forest's cut: up to 32,000 triangles (the wavelet engine's, [`DemoWaveletCut`], holds
+/// 60,000).
+type ForestCut = Cut<16_000, 32_000, 2_000>;
+
+/// One engine's frame.
+#[derive(Clone, Copy, Debug, Default)]
+struct EngineFrame {
+    triangles: u32,
+    /// Triangles not in the previous frame's mesh.
+    new: u32,
+    adapt_us: f64,
+    psnr_db: f64,
+}
+
+/// A mesh's triangles over global vertex ids, each from its smallest corner, sorted.
+fn canonical(triangles: impl Iterator<Item = [u32; 3]>) -> Vec<[u32; 3]> {
+    let mut v: Vec<[u32; 3]> = triangles
+        .map(|t| {
+            let m = (0..3).min_by_key(|&i| t[i]).unwrap_or(0);
+            [t[m], t[(m + 1) % 3], t[(m + 2) % 3]]
+        })
+        .collect();
+    v.sort_unstable();
+    v
+}
+
+/// How many of `now` are not in `before` (both sorted).
+fn new_triangles(before: &[[u32; 3]], now: &[[u32; 3]]) -> u32 {
+    now.iter()
+        .filter(|t| before.binary_search(t).is_err())
+        .count() as u32
+}
+
+/// Runs the comparison, writing `terrain_engines.csv` and `terrain_engines.png` (new triangles
+/// and PSNR per frame) into `out`; returns one summary line per engine.
+pub fn terrain_engines(out: &Path, setup: Setup) -> Result<Vec<String>, String> {
+    std::fs::create_dir_all(out).map_err(|e| format!("{}: {e}", out.display()))?;
+    let Setup {
+        samples: side,
+        frames: count,
+    } = setup;
+    let land = Terrain::procedural(side, SEED, DEFAULT_VERTICAL_SCALE);
+    let samples = (side * side) as f64;
+    let semi = land
+        .semi_regular()
+        .ok_or("the terrain is not 2^k + 1 samples square")?;
+    let start = Instant::now();
+    let sbytes = semi.to_bytes().map_err(|e| e.to_string())?;
+    let wavelet_build_s = start.elapsed().as_secs_f64();
+    let s = SemiRegularView::parse(&sbytes).map_err(|e| e.to_string())?;
+    let mut full = land.mesh();
+    let (_, hbytes, forest_build_s) = build_with_progress(&full, &BuildOptions::default(), false)
+        .map_err(|e| format!("terrain: {e}"))?;
+    let h = HierarchyView::parse(&hbytes).map_err(|e| e.to_string())?;
+    full.reorder_for_locality();
+    let fly_over = FlyOver::new(&land, count, WIDTH, HEIGHT);
+    let cameras: Vec<Camera> = (0..count).map(|i| fly_over.camera(i)).collect();
+    let drawn = Style {
+        vertex_colors: true,
+        ..style(Shading::Gouraud, false)
+    };
+
+    let mut frame = Frame::new(WIDTH, HEIGHT).map_err(|e| e.to_string())?;
+    let mut wavelet = DemoWaveletCut::boxed();
+    wavelet.reset(&s).map_err(|e| e.to_string())?;
+    let mut forest = ForestCut::boxed();
+    forest.reset(&h).map_err(|e| e.to_string())?;
+    let (wavelet_policy, forest_policy) = (QRefine::new(1.0), QRefine::new(0.1));
+    let mut frames: Vec<[EngineFrame; 2]> = Vec::with_capacity(cameras.len());
+    let (mut wavelet_before, mut forest_before) = (Vec::new(), Vec::new());
+    for camera in &cameras {
+        frame
+            .draw(&full.as_raster_mesh(), &drawn.params(camera))
+            .map_err(|e| e.to_string())?;
+        let reference = frame.pixels().to_vec();
+
+        let start = Instant::now();
+        let stats = vdlod::adapt_wavelets(
+            &mut wavelet,
+            &s,
+            camera,
+            &wavelet_policy,
+            &Budget::default(),
+        )
+        .map_err(|e| e.to_string())?;
+        let adapt_us = start.elapsed().as_secs_f64() * 1e6;
+        frame
+            .draw_styled(&WaveletMesh::new(&wavelet, &s, true), camera, &drawn)
+            .map_err(|e| e.to_string())?;
+        let now = canonical(
+            wavelet
+                .triangles()
+                .iter()
+                .map(|t| t.map(|i| wavelet.vertex_id(i as usize))),
+        );
+        let w = EngineFrame {
+            triangles: stats.triangles,
+            new: new_triangles(&wavelet_before, &now),
+            adapt_us,
+            psnr_db: psnr(frame.pixels(), &reference),
+        };
+        wavelet_before = now;
+
+        let budget = Budget {
+            max_triangles: stats.triangles,
+            ..Budget::default()
+        };
+        let start = Instant::now();
+        let stats = vdlod::adapt(&mut forest, &h, camera, &forest_policy, &budget)
+            .map_err(|e| e.to_string())?;
+        let adapt_us = start.elapsed().as_secs_f64() * 1e6;
+        frame
+            .draw_cut(&forest, &h, camera, &drawn)
+            .map_err(|e| e.to_string())?;
+        let nodes = forest.nodes();
+        let now = canonical(
+            forest
+                .triangles()
+                .iter()
+                .map(|t| t.map(|i| nodes[i as usize])),
+        );
+        let f = EngineFrame {
+            triangles: stats.triangles,
+            new: new_triangles(&forest_before, &now),
+            adapt_us,
+            psnr_db: psnr(frame.pixels(), &reference),
+        };
+        forest_before = now;
+        frames.push([w, f]);
+    }
+
+    let mut csv = String::from("frame,wavelet_triangles,forest_triangles,wavelet_new,forest_new,wavelet_adapt_us,forest_adapt_us,wavelet_psnr_db,forest_psnr_db\n");
+    for (i, [w, f]) in frames.iter().enumerate() {
+        csv.push_str(&format!(
+            "{i},{},{},{},{},{:.1},{:.1},{:.2},{:.2}\n",
+            w.triangles, f.triangles, w.new, f.new, w.adapt_us, f.adapt_us, w.psnr_db, f.psnr_db
+        ));
+    }
+    let path = out.join("terrain_engines.csv");
+    std::fs::write(&path, csv).map_err(|e| format!("{}: cannot write: {e}", path.display()))?;
+    let series = |k: usize, f: fn(&EngineFrame) -> f64| -> Vec<f64> {
+        frames.iter().skip(1).map(|x| f(&x[k])).collect()
+    };
+    let new_pct = |f: &EngineFrame| 100.0 * f.new as f64 / f.triangles.max(1) as f64;
+    let psnr_db = |f: &EngineFrame| f.psnr_db.min(99.0);
+    let png = chart::panels(&[
+        Panel {
+            title: vec![
+                ("percent new triangles per frame: wavelets", BLUE),
+                (", vertex forest", ORANGE),
+            ],
+            series: vec![(series(0, new_pct), BLUE), (series(1, new_pct), ORANGE)],
+        },
+        Panel {
+            title: vec![("PSNR dB: wavelets", BLUE), (", vertex forest", ORANGE)],
+            series: vec![(series(0, psnr_db), BLUE), (series(1, psnr_db), ORANGE)],
+        },
+    ])?;
+    let path = out.join("terrain_engines.png");
+    std::fs::write(&path, png).map_err(|e| format!("{}: cannot write: {e}", path.display()))?;
+
+    let engines = [
+        (
+            "wavelet",
+            sbytes.len(),
+            DemoWaveletCut::BYTES,
+            60_000,
+            wavelet_build_s,
+        ),
+        (
+            "forest",
+            hbytes.len(),
+            ForestCut::BYTES,
+            32_000,
+            forest_build_s,
+        ),
+    ];
+    let mut lines = Vec::new();
+    for (k, (engine, file, cut, capacity, build_s)) in engines.into_iter().enumerate() {
+        // The first frame starts from the base mesh: the others show coherence.
+        let after_first = || frames.iter().skip(1).map(|f| f[k]);
+        let new_pct: Vec<f64> = after_first()
+            .map(|f| 100.0 * f.new as f64 / f.triangles.max(1) as f64)
+            .collect();
+        lines.push(format!(
+            "experiment=terrain-engines engine={engine} grid={side}x{side} frames={count} triangles_mean={:.0} psnr_db_mean={:.2} new_triangles_pct_median={:.2} new_triangles_pct_max={:.2} adapt_us_median={:.0} build_s={build_s:.2} file_bytes_per_sample={:.2} cut_bytes_per_triangle={:.1}",
+            mean(after_first().map(|f| f.triangles as f64)),
+            mean(after_first().map(|f| f.psnr_db.min(99.0))),
+            median(new_pct.clone()),
+            new_pct.iter().copied().fold(0.0, f64::max),
+            median(after_first().map(|f| f.adapt_us).collect()),
+            file as f64 / samples,
+            cut as f64 / capacity as f64,
+        ));
+    }
+    Ok(lines)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn field(line: &str, key: &str) -> f64 {
+        line.split(' ')
+            .find_map(|kv| kv.strip_prefix(key)?.strip_prefix('='))
+            .and_then(|v| v.parse().ok())
+            .unwrap_or_else(|| panic!("no {key} in {line}"))
+    }
+
+    #[test]
+    fn both_engines_fly_the_same_terrain_at_equal_triangles() {
+        let out =
+            std::env::temp_dir().join(format!("vdlod_terrain_engines_{}", std::process::id()));
+        let setup = Setup {
+            samples: 65,
+            frames: 24,
+        };
+        let lines = terrain_engines(&out, setup).unwrap();
+        assert_eq!(lines.len(), 2);
+        let (w, f) = (&lines[0], &lines[1]);
+        assert!(w.contains("engine=wavelet") && f.contains("engine=forest"));
+        // The forest runs under the wavelet engine's count, at a finer tolerance: the same
+        // triangles in every frame (a split adds two, so it may stop one short).
+        let csv = std::fs::read_to_string(out.join("terrain_engines.csv")).unwrap();
+        for row in csv.lines().skip(1) {
+            let v: Vec<&str> = row.split(',').collect();
+            let (wavelet, forest): (u32, u32) = (v[1].parse().unwrap(), v[2].parse().unwrap());
+            assert!(forest <= wavelet && forest + 1 >= wavelet, "{row}");
+            let new: u32 = v[3].parse().unwrap();
+            assert!(new <= v[1].parse().unwrap());
+        }
+        assert!((field(w, "triangles_mean") - field(f, "triangles_mean")).abs() <= 1.0);
+        // Heights on a grid need no connectivity: the wavelet file is the smaller.
+        assert!(field(w, "file_bytes_per_sample") < field(f, "file_bytes_per_sample"));
+        for line in &lines {
+            let pct = field(line, "new_triangles_pct_median");
+            assert!((0.0..=100.0).contains(&pct), "{line}");
+            assert!(field(line, "psnr_db_mean") > 20.0, "{line}");
+        }
+        assert!(out.join("terrain_engines.png").exists());
+        std::fs::remove_dir_all(&out).unwrap();
+    }
+}
