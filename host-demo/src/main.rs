@@ -220,6 +220,10 @@ enum Experiment {
     /// Both engines (wavelets, vertex forest) on one 257 x 257 terrain's fly-over at equal
     /// triangle counts: PSNR, new triangles per frame, adaptation time, file and cut sizes.
     TerrainEngines,
+    /// Both engines on a 1025 x 1025 terrain at Lindstrom et al.'s tolerances (0.5, 1, 2,
+    /// 4 px): triangles and the share of pixels differing from full detail (takes minutes and
+    /// about 1.5 GB).
+    TerrainTolerances,
 }
 
 #[derive(clap::Args)]
@@ -871,6 +875,10 @@ fn reproduce(args: ReproduceArgs) -> Result<(), String> {
                 &args.out.join("terrain-engines"),
                 terrain_engines::Setup::REPRODUCE,
             )?,
+        ),
+        Experiment::TerrainTolerances => (
+            "terrain-tolerances",
+            terrain_engines::tolerances(&args.out.join("terrain-tolerances"), 1025, 36)?,
         ),
     };
     for line in lines {

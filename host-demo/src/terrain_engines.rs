@@ -11,6 +11,12 @@
 //!
 //! The colormap reaches the wavelet engine as a colour per vertex (one per sample), not as a
 //! texture over the parametric domain: the wavelet engine has no textures yet.
+//!
+//! [`tolerances`] (`vdlod-demo reproduce terrain-tolerances`) sets both engines beside the
+//! anchor of Lindstrom et al. ("Real-time, continuous level of detail rendering of height
+//! fields", 1996): at 0.5, 1, 2 and 4 px they keep 62,497, 23,287, 8,612 and 3,385 polygons of a
+//! 13.3M-triangle terrain with under 5% of the pixels differing from full detail; here, the
+//! triangles and the share of differing pixels on our largest procedural terrain.
 
 use std::path::Path;
 use std::time::Instant;
@@ -21,7 +27,7 @@ use vdlod_core::build::BuildOptions;
 use vdlod_core::cut::Cut;
 use vdlod_core::format::HierarchyView;
 use vdlod_core::policy::QRefine;
-use vdlod_core::wavelet::SemiRegularView;
+use vdlod_core::wavelet::{SemiRegularView, WaveletCut};
 use vdlod_raster::Shading;
 
 use crate::chart::{self, Panel, BLUE, ORANGE};
@@ -255,6 +261,102 @@ pub fn terrain_engines(out: &Path, setup: Setup) -> Result<Vec<String>, String> 
     Ok(lines)
 }
 
+/// Lindstrom et al.'s tolerances, in pixels, and the polygons they kept at each.
+pub const LINDSTROM: [(f32, u32); 4] = [(0.5, 62_497), (1.0, 23_287), (2.0, 8_612), (4.0, 3_385)];
+
+/// Cuts big enough for a 1025 x 1025 terrain at 0.5 px (32-bit indices).
+type BigWaveletCut = WaveletCut<32_832, 400_000, 200_000, 32_768, u32>;
+type BigForestCut = Cut<200_000, 400_000, 25_000, u32>;
+
+/// Flies both engines over the `samples`-square terrain's fly-over (`frames` views) at each of
+/// [`LINDSTROM`]'s tolerances, without a budget; returns one line per engine and tolerance:
+/// mean triangles, and the mean share of pixels that differ at all from full detail.
+pub fn tolerances(out: &Path, samples: usize, frames: u32) -> Result<Vec<String>, String> {
+    std::fs::create_dir_all(out).map_err(|e| format!("{}: {e}", out.display()))?;
+    let land = Terrain::procedural(samples, SEED, DEFAULT_VERTICAL_SCALE);
+    let semi = land
+        .semi_regular()
+        .ok_or("the terrain is not 2^k + 1 samples square")?;
+    let sbytes = semi.to_bytes().map_err(|e| e.to_string())?;
+    drop(semi);
+    let s = SemiRegularView::parse(&sbytes).map_err(|e| e.to_string())?;
+    let mut full = land.mesh();
+    let show = std::io::IsTerminal::is_terminal(&std::io::stderr());
+    let (_, hbytes, _) = build_with_progress(&full, &BuildOptions::default(), show)
+        .map_err(|e| format!("terrain: {e}"))?;
+    let h = HierarchyView::parse(&hbytes).map_err(|e| e.to_string())?;
+    full.reorder_for_locality();
+    let fly_over = FlyOver::new(&land, frames, WIDTH, HEIGHT);
+    let cameras: Vec<Camera> = (0..frames).map(|i| fly_over.camera(i)).collect();
+    let drawn = Style {
+        vertex_colors: true,
+        ..style(Shading::Gouraud, false)
+    };
+    let mut frame = Frame::new(WIDTH, HEIGHT).map_err(|e| e.to_string())?;
+    let mut references = Vec::with_capacity(cameras.len());
+    for camera in &cameras {
+        frame
+            .draw(&full.as_raster_mesh(), &drawn.params(camera))
+            .map_err(|e| e.to_string())?;
+        references.push(frame.pixels().to_vec());
+    }
+    let differing = |a: &[vdlod_raster::Rgba8], b: &[vdlod_raster::Rgba8]| {
+        100.0 * a.iter().zip(b).filter(|(x, y)| x != y).count() as f64 / a.len().max(1) as f64
+    };
+    let mut wavelet = BigWaveletCut::boxed();
+    let mut forest = BigForestCut::boxed();
+    let mut lines = Vec::new();
+    let mut csv = String::from("engine,tolerance_px,frame,triangles,differing_pct,psnr_db\n");
+    for (tau, paper) in LINDSTROM {
+        let policy = QRefine::new(tau);
+        wavelet.reset(&s).map_err(|e| e.to_string())?;
+        forest.reset(&h).map_err(|e| e.to_string())?;
+        let mut rows: [Vec<(u32, f64, f64, bool)>; 2] = [Vec::new(), Vec::new()];
+        for (i, camera) in cameras.iter().enumerate() {
+            let w = vdlod::adapt_wavelets(&mut wavelet, &s, camera, &policy, &Budget::default())
+                .map_err(|e| e.to_string())?;
+            frame
+                .draw_styled(&WaveletMesh::new(&wavelet, &s, true), camera, &drawn)
+                .map_err(|e| e.to_string())?;
+            let (d, p) = (
+                differing(frame.pixels(), &references[i]),
+                psnr(frame.pixels(), &references[i]),
+            );
+            rows[0].push((w.triangles, d, p, w.capacity_limited));
+            let f = vdlod::adapt(&mut forest, &h, camera, &policy, &Budget::default())
+                .map_err(|e| e.to_string())?;
+            frame
+                .draw_cut(&forest, &h, camera, &drawn)
+                .map_err(|e| e.to_string())?;
+            let (d, p) = (
+                differing(frame.pixels(), &references[i]),
+                psnr(frame.pixels(), &references[i]),
+            );
+            rows[1].push((f.triangles, d, p, f.capacity_limited || f.queue_overflow));
+        }
+        for (k, engine) in ["wavelet", "forest"].into_iter().enumerate() {
+            for (i, r) in rows[k].iter().enumerate() {
+                csv.push_str(&format!(
+                    "{engine},{tau},{i},{},{:.3},{:.2}\n",
+                    r.0, r.1, r.2
+                ));
+            }
+            let limited = rows[k].iter().filter(|r| r.3).count();
+            lines.push(format!(
+                "experiment=terrain-tolerances engine={engine} grid={samples}x{samples} full_triangles={} frames={frames} tolerance_px={tau} triangles_mean={:.0} differing_pixels_pct_mean={:.2} differing_pixels_pct_max={:.2} psnr_db_mean={:.2} limited_frames={limited} lindstrom_polygons={paper} lindstrom_full_triangles=13300000 lindstrom_differing_pct_below=5",
+                full.triangles.len(),
+                mean(rows[k].iter().map(|r| r.0 as f64)),
+                mean(rows[k].iter().map(|r| r.1)),
+                rows[k].iter().map(|r| r.1).fold(0.0, f64::max),
+                mean(rows[k].iter().map(|r| r.2.min(99.0))),
+            ));
+        }
+    }
+    let path = out.join("terrain_tolerances.csv");
+    std::fs::write(&path, csv).map_err(|e| format!("{}: cannot write: {e}", path.display()))?;
+    Ok(lines)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -297,6 +399,35 @@ mod tests {
             assert!(field(line, "psnr_db_mean") > 20.0, "{line}");
         }
         assert!(out.join("terrain_engines.png").exists());
+        std::fs::remove_dir_all(&out).unwrap();
+    }
+
+    #[test]
+    fn coarser_tolerances_keep_fewer_triangles_and_differ_more() {
+        let out = std::env::temp_dir().join(format!("vdlod_tolerances_{}", std::process::id()));
+        let lines = tolerances(&out, 65, 6).unwrap();
+        assert_eq!(lines.len(), 8);
+        for engine in ["wavelet", "forest"] {
+            let of: Vec<&String> = lines
+                .iter()
+                .filter(|l| l.contains(&format!("engine={engine} ")))
+                .collect();
+            assert_eq!(of.len(), 4);
+            for pair in of.windows(2) {
+                let (fine, coarse) = (pair[0], pair[1]);
+                assert!(field(fine, "tolerance_px") < field(coarse, "tolerance_px"));
+                assert!(
+                    field(fine, "triangles_mean") >= field(coarse, "triangles_mean"),
+                    "{fine}\n{coarse}"
+                );
+            }
+            for l in &of {
+                let d = field(l, "differing_pixels_pct_mean");
+                assert!((0.0..=100.0).contains(&d), "{l}");
+                assert_eq!(field(l, "limited_frames"), 0.0, "{l}");
+            }
+        }
+        assert!(out.join("terrain_tolerances.csv").exists());
         std::fs::remove_dir_all(&out).unwrap();
     }
 }
