@@ -6,7 +6,7 @@ use std::io::Write as _;
 use std::path::Path;
 use std::time::Instant;
 
-use vdlod::Style;
+use vdlod::{Style, WaveletMesh};
 use vdlod_core::adapt::{Budget, FrameStats};
 use vdlod_core::cut::{Coloring, Cut, SlotIndex};
 use vdlod_core::format::HierarchyView;
@@ -14,6 +14,7 @@ use vdlod_core::policy::{
     Bounds as NodeBounds, Demand, Frustum, Importance, MergeTree, Policy, QRefine, ScreenError,
     View,
 };
+use vdlod_core::wavelet::{SemiRegularView, WaveletCut};
 use vdlod_raster::{Rgba8, Shading, VertexIndex};
 
 use crate::camera::{merge_tree_orbit, peer_orbit, Camera, Orbit};
@@ -22,6 +23,7 @@ use crate::frame::{encode_png, Frame, FrameError};
 use crate::label;
 use crate::mesh::{vertex_normals, Bounds, IndexedMesh};
 use crate::render::style;
+use crate::wavelet::DemoWaveletCut;
 
 /// Calls `$body` with `$cut` bound to a new boxed cut of the smallest capacity class that holds
 /// `$vertices` vertices and `$triangles` triangles: 16-bit cuts up to 32,767 vertices and 65,534
@@ -295,8 +297,10 @@ impl Policy for DemoPolicy {
     }
 }
 
-/// The policy for `choice` on the model `h` holds.
-pub fn make_policy(choice: PolicyChoice, h: &HierarchyView<'_>) -> DemoPolicy {
+/// The policy for `choice` on a model in the box `(min, max)` (its diagonal sizes the
+/// importance test).
+pub fn make_policy(choice: PolicyChoice, (min, max): ([f32; 3], [f32; 3])) -> DemoPolicy {
+    let size = libm::sqrtf((0..3).map(|k| (max[k] - min[k]) * (max[k] - min[k])).sum());
     match choice {
         PolicyChoice::Screen {
             silhouette,
@@ -311,7 +315,7 @@ pub fn make_policy(choice: PolicyChoice, h: &HierarchyView<'_>) -> DemoPolicy {
             near: f32::INFINITY,
         }),
         PolicyChoice::Importance { threshold } => {
-            DemoPolicy::Importance((Frustum, Importance::for_model(threshold, h)))
+            DemoPolicy::Importance((Frustum, Importance::new(threshold, size)))
         }
     }
 }
@@ -503,28 +507,179 @@ pub fn run_orbit(
     out_dir: &Path,
     mut report: impl FnMut(&OrbitFrame),
 ) -> Result<OrbitSummary, String> {
+    if bytes.starts_with(&vdlod_core::wavelet::format::MAGIC) {
+        let s = SemiRegularView::parse(bytes).map_err(|e| e.to_string())?;
+        if opts.depth_colors {
+            return Err("--depth-colors needs the vertex forest (a .vdh file or a mesh)".into());
+        }
+        let triangles = s
+            .counts()
+            .finest_faces()
+            .min(opts.budget.max_triangles as u64);
+        if s.wavelets() <= 8192 * 32 && triangles <= 60_000 {
+            let mut cut = DemoWaveletCut::boxed();
+            let engine = Wavelets::new(&s, &mut cut, opts)?;
+            return fly_orbit(engine, full, opts, out_dir, &mut report);
+        }
+        let mut cut = LargeWaveletCut::boxed();
+        let engine = Wavelets::new(&s, &mut cut, opts)?;
+        return fly_orbit(engine, full, opts, out_dir, &mut report);
+    }
     let h = HierarchyView::parse(bytes).map_err(|e| e.to_string())?;
     let (v, f) = cut_size(&h, opts.budget.max_triangles);
-    with_cut!(v, f, |cut| fly_orbit(
-        &h,
-        &mut cut,
-        full,
-        opts,
-        out_dir,
-        &mut report
-    ))
+    with_cut!(v, f, |cut| {
+        let engine = Forest::new(h, &mut cut, opts)?;
+        fly_orbit(engine, full, opts, out_dir, &mut report)
+    })
 }
 
-/// [`run_orbit`] with its cut.
-fn fly_orbit<const V: usize, const F: usize, const Q: usize, I: SlotIndex + VertexIndex>(
-    h: &HierarchyView<'_>,
-    cut: &mut Cut<V, F, Q, I>,
+/// The wavelet engine's cut for files beyond [`DemoWaveletCut`]: up to 4M wavelets and 2^20
+/// triangles, 32-bit indices.
+type LargeWaveletCut = WaveletCut<{ 1 << 17 }, { 1 << 20 }, { 1 << 19 }, { 1 << 15 }, u32>;
+
+/// What a flight needs of an engine: the vertex forest ([`Forest`]) or the wavelet engine
+/// ([`Wavelets`]), set up for the flight's options.
+trait FlightEngine {
+    /// Triangles of the coarsest mesh.
+    fn base_triangles(&self) -> u32;
+    /// Whether the file has colours.
+    fn has_colors(&self) -> bool;
+    /// The model's bounding box.
+    fn bounding_box(&self) -> ([f32; 3], [f32; 3]);
+    fn adapt(&mut self, view: &View, policy: &DemoPolicy, budget: &Budget) -> FrameStats;
+    fn draw(&self, frame: &mut Frame, camera: &Camera, style: &Style) -> Result<(), FrameError>;
+    /// Writes the current mesh as an OBJ file.
+    fn write_obj(&self, path: &Path) -> std::io::Result<()>;
+}
+
+/// The vertex forest in a flight.
+struct Forest<'a, 'h, const V: usize, const F: usize, const Q: usize, I: SlotIndex> {
+    h: HierarchyView<'h>,
+    cut: &'a mut Cut<V, F, Q, I>,
+}
+
+impl<'a, 'h, const V: usize, const F: usize, const Q: usize, I: SlotIndex>
+    Forest<'a, 'h, V, F, Q, I>
+{
+    fn new(
+        h: HierarchyView<'h>,
+        cut: &'a mut Cut<V, F, Q, I>,
+        opts: &OrbitOptions,
+    ) -> Result<Self, String> {
+        cut.set_coloring(if opts.depth_colors {
+            Coloring::Depth
+        } else {
+            Coloring::Node
+        });
+        cut.reset(&h).map_err(|e| e.to_string())?;
+        cut.set_geomorph_frames(opts.geomorph_frames);
+        Ok(Forest { h, cut })
+    }
+}
+
+impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex + VertexIndex> FlightEngine
+    for Forest<'_, '_, V, F, Q, I>
+{
+    fn base_triangles(&self) -> u32 {
+        self.h.base_triangles()
+    }
+
+    fn has_colors(&self) -> bool {
+        self.h.has_colors()
+    }
+
+    fn bounding_box(&self) -> ([f32; 3], [f32; 3]) {
+        self.h.bounding_box()
+    }
+
+    fn adapt(&mut self, view: &View, policy: &DemoPolicy, budget: &Budget) -> FrameStats {
+        self.cut.adapt(&self.h, view, policy, budget)
+    }
+
+    fn draw(&self, frame: &mut Frame, camera: &Camera, style: &Style) -> Result<(), FrameError> {
+        frame.draw_cut(self.cut, &self.h, camera, style).map(|_| ())
+    }
+
+    fn write_obj(&self, path: &Path) -> std::io::Result<()> {
+        write_obj(path, self.cut, &self.h)
+    }
+}
+
+/// The wavelet engine in a flight.
+struct Wavelets<
+    'a,
+    's,
+    const W: usize,
+    const T: usize,
+    const V: usize,
+    const Q: usize,
+    I: SlotIndex,
+> {
+    s: SemiRegularView<'s>,
+    cut: &'a mut WaveletCut<W, T, V, Q, I>,
+}
+
+impl<'a, 's, const W: usize, const T: usize, const V: usize, const Q: usize, I: SlotIndex>
+    Wavelets<'a, 's, W, T, V, Q, I>
+{
+    fn new(
+        s: &SemiRegularView<'s>,
+        cut: &'a mut WaveletCut<W, T, V, Q, I>,
+        opts: &OrbitOptions,
+    ) -> Result<Self, String> {
+        cut.reset(s).map_err(|e| e.to_string())?;
+        cut.set_geomorph_frames(opts.geomorph_frames);
+        Ok(Wavelets { s: *s, cut })
+    }
+}
+
+impl<const W: usize, const T: usize, const V: usize, const Q: usize, I> FlightEngine
+    for Wavelets<'_, '_, W, T, V, Q, I>
+where
+    I: SlotIndex + VertexIndex,
+{
+    fn base_triangles(&self) -> u32 {
+        self.s.counts().base_faces
+    }
+
+    fn has_colors(&self) -> bool {
+        self.s.has_colors()
+    }
+
+    fn bounding_box(&self) -> ([f32; 3], [f32; 3]) {
+        self.s.bounding_box()
+    }
+
+    fn adapt(&mut self, view: &View, policy: &DemoPolicy, budget: &Budget) -> FrameStats {
+        self.cut.adapt(&self.s, view, policy, budget)
+    }
+
+    fn draw(&self, frame: &mut Frame, camera: &Camera, style: &Style) -> Result<(), FrameError> {
+        let mesh = WaveletMesh::new(self.cut, &self.s, style.vertex_colors);
+        frame.draw_styled(&mesh, camera, style).map(|_| ())
+    }
+
+    fn write_obj(&self, path: &Path) -> std::io::Result<()> {
+        let positions: Vec<[f32; 3]> = (0..self.cut.vertex_count())
+            .map(|i| self.cut.position(i))
+            .collect();
+        let triangles = self
+            .cut
+            .triangles()
+            .iter()
+            .map(|t| t.map(|i| i.index() as u32));
+        std::fs::write(path, crate::mesh::obj_text(&positions, None, triangles))
+    }
+}
+
+/// [`run_orbit`] with its engine.
+fn fly_orbit(
+    mut engine: impl FlightEngine,
     full: &IndexedMesh,
     opts: &OrbitOptions,
     out_dir: &Path,
     report: &mut impl FnMut(&OrbitFrame),
 ) -> Result<OrbitSummary, String> {
-    let h = *h;
     let io = |e: std::io::Error| format!("{}: {e}", out_dir.display());
     std::fs::create_dir_all(out_dir).map_err(io)?;
     // Only what this run writes is cleaned: frames (and meshes) past its last one.
@@ -534,17 +689,10 @@ fn fly_orbit<const V: usize, const F: usize, const Q: usize, I: SlotIndex + Vert
         .map(|(prefix, _)| (prefix, opts.frames))
         .collect();
     crate::render::remove_stale(out_dir, &stale).map_err(io)?;
-    cut.set_coloring(if opts.depth_colors {
-        Coloring::Depth
-    } else {
-        Coloring::Node
-    });
-    cut.reset(&h).map_err(|e| e.to_string())?;
-    cut.set_geomorph_frames(opts.geomorph_frames);
     // The comparison with full detail uses the mesh's own colours; false colours, the wireframe
     // and the observer's view are drawn after it, for the pictures only.
-    let true_colors = h.has_colors() && !opts.depth_colors;
-    let colors = opts.depth_colors || h.has_colors();
+    let true_colors = engine.has_colors() && !opts.depth_colors;
+    let colors = opts.depth_colors || engine.has_colors();
     let picture = opts.depth_colors || opts.wireframe || opts.observer;
     let bounds = full.bounds();
     let orbit = if opts.peer_orbit {
@@ -552,7 +700,7 @@ fn fly_orbit<const V: usize, const F: usize, const Q: usize, I: SlotIndex + Vert
     } else {
         merge_tree_orbit(&bounds, opts.frames, opts.width, opts.height)
     };
-    let policy = make_policy(opts.policy, &h);
+    let policy = make_policy(opts.policy, engine.bounding_box());
     let mut frame = Frame::new(opts.width, opts.height).map_err(|e| e.to_string())?;
     let mut reference = Frame::new(opts.width, opts.height).map_err(|e| e.to_string())?;
     let full_mesh = full.as_raster_mesh();
@@ -570,13 +718,13 @@ fn fly_orbit<const V: usize, const F: usize, const Q: usize, I: SlotIndex + Vert
         let camera = camera_of(i);
         let view = camera.view_scaled(opts.frustum);
         let start = Instant::now();
-        let stats = cut.adapt(&h, &view, &policy, &opts.budget);
-        if stats.over_budget && !warned && h.base_triangles() > opts.budget.max_triangles {
+        let stats = engine.adapt(&view, &policy, &opts.budget);
+        let base = engine.base_triangles();
+        if stats.over_budget && !warned && base > opts.budget.max_triangles {
             eprintln!(
                 "vdlod-demo: warning: the base mesh has {} triangles, more than the budget of {}: \
                  no cut of this hierarchy fits it",
-                h.base_triangles(),
-                opts.budget.max_triangles
+                base, opts.budget.max_triangles
             );
             warned = true;
         }
@@ -587,8 +735,8 @@ fn fly_orbit<const V: usize, const F: usize, const Q: usize, I: SlotIndex + Vert
         };
         let params = drawn.params(&camera);
         let start = Instant::now();
-        frame
-            .draw_cut(cut, &h, &camera, &drawn)
+        engine
+            .draw(&mut frame, &camera, &drawn)
             .map_err(|e| e.to_string())?;
         let render_us = start.elapsed().as_secs_f64() * 1e6;
         let start = Instant::now();
@@ -626,8 +774,8 @@ fn fly_orbit<const V: usize, const F: usize, const Q: usize, I: SlotIndex + Vert
                 vertex_colors: colors,
                 ..style(Shading::Gouraud, opts.wireframe)
             };
-            frame
-                .draw_cut(cut, &h, &seen_from, &drawn)
+            engine
+                .draw(&mut frame, &seen_from, &drawn)
                 .map_err(|e| e.to_string())?;
         }
         if opts.write_frames {
@@ -636,7 +784,9 @@ fn fly_orbit<const V: usize, const F: usize, const Q: usize, I: SlotIndex + Vert
                 .map_err(|e| e.to_string())?;
         }
         if opts.dump_mesh {
-            write_obj(&out_dir.join(format!("mesh_{i:04}.obj")), cut, &h).map_err(io)?;
+            engine
+                .write_obj(&out_dir.join(format!("mesh_{i:04}.obj")))
+                .map_err(io)?;
         }
         let _ = writeln!(
             csv,

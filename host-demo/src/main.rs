@@ -432,8 +432,8 @@ impl FlightArgs {
 
 #[derive(clap::Args)]
 struct OrbitArgs {
-    /// Mesh file (OBJ, OFF, PLY or STL; its hierarchy is built first) or .vdh hierarchy
-    /// (default: the bundled bunny).
+    /// Mesh file (OBJ, OFF, PLY or STL; its hierarchy is built first), .vdh hierarchy, or .vdw
+    /// semi-regular file (flown by the wavelet engine) (default: the bundled bunny).
     mesh: Option<PathBuf>,
     #[command(flatten)]
     input: InputArgs,
@@ -480,8 +480,20 @@ struct TerrainArgs {
     /// Output directory.
     #[arg(long, short, default_value = "out/terrain")]
     out: PathBuf,
+    /// The engine: the vertex forest, or the wavelet engine (a square terrain of 2^k + 1
+    /// samples a side, taken as it is).
+    #[arg(long, value_enum, default_value = "forest")]
+    engine: EngineArg,
     #[command(flatten)]
     flight: FlightArgs,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum EngineArg {
+    /// The vertex forest: a hierarchy built by edge collapses.
+    Forest,
+    /// The wavelet engine: the grid's own subdivision connectivity.
+    Wavelet,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -547,13 +559,31 @@ fn load(mesh: Option<&PathBuf>, input: InputArgs) -> Result<(String, IndexedMesh
     Ok((name, loaded.mesh))
 }
 
-/// Whether the file is a vdlod hierarchy (by its first bytes, whatever its name).
-fn is_hierarchy(path: &Path) -> bool {
+/// The first four bytes of a file (zeros when it is shorter or unreadable).
+fn magic(path: &Path) -> [u8; 4] {
     use std::io::Read as _;
     let mut magic = [0u8; 4];
-    std::fs::File::open(path)
-        .and_then(|mut f| f.read_exact(&mut magic))
-        .is_ok_and(|()| magic == vdlod_core::format::MAGIC)
+    let _ = std::fs::File::open(path).and_then(|mut f| f.read_exact(&mut magic));
+    magic
+}
+
+/// Whether the file is a vdlod hierarchy (by its first bytes, whatever its name).
+fn is_hierarchy(path: &Path) -> bool {
+    magic(path) == vdlod_core::format::MAGIC
+}
+
+/// Whether the file is a vdlod semi-regular mesh (by its first bytes, whatever its name).
+fn is_semi_regular(path: &Path) -> bool {
+    magic(path) == vdlod_core::wavelet::format::MAGIC
+}
+
+/// The bytes and the finest level of a .vdw file.
+fn load_semi_regular(path: &Path) -> Result<(String, Vec<u8>, IndexedMesh), String> {
+    let bytes = std::fs::read(path).map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
+    let s = SemiRegularView::parse(&bytes).map_err(|e| format!("{}: {e}", path.display()))?;
+    let mut full = wavelet::finest_of(&s);
+    full.reorder_for_locality();
+    Ok((path.display().to_string(), bytes, full))
 }
 
 fn render(args: RenderArgs) -> Result<(), String> {
@@ -621,6 +651,9 @@ fn load_lod(
     if let Some(path) = mesh.filter(|p| is_hierarchy(p)) {
         return load_hierarchy(path);
     }
+    if let Some(path) = mesh.filter(|p| is_semi_regular(p)) {
+        return load_semi_regular(path);
+    }
     let (name, mut full) = load(mesh, input)?;
     let show = std::io::IsTerminal::is_terminal(&std::io::stderr());
     let (_, bytes, seconds) = hierarchy::build_with_progress(&full, &BuildOptions::default(), show)
@@ -658,13 +691,35 @@ fn terrain_command(args: TerrainArgs) -> Result<(), String> {
         ),
     };
     let mut full = land.mesh();
-    let show = std::io::IsTerminal::is_terminal(&std::io::stderr());
-    let (_, bytes, seconds) = hierarchy::build_with_progress(&full, &BuildOptions::default(), show)
-        .map_err(|e| format!("{name}: {e}"))?;
+    let start = std::time::Instant::now();
+    let bytes = match args.engine {
+        EngineArg::Forest => {
+            let show = std::io::IsTerminal::is_terminal(&std::io::stderr());
+            hierarchy::build_with_progress(&full, &BuildOptions::default(), show)
+                .map_err(|e| format!("{name}: {e}"))?
+                .1
+        }
+        EngineArg::Wavelet => land
+            .semi_regular()
+            .ok_or_else(|| {
+                format!(
+                    "{name}: the wavelet engine needs a square terrain of 2^k + 1 samples a side \
+                     (3, 5, 9, ..., 2049); this one is {} x {}",
+                    land.width, land.depth
+                )
+            })?
+            .to_bytes()
+            .map_err(|e| format!("{name}: {e}"))?,
+    };
     say!(
-        "{name}: {} x {} samples, hierarchy built in {seconds:.2} s",
+        "{name}: {} x {} samples, {} built in {:.2} s",
         land.width,
-        land.depth
+        land.depth,
+        match args.engine {
+            EngineArg::Forest => "hierarchy",
+            EngineArg::Wavelet => "semi-regular mesh",
+        },
+        start.elapsed().as_secs_f64()
     );
     full.reorder_for_locality();
     let path = match args.flight.path(&full.bounds())? {

@@ -22,13 +22,13 @@ use std::path::Path;
 use std::time::Instant;
 
 use vdlod::{Camera, Style, WaveletMesh};
-use vdlod_core::adapt::Budget;
+use vdlod_core::adapt::{Budget, FrameStats};
 use vdlod_core::build::BuildOptions;
 use vdlod_core::cut::Cut;
 use vdlod_core::format::HierarchyView;
 use vdlod_core::policy::QRefine;
 use vdlod_core::wavelet::{SemiRegularView, WaveletCut};
-use vdlod_raster::Shading;
+use vdlod_raster::{Rgba8, Shading};
 
 use crate::chart::{self, Panel, BLUE, ORANGE};
 use crate::frame::Frame;
@@ -261,6 +261,38 @@ pub fn terrain_engines(out: &Path, setup: Setup) -> Result<Vec<String>, String> 
     Ok(lines)
 }
 
+/// One engine's frame at one tolerance.
+struct Measured {
+    triangles: u32,
+    /// Percent of pixels that differ at all from full detail.
+    differing: f64,
+    /// Percent of pixels with a channel more than 16 levels (of 255) away.
+    differing_16: f64,
+    psnr_db: f64,
+    /// A capacity or queue limit was met.
+    limited: bool,
+}
+
+impl Measured {
+    fn of(stats: &FrameStats, pixels: &[Rgba8], reference: &[Rgba8]) -> Measured {
+        let share = |by: u8| {
+            let off = pixels
+                .iter()
+                .zip(reference)
+                .filter(|(x, y)| (0..3).any(|k| x.0[k].abs_diff(y.0[k]) > by))
+                .count();
+            100.0 * off as f64 / pixels.len().max(1) as f64
+        };
+        Measured {
+            triangles: stats.triangles,
+            differing: share(0),
+            differing_16: share(16),
+            psnr_db: psnr(pixels, reference),
+            limited: stats.capacity_limited || stats.queue_overflow,
+        }
+    }
+}
+
 /// Lindstrom et al.'s tolerances, in pixels, and the polygons they kept at each.
 pub const LINDSTROM: [(f32, u32); 4] = [(0.5, 62_497), (1.0, 23_287), (2.0, 8_612), (4.0, 3_385)];
 
@@ -270,7 +302,8 @@ type BigForestCut = Cut<200_000, 400_000, 25_000, u32>;
 
 /// Flies both engines over the `samples`-square terrain's fly-over (`frames` views) at each of
 /// [`LINDSTROM`]'s tolerances, without a budget; returns one line per engine and tolerance:
-/// mean triangles, and the mean share of pixels that differ at all from full detail.
+/// mean triangles, and the mean share of pixels that differ at all from full detail, and by
+/// more than 16 levels of 255 in a channel.
 pub fn tolerances(out: &Path, samples: usize, frames: u32) -> Result<Vec<String>, String> {
     std::fs::create_dir_all(out).map_err(|e| format!("{}: {e}", out.display()))?;
     let land = Terrain::procedural(samples, SEED, DEFAULT_VERTICAL_SCALE);
@@ -300,55 +333,48 @@ pub fn tolerances(out: &Path, samples: usize, frames: u32) -> Result<Vec<String>
             .map_err(|e| e.to_string())?;
         references.push(frame.pixels().to_vec());
     }
-    let differing = |a: &[vdlod_raster::Rgba8], b: &[vdlod_raster::Rgba8]| {
-        100.0 * a.iter().zip(b).filter(|(x, y)| x != y).count() as f64 / a.len().max(1) as f64
-    };
     let mut wavelet = BigWaveletCut::boxed();
     let mut forest = BigForestCut::boxed();
     let mut lines = Vec::new();
-    let mut csv = String::from("engine,tolerance_px,frame,triangles,differing_pct,psnr_db\n");
+    let mut csv = String::from(
+        "engine,tolerance_px,frame,triangles,differing_pct,differing_by_16_pct,psnr_db\n",
+    );
     for (tau, paper) in LINDSTROM {
         let policy = QRefine::new(tau);
         wavelet.reset(&s).map_err(|e| e.to_string())?;
         forest.reset(&h).map_err(|e| e.to_string())?;
-        let mut rows: [Vec<(u32, f64, f64, bool)>; 2] = [Vec::new(), Vec::new()];
-        for (i, camera) in cameras.iter().enumerate() {
+        let mut rows: [Vec<Measured>; 2] = [Vec::new(), Vec::new()];
+        for (camera, reference) in cameras.iter().zip(&references) {
             let w = vdlod::adapt_wavelets(&mut wavelet, &s, camera, &policy, &Budget::default())
                 .map_err(|e| e.to_string())?;
             frame
                 .draw_styled(&WaveletMesh::new(&wavelet, &s, true), camera, &drawn)
                 .map_err(|e| e.to_string())?;
-            let (d, p) = (
-                differing(frame.pixels(), &references[i]),
-                psnr(frame.pixels(), &references[i]),
-            );
-            rows[0].push((w.triangles, d, p, w.capacity_limited));
+            rows[0].push(Measured::of(&w, frame.pixels(), reference));
             let f = vdlod::adapt(&mut forest, &h, camera, &policy, &Budget::default())
                 .map_err(|e| e.to_string())?;
             frame
                 .draw_cut(&forest, &h, camera, &drawn)
                 .map_err(|e| e.to_string())?;
-            let (d, p) = (
-                differing(frame.pixels(), &references[i]),
-                psnr(frame.pixels(), &references[i]),
-            );
-            rows[1].push((f.triangles, d, p, f.capacity_limited || f.queue_overflow));
+            rows[1].push(Measured::of(&f, frame.pixels(), reference));
         }
         for (k, engine) in ["wavelet", "forest"].into_iter().enumerate() {
-            for (i, r) in rows[k].iter().enumerate() {
+            let rows = &rows[k];
+            for (i, r) in rows.iter().enumerate() {
                 csv.push_str(&format!(
-                    "{engine},{tau},{i},{},{:.3},{:.2}\n",
-                    r.0, r.1, r.2
+                    "{engine},{tau},{i},{},{:.3},{:.3},{:.2}\n",
+                    r.triangles, r.differing, r.differing_16, r.psnr_db
                 ));
             }
-            let limited = rows[k].iter().filter(|r| r.3).count();
+            let limited = rows.iter().filter(|r| r.limited).count();
             lines.push(format!(
-                "experiment=terrain-tolerances engine={engine} grid={samples}x{samples} full_triangles={} frames={frames} tolerance_px={tau} triangles_mean={:.0} differing_pixels_pct_mean={:.2} differing_pixels_pct_max={:.2} psnr_db_mean={:.2} limited_frames={limited} lindstrom_polygons={paper} lindstrom_full_triangles=13300000 lindstrom_differing_pct_below=5",
+                "experiment=terrain-tolerances engine={engine} grid={samples}x{samples} full_triangles={} frames={frames} tolerance_px={tau} triangles_mean={:.0} differing_pixels_pct_mean={:.2} differing_pixels_pct_max={:.2} differing_by_16_pct_mean={:.2} psnr_db_mean={:.2} limited_frames={limited} lindstrom_polygons={paper} lindstrom_full_triangles=13300000 lindstrom_differing_pct_below=5",
                 full.triangles.len(),
-                mean(rows[k].iter().map(|r| r.0 as f64)),
-                mean(rows[k].iter().map(|r| r.1)),
-                rows[k].iter().map(|r| r.1).fold(0.0, f64::max),
-                mean(rows[k].iter().map(|r| r.2.min(99.0))),
+                mean(rows.iter().map(|r| r.triangles as f64)),
+                mean(rows.iter().map(|r| r.differing)),
+                rows.iter().map(|r| r.differing).fold(0.0, f64::max),
+                mean(rows.iter().map(|r| r.differing_16)),
+                mean(rows.iter().map(|r| r.psnr_db.min(99.0))),
             ));
         }
     }

@@ -381,6 +381,20 @@ pub struct SessionFrame {
     pub psnr_db: f64,
 }
 
+/// The finest level of a semi-regular file, for drawing (with its colours, if it has them).
+pub fn finest_of(s: &SemiRegularView<'_>) -> IndexedMesh {
+    let positions: Vec<[f32; 3]> = (0..s.vertices()).map(|v| s.position(v)).collect();
+    let triangles = vdlod_core::wavelet::build::finest_triangles(s);
+    IndexedMesh {
+        normals: vertex_normals(&positions, &triangles),
+        colors: s
+            .has_colors()
+            .then(|| (0..s.vertices()).map(|v| s.color(v)).collect()),
+        positions,
+        triangles,
+    }
+}
+
 /// The full-detail mesh of a semi-regular mesh, for drawing.
 pub fn finest_mesh(mesh: &SemiRegular) -> IndexedMesh {
     let triangles = mesh.finest_triangles();

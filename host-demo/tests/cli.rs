@@ -797,3 +797,42 @@ fn terrain_flies_the_procedural_island_and_a_path_file() {
         assert!(stderr.contains("at most 10"), "{scale}: {stderr}");
     }
 }
+
+#[test]
+fn the_wavelet_engine_flies_terrains_paths_and_vdw_files() {
+    let dir = scratch_dir("cli_wavelet_flights");
+    let small = ["--width", "48", "--height", "32", "--frames", "3"];
+    let mut args = vec!["terrain", "--engine", "wavelet", "--size", "33", "-o", "t"];
+    args.extend_from_slice(&small);
+    let out = succeed(&args, &dir);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("33 x 33 samples, semi-regular mesh built"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("2048 triangles at full detail"), "{stdout}");
+    let csv = std::fs::read_to_string(dir.join("t/stats.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 4, "{csv}");
+    // Adapted: more than the two base triangles, fewer than full detail.
+    for row in csv.lines().skip(1) {
+        let triangles: u32 = row.split(',').nth(1).unwrap().parse().unwrap();
+        assert!(triangles > 2 && triangles <= 2048, "{row}");
+    }
+    // A grid that is not 2^k + 1 square: one line saying what the engine needs.
+    let out = demo(&["terrain", "--engine", "wavelet", "--size", "32"], &dir);
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(stderr.contains("2^k + 1 samples a side") && stderr.contains("32 x 32"));
+    // A .vdw file through `orbit`, on the wavelet paper's session, with meshes dumped.
+    succeed(&["sphere", "--levels", "3", "-o", "s.vdw"], &dir);
+    let mut args = vec!["orbit", "s.vdw", "--session", "--dump-mesh", "-o", "o"];
+    args.extend_from_slice(&small);
+    let out = succeed(&args, &dir);
+    assert!(String::from_utf8_lossy(&out.stdout).contains("512 triangles at full detail"));
+    assert!(dir.join("o/frame_0002.png").exists() && dir.join("o/mesh_0002.obj").exists());
+    // False colours by forest depth need the forest.
+    let out = demo(&["orbit", "s.vdw", "--depth-colors", "--frames", "1"], &dir);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("vertex forest"));
+}

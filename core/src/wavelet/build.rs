@@ -440,12 +440,8 @@ impl SemiRegular {
     /// The finest level as a triangle mesh over [`SemiRegular::positions`] (counter-clockwise).
     #[must_use]
     pub fn finest_triangles(&self) -> Vec<[u32; 3]> {
-        let Some(view) = self.view() else {
-            return Vec::new();
-        };
-        let mut out = Vec::with_capacity(view.counts().finest_faces() as usize);
-        for_finest_triangles(&view, |_, t| out.push(t));
-        out
+        self.view()
+            .map_or_else(Vec::new, |view| finest_triangles(&view))
     }
 
     /// The file: positions quantized over the bounding box, normals, and every wavelet's bounds
@@ -530,6 +526,16 @@ impl SemiRegular {
             &model,
         ))
     }
+}
+
+/// The finest level of the file `view` as a triangle mesh over its vertex ids
+/// (counter-clockwise): what a full-detail picture of a `.vdw` file draws.
+#[must_use]
+pub fn finest_triangles(view: &SemiRegularView<'_>) -> Vec<[u32; 3]> {
+    let faces = usize::try_from(view.counts().finest_faces()).unwrap_or(0);
+    let mut out = Vec::with_capacity(faces);
+    for_finest_triangles(view, |_, t| out.push(t));
+    out
 }
 
 /// Calls `f(face, triangle)` for every triangle of `K^J` (vertex ids, counter-clockwise), face
