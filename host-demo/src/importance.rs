@@ -121,7 +121,15 @@ fn reduced(h: &HierarchyView<'_>, triangles: usize) -> Result<Box<TerrainCut>, S
     Ok(cut)
 }
 
-/// Pixels of `cut` seen by `camera`, shaded with the terrain's colours, edges when `edges`.
+/// Shaded with the terrain's colours, with dark edges when `edges`.
+fn terrain_style(edges: bool) -> Style {
+    Style {
+        vertex_colors: true,
+        ..style(Shading::Gouraud, edges)
+    }
+}
+
+/// Pixels of `cut` seen by `camera`.
 fn draw_cut(
     frame: &mut Frame,
     cut: &TerrainCut,
@@ -129,28 +137,23 @@ fn draw_cut(
     camera: &Camera,
     edges: bool,
 ) -> Result<Vec<Rgba8>, String> {
-    let drawn = Style {
-        vertex_colors: true,
-        ..style(Shading::Gouraud, edges)
-    };
+    let drawn = terrain_style(edges);
     frame
         .draw_cut(cut, h, camera, &drawn)
         .map_err(|e| e.to_string())?;
     Ok(frame.pixels().to_vec())
 }
 
+/// Pixels of the full-detail mesh seen by `camera`.
 fn draw_full(
     frame: &mut Frame,
     full: &IndexedMesh,
     camera: &Camera,
     edges: bool,
 ) -> Result<Vec<Rgba8>, String> {
-    let drawn = Style {
-        vertex_colors: true,
-        ..style(Shading::Gouraud, edges)
-    };
+    let params = terrain_style(edges).params(camera);
     frame
-        .draw(&full.as_raster_mesh(), &drawn.params(camera))
+        .draw(&full.as_raster_mesh(), &params)
         .map_err(|e| e.to_string())?;
     Ok(frame.pixels().to_vec())
 }

@@ -17,3 +17,18 @@ pub mod repair;
 pub mod terrain;
 pub mod terrain_engines;
 pub mod wavelet;
+
+/// The value of `key` in one of the `key=value` summary lines `vdlod-demo reproduce` prints
+/// (`None` when the line has no such key or its value does not parse).
+///
+/// ```
+/// let line = "experiment=terrain cost=color triangles=5001 psnr_top_db=27.82";
+/// assert_eq!(vdlod_demo::summary_value::<u32>(line, "triangles"), Some(5001));
+/// assert_eq!(vdlod_demo::summary_value::<f64>(line, "psnr_top_db"), Some(27.82));
+/// assert_eq!(vdlod_demo::summary_value::<u32>(line, "faces"), None);
+/// ```
+pub fn summary_value<T: std::str::FromStr>(line: &str, key: &str) -> Option<T> {
+    line.split(' ')
+        .find_map(|kv| kv.strip_prefix(key)?.strip_prefix('='))
+        .and_then(|v| v.parse().ok())
+}

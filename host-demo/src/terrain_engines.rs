@@ -388,10 +388,7 @@ mod tests {
     use super::*;
 
     fn field(line: &str, key: &str) -> f64 {
-        line.split(' ')
-            .find_map(|kv| kv.strip_prefix(key)?.strip_prefix('='))
-            .and_then(|v| v.parse().ok())
-            .unwrap_or_else(|| panic!("no {key} in {line}"))
+        crate::summary_value(line, key).unwrap_or_else(|| panic!("no {key} in {line}"))
     }
 
     #[test]

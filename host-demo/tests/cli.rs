@@ -549,11 +549,7 @@ fn reproduce_fig11_writes_pictures_csv_and_summary_lines() {
         .collect();
     assert_eq!(lines.len(), 2, "{stdout}");
     for line in &lines {
-        let faces: u32 = line
-            .split(' ')
-            .find_map(|kv| kv.strip_prefix("faces="))
-            .and_then(|v| v.parse().ok())
-            .unwrap();
+        let faces: u32 = field(line, "faces");
         assert!(faces > 100 && faces < 8192, "{line}");
     }
     for file in [
@@ -569,10 +565,7 @@ fn reproduce_fig11_writes_pictures_csv_and_summary_lines() {
 
 /// The value of `key` in a `key=value` summary line.
 fn field<T: std::str::FromStr>(line: &str, key: &str) -> T {
-    line.split(' ')
-        .find_map(|kv| kv.strip_prefix(key)?.strip_prefix('='))
-        .and_then(|v| v.parse().ok())
-        .unwrap_or_else(|| panic!("no {key} in {line}"))
+    vdlod_demo::summary_value(line, key).unwrap_or_else(|| panic!("no {key} in {line}"))
 }
 
 #[test]

@@ -57,6 +57,36 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         h.length(self.v.digest[s as usize].radius)
     }
 
+    /// The policy's demand for the active triangle `f`, with the corner at slot `moved` (if
+    /// any) standing at a position of its own with a region of its own.
+    #[inline]
+    fn judge_triangle<P: Policy>(
+        &self,
+        h: &HierarchyView<'_>,
+        f: u32,
+        moved: Option<(u32, [f32; 3], f32)>,
+        view: &View,
+        policy: &P,
+    ) -> f32 {
+        let t = self.t.at(f);
+        let at = |x: u32| match moved {
+            Some((slot, position, reach)) if slot == x => (position, reach),
+            _ => (self.node_position(h, x), self.node_reach(h, x)),
+        };
+        let corners = t.map(at);
+        let reach = corners.iter().fold(0.0f32, |r, c| r.max(c.1));
+        policy.triangle(&corners.map(|c| c.0), reach, view)
+    }
+
+    /// `d` raised to `error`; a triangle in view speaks for a vertex whose own bounds the
+    /// frustum culled.
+    fn raised(d: Demand, error: f32) -> Demand {
+        Demand {
+            visible: d.visible || error > 0.0,
+            error,
+        }
+    }
+
     /// `d`, the policy's demand for slot `s`'s own bounds, raised by the triangles around it.
     #[inline]
     pub(crate) fn judged<P: Policy>(
@@ -72,16 +102,9 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         }
         let mut error = if d.visible { d.error } else { 0.0 };
         self.for_each_around(s as u32, |f| {
-            let t = self.t.at(f);
-            let c = t.map(|x| self.node_position(h, x));
-            let reach = t.map(|x| self.node_reach(h, x));
-            error = error.max(policy.triangle(&c, reach[0].max(reach[1]).max(reach[2]), view));
+            error = error.max(self.judge_triangle(h, f, None, view, policy));
         });
-        // A triangle in view speaks for a vertex whose own bounds the frustum culled.
-        Demand {
-            visible: d.visible || error > 0.0,
-            error,
-        }
+        Self::raised(d, error)
     }
 
     /// `d`, the policy's demand for the parent of the pair at slots `a` and `b` (at `parent`,
@@ -104,32 +127,13 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         let mut error = if d.visible { d.error } else { 0.0 };
         for (x, other) in [(a, b), (b, a)] {
             self.for_each_around(x, |f| {
-                let t = self.t.at(f);
-                if t.contains(&other) {
-                    return; // the collapse removes it
+                // A triangle on both is removed by the collapse.
+                if !self.t.at(f).contains(&other) {
+                    let moved = Some((x, parent, parent_reach));
+                    error = error.max(self.judge_triangle(h, f, moved, view, policy));
                 }
-                let c = t.map(|y| {
-                    if y == x {
-                        parent
-                    } else {
-                        self.node_position(h, y)
-                    }
-                });
-                let reach = t.map(|y| {
-                    if y == x {
-                        parent_reach
-                    } else {
-                        self.node_reach(h, y)
-                    }
-                });
-                let reach = reach[0].max(reach[1]).max(reach[2]);
-                error = error.max(policy.triangle(&c, reach, view));
             });
         }
-        // A triangle in view speaks for a vertex whose own bounds the frustum culled.
-        Demand {
-            visible: d.visible || error > 0.0,
-            error,
-        }
+        Self::raised(d, error)
     }
 }
