@@ -161,6 +161,8 @@ pub struct OrbitFrame {
     pub full_render_us: f64,
     /// PSNR of the adapted frame against the full-detail frame, in dB (infinite when equal).
     pub psnr_db: f64,
+    /// Triangles not in the previous frame's mesh (all of them in the first frame).
+    pub new_triangles: u32,
 }
 
 /// A camera a quarter turn ahead of frame `i`'s and a quarter farther from the centre.
@@ -318,6 +320,27 @@ pub fn make_policy(choice: PolicyChoice, (min, max): ([f32; 3], [f32; 3])) -> De
             DemoPolicy::Importance((Frustum, Importance::new(threshold, size)))
         }
     }
+}
+
+/// A mesh's triangles over global vertex ids (hierarchy nodes, wavelet vertices), each from its
+/// smallest corner, sorted: what [`new_triangles`] compares from frame to frame.
+pub fn triangle_set(triangles: impl Iterator<Item = [u32; 3]>) -> Vec<[u32; 3]> {
+    let mut v: Vec<[u32; 3]> = triangles
+        .map(|t| {
+            let m = (0..3).min_by_key(|&i| t[i]).unwrap_or(0);
+            [t[m], t[(m + 1) % 3], t[(m + 2) % 3]]
+        })
+        .collect();
+    v.sort_unstable();
+    v
+}
+
+/// How many of `now` are not in `before` (both from [`triangle_set`]): ROAM's measure of how
+/// much a frame changed.
+pub fn new_triangles(before: &[[u32; 3]], now: &[[u32; 3]]) -> u32 {
+    now.iter()
+        .filter(|t| before.binary_search(t).is_err())
+        .count() as u32
 }
 
 /// PSNR in dB of `a` against `b` over the RGB channels (infinite when equal).
@@ -550,6 +573,8 @@ trait FlightEngine {
     fn draw(&self, frame: &mut Frame, camera: &Camera, style: &Style) -> Result<(), FrameError>;
     /// Writes the current mesh as an OBJ file.
     fn write_obj(&self, path: &Path) -> std::io::Result<()>;
+    /// The current mesh's triangles ([`triangle_set`]).
+    fn triangle_set(&self) -> Vec<[u32; 3]>;
 }
 
 /// The vertex forest in a flight.
@@ -602,6 +627,16 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex + VertexIndex>
 
     fn write_obj(&self, path: &Path) -> std::io::Result<()> {
         write_obj(path, self.cut, &self.h)
+    }
+
+    fn triangle_set(&self) -> Vec<[u32; 3]> {
+        let nodes = self.cut.nodes();
+        triangle_set(
+            self.cut
+                .triangles()
+                .iter()
+                .map(|t| t.map(|i| nodes[i.index()])),
+        )
     }
 }
 
@@ -670,6 +705,11 @@ where
             .map(|t| t.map(|i| i.index() as u32));
         std::fs::write(path, crate::mesh::obj_text(&positions, None, triangles))
     }
+
+    fn triangle_set(&self) -> Vec<[u32; 3]> {
+        let ids = self.cut.triangles().iter();
+        triangle_set(ids.map(|t| t.map(|i| self.cut.vertex_id(i.index()))))
+    }
 }
 
 /// [`run_orbit`] with its engine.
@@ -705,9 +745,10 @@ fn fly_orbit(
     let mut reference = Frame::new(opts.width, opts.height).map_err(|e| e.to_string())?;
     let full_mesh = full.as_raster_mesh();
     let mut csv = String::from(
-        "frame,triangles,vsplits,ecols,adapt_us,render_us,full_render_us,psnr_db,vertices,forced,blending,threshold,budget_limited,ops_limited,capacity_limited,queue_overflow,blend_limited,over_budget\n",
+        "frame,triangles,vsplits,ecols,adapt_us,render_us,full_render_us,psnr_db,vertices,forced,blending,threshold,budget_limited,ops_limited,capacity_limited,queue_overflow,blend_limited,over_budget,new_triangles\n",
     );
     let mut frames = Vec::with_capacity(opts.frames as usize);
+    let mut before = Vec::new();
     let mut warned = false;
     let compared = opts.frames / 2;
     let camera_of = |i: u32| match &opts.path {
@@ -751,6 +792,12 @@ fn fly_orbit(
             render_us,
             full_render_us,
             psnr_db: psnr(frame.pixels(), reference.pixels()),
+            new_triangles: {
+                let now = engine.triangle_set();
+                let new = new_triangles(&before, &now);
+                before = now;
+                new
+            },
         };
         if i == compared {
             let side = side_by_side(opts.width, opts.height, frame.pixels(), reference.pixels());
@@ -790,7 +837,7 @@ fn fly_orbit(
         }
         let _ = writeln!(
             csv,
-            "{},{},{},{},{:.1},{:.1},{:.1},{:.3},{},{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{:.1},{:.1},{:.1},{:.3},{},{},{},{},{},{},{},{},{},{},{}",
             i,
             stats.triangles,
             stats.vsplits,
@@ -809,6 +856,7 @@ fn fly_orbit(
             stats.queue_overflow as u8,
             stats.blend_limited as u8,
             stats.over_budget as u8,
+            f.new_triangles,
         );
         report(&f);
         frames.push(f);

@@ -776,9 +776,12 @@ fn fly(
     );
     if summary.frames.len() > 1 {
         say!(
-            "other frames, median: adapt {:.1} us, {:.0} triangles, {:.1} splits + {:.1} collapses; adapt + render {:.2} ms vs full detail {:.2} ms; PSNR mean {:.2} dB",
+            "other frames, median: adapt {:.1} us, {:.0} triangles ({:.1}% new), {:.1} splits + {:.1} collapses; adapt + render {:.2} ms vs full detail {:.2} ms; PSNR mean {:.2} dB",
             summary.median_after_first(|f| f.adapt_us),
             summary.median_after_first(|f| f.stats.triangles as f64),
+            summary.median_after_first(|f| {
+                100.0 * f.new_triangles as f64 / f.stats.triangles.max(1) as f64
+            }),
             summary.mean_after_first(|f| f.stats.vsplits as f64),
             summary.mean_after_first(|f| f.stats.ecols as f64),
             summary.median_after_first(|f| (f.adapt_us + f.render_us) / 1e3),

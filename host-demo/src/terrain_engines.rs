@@ -33,7 +33,7 @@ use vdlod_raster::{Rgba8, Shading};
 use crate::chart::{self, Panel, BLUE, ORANGE};
 use crate::frame::Frame;
 use crate::hierarchy::build_with_progress;
-use crate::lod::psnr;
+use crate::lod::{new_triangles, psnr, triangle_set};
 use crate::render::style;
 use crate::terrain::{FlyOver, Terrain, DEFAULT_VERTICAL_SCALE};
 use crate::wavelet::{mean, median, DemoWaveletCut};
@@ -75,25 +75,6 @@ struct EngineFrame {
     new: u32,
     adapt_us: f64,
     psnr_db: f64,
-}
-
-/// A mesh's triangles over global vertex ids, each from its smallest corner, sorted.
-fn canonical(triangles: impl Iterator<Item = [u32; 3]>) -> Vec<[u32; 3]> {
-    let mut v: Vec<[u32; 3]> = triangles
-        .map(|t| {
-            let m = (0..3).min_by_key(|&i| t[i]).unwrap_or(0);
-            [t[m], t[(m + 1) % 3], t[(m + 2) % 3]]
-        })
-        .collect();
-    v.sort_unstable();
-    v
-}
-
-/// How many of `now` are not in `before` (both sorted).
-fn new_triangles(before: &[[u32; 3]], now: &[[u32; 3]]) -> u32 {
-    now.iter()
-        .filter(|t| before.binary_search(t).is_err())
-        .count() as u32
 }
 
 /// Runs the comparison, writing `terrain_engines.csv` and `terrain_engines.png` (new triangles
@@ -152,7 +133,7 @@ pub fn terrain_engines(out: &Path, setup: Setup) -> Result<Vec<String>, String> 
         frame
             .draw_styled(&WaveletMesh::new(&wavelet, &s, true), camera, &drawn)
             .map_err(|e| e.to_string())?;
-        let now = canonical(
+        let now = triangle_set(
             wavelet
                 .triangles()
                 .iter()
@@ -178,7 +159,7 @@ pub fn terrain_engines(out: &Path, setup: Setup) -> Result<Vec<String>, String> 
             .draw_cut(&forest, &h, camera, &drawn)
             .map_err(|e| e.to_string())?;
         let nodes = forest.nodes();
-        let now = canonical(
+        let now = triangle_set(
             forest
                 .triangles()
                 .iter()

@@ -806,10 +806,24 @@ fn the_wavelet_engine_flies_terrains_paths_and_vdw_files() {
     assert!(stdout.contains("2048 triangles at full detail"), "{stdout}");
     let csv = std::fs::read_to_string(dir.join("t/stats.csv")).unwrap();
     assert_eq!(csv.lines().count(), 4, "{csv}");
-    // Adapted: more than the two base triangles, fewer than full detail.
-    for row in csv.lines().skip(1) {
-        let triangles: u32 = row.split(',').nth(1).unwrap().parse().unwrap();
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let new = header.iter().position(|&c| c == "new_triangles").unwrap();
+    // Adapted: more than the two base triangles, fewer than full detail; every triangle of the
+    // first frame is new, and later frames keep some of the last one's.
+    for (i, row) in csv.lines().skip(1).enumerate() {
+        let (triangles, fresh): (u32, u32) = (
+            row.split(',').nth(1).unwrap().parse().unwrap(),
+            row.split(',').nth(new).unwrap().parse().unwrap(),
+        );
         assert!(triangles > 2 && triangles <= 2048, "{row}");
+        assert!(
+            if i == 0 {
+                fresh == triangles
+            } else {
+                fresh < triangles
+            },
+            "{row}"
+        );
     }
     // A grid that is not 2^k + 1 square: one line saying what the engine needs.
     let out = demo(&["terrain", "--engine", "wavelet", "--size", "32"], &dir);
