@@ -7,6 +7,10 @@
 //! and how far over tolerance its error is (`error > 1` asks for a split; larger is more urgent,
 //! which orders the budget's priority queue).
 //!
+//! A policy may also judge triangles ([`Policy::judges_triangles`], [`Policy::triangle`]), as
+//! the importance paper's does: the vertex forest then raises each vertex's demand to that of
+//! the triangles around it, and a pair's to that of the triangles its collapse would make.
+//!
 //! Policies compose: a tuple `(A, B)` is visible when both are and demands the larger error, so
 //! the LOD lecture's `qrefine` is `(Frustum, (BackFace, ScreenError::new(1.0)))`. [`QRefine`] is
 //! the same three tests fused, sharing their subexpressions: the one to use when speed matters
