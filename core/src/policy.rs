@@ -605,9 +605,9 @@ impl Policy for MergeTree {
 /// README's terrain section). The paper's 0.3 was in the units of its own 100-sample terrain,
 /// whose diagonal is about 141 samples: 0.3 there is about 0.002 here.
 ///
-/// The vertex engine judges triangles exactly; [`Importance::demand`] wants nothing of a vertex
-/// by itself, so an engine that asks only about vertices (the wavelet engine) refines nothing
-/// with it.
+/// [`Importance::demand`] wants nothing of a vertex by itself: both engines ask the triangles.
+/// The vertex forest judges the active triangles around each vertex; the wavelet engine judges
+/// the two triangles of the level above that a wavelet subdivides.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Importance {
     /// Importance above which a triangle splits its corners.

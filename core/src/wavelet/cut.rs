@@ -39,7 +39,7 @@ use crate::adapt::{Budget, FrameStats};
 use crate::cut::slot::{Arena, SlotIndex};
 use crate::cut::NIL;
 use crate::nodemap::NodeMap;
-use crate::policy::{Policy, View};
+use crate::policy::{Demand, Policy, View};
 
 use super::format::SemiRegularView;
 use super::lattice::Point;
@@ -353,6 +353,46 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         self.positions.get(i).copied().unwrap_or([0.0; 3])
     }
 
+    /// The policy's demand for wavelet vertex `id`. A policy that judges triangles
+    /// ([`Policy::judges_triangles`], the importance paper's) also speaks through the two
+    /// triangles of the level above that the wavelet subdivides (the ones around its parent
+    /// edge): when either is important the wavelet is wanted, which is the paper's rule that an
+    /// important triangle splits everything it can. Those triangles are coarser than the
+    /// wavelet, so its coming and going never changes its own verdict.
+    #[inline]
+    fn demand<P: Policy>(s: &SemiRegularView<'_>, id: u32, view: &View, policy: &P) -> Demand {
+        let b = s.bounds(id);
+        let d = policy.demand(&b, view);
+        if !policy.judges_triangles() {
+            return d;
+        }
+        let Some(p) = s.point(id) else { return d };
+        let [x, y] = s.parent_edge(p, s.level(p));
+        let at = |q: Point| {
+            s.canonical(q)
+                .and_then(|c| s.vertex_id(c))
+                .map(|v| s.position(v))
+        };
+        let (Some(a), Some(c)) = (at(x), at(y)) else {
+            return d;
+        };
+        let mut error = if d.visible { d.error } else { 0.0 };
+        // Counter-clockwise: `x, y, left` and `y, x, right` (a border edge has one side).
+        for corners in [
+            at(x.left_of(y)).map(|l| [a, c, l]),
+            at(x.right_of(y)).map(|r| [c, a, r]),
+        ]
+        .into_iter()
+        .flatten()
+        {
+            error = error.max(policy.triangle(&corners, b.radius, view));
+        }
+        Demand {
+            visible: d.visible || error > 0.0,
+            error,
+        }
+    }
+
     /// The policy's verdict on wavelet vertex `id` at threshold `t`: wanted, and how much.
     #[inline]
     fn wants<P: Policy>(
@@ -362,7 +402,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         policy: &P,
         t: f32,
     ) -> Option<f32> {
-        let d = policy.demand(&s.bounds(id), view);
+        let d = Self::demand(s, id, view, policy);
         (d.visible && d.error > t).then_some(d.error)
     }
 
@@ -653,7 +693,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
                 if !leaving && self.any_child_in(s, p, level, true) {
                     continue;
                 }
-                let d = policy.demand(&s.bounds(id), view);
+                let d = Self::demand(s, id, view, policy);
                 let wanted = d.visible && d.error > t;
                 if leaving {
                     if wanted {
@@ -772,7 +812,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         stats: &mut FrameStats,
     ) {
         let priority = |id: u32| {
-            let d = policy.demand(&s.bounds(id), view);
+            let d = Self::demand(s, id, view, policy);
             !(if d.visible { d.error.max(0.0) } else { 0.0 }).to_bits()
         };
         self.heap.clear();

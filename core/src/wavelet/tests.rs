@@ -166,6 +166,46 @@ fn a_second_call_with_the_same_view_does_nothing() {
 }
 
 #[test]
+fn the_importance_test_subdivides_important_triangles_facing_the_eye() {
+    use crate::policy::{Frustum, Importance};
+    let bytes = sphere(5);
+    let s = SemiRegularView::parse(&bytes).unwrap();
+    // Close in front of the sphere, seeing all of it: the cap facing the eye is near and seen
+    // face-on; the cap behind faces exactly away, so its triangles weigh nothing.
+    let view = View::look_at([0.0, 0.0, 3.0], [0.0; 3], [0.0, 1.0, 0.0], 1.0, 1.0, 480.0);
+    let policy = (Frustum, Importance::new(2e-3, 2.0 * libm::sqrtf(3.0)));
+    let mut cut = Cut::boxed();
+    cut.reset(&s).unwrap();
+    let first = cut.adapt(&s, &view, &policy, &Budget::default());
+    assert!(first.vsplits > 0 && first.triangles < 8192, "{first:?}");
+    // Judged on coarser triangles than the wavelets themselves: one call settles.
+    let again = cut.adapt(&s, &view, &policy, &Budget::default());
+    assert_eq!((again.vsplits, again.ecols), (0, 0));
+    let cap = |front: bool| {
+        (s.counts().base_vertices..s.vertices())
+            .filter(|&v| cut.includes(v))
+            .filter(|&v| {
+                let z = s.position(v)[2];
+                if front {
+                    z > 0.8
+                } else {
+                    z < -0.8
+                }
+            })
+            .count()
+    };
+    // Triangles are counter-clockwise from outside: were they not, the front cap would weigh
+    // as little as the back one does.
+    let (front, back) = (cap(true), cap(false));
+    assert!(front > 4 * back.max(1), "{front} in front, {back} behind");
+    // The vertex alone wants nothing: a policy that does not judge triangles keeps the base.
+    let mut plain = Cut::boxed();
+    plain.reset(&s).unwrap();
+    let none = plain.adapt(&s, &view, &Frustum, &Budget::default());
+    assert_eq!(none.vsplits, 0);
+}
+
+#[test]
 fn the_budget_keeps_the_largest_errors() {
     let bytes = sphere(5);
     let s = SemiRegularView::parse(&bytes).unwrap();
