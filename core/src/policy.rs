@@ -608,6 +608,16 @@ impl Policy for MergeTree {
 /// [`Importance::demand`] wants nothing of a vertex by itself: both engines ask the triangles.
 /// The vertex forest judges the active triangles around each vertex; the wavelet engine judges
 /// the two triangles of the level above that a wavelet subdivides.
+///
+/// ```
+/// use vdlod_core::policy::{Importance, Policy, View};
+/// let view = View::look_at([0.0, 0.0, 10.0], [0.0; 3], [0.0, 1.0, 0.0], 1.0, 1.0, 480.0);
+/// let policy = Importance::new(1e-3, 4.0); // a model whose bounding box is 4 units across
+/// let facing = [[-1.0, -1.0, 0.0], [1.0, -1.0, 0.0], [0.0, 2.0, 0.0]];
+/// assert!(policy.triangle(&facing, 0.0, &view) > 1.0); // important: its corners split
+/// let away = [facing[0], facing[2], facing[1]];
+/// assert_eq!(policy.triangle(&away, 0.0, &view), 0.0);
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Importance {
     /// Importance above which a triangle splits its corners.

@@ -279,7 +279,7 @@ pub const LINDSTROM: [(f32, u32); 4] = [(0.5, 62_497), (1.0, 23_287), (2.0, 8_61
 
 /// Cuts big enough for a 1025 x 1025 terrain at 0.5 px (32-bit indices).
 type BigWaveletCut = WaveletCut<32_832, 400_000, 200_000, 32_768, u32>;
-type BigForestCut = Cut<200_000, 400_000, 25_000, u32>;
+type BigForestCut = Cut<200_000, 400_000, 100_000, u32>;
 
 /// Flies both engines over the `samples`-square terrain's fly-over (`frames` views) at each of
 /// [`LINDSTROM`]'s tolerances, without a budget; returns one line per engine and tolerance:
