@@ -34,6 +34,7 @@ use crate::chart::{self, Panel, BLUE, ORANGE};
 use crate::frame::Frame;
 use crate::hierarchy::build_with_progress;
 use crate::lod::{new_triangles, psnr, triangle_set};
+use crate::mesh::IndexedMesh;
 use crate::render::style;
 use crate::terrain::{FlyOver, Terrain, DEFAULT_VERTICAL_SCALE};
 use crate::wavelet::{mean, median, DemoWaveletCut};
@@ -67,6 +68,57 @@ impl Setup {
 /// 60,000).
 type ForestCut = Cut<16_000, 32_000, 2_000>;
 
+/// What both engines fly: the procedural terrain of `side` samples a side as a semi-regular file
+/// and as a hierarchy, its full-detail mesh, and the fly-over's cameras.
+struct Flight {
+    full: IndexedMesh,
+    cameras: Vec<Camera>,
+    drawn: Style,
+    sbytes: Vec<u8>,
+    hbytes: Vec<u8>,
+    wavelet_build_s: f64,
+    forest_build_s: f64,
+}
+
+impl Flight {
+    fn new(side: usize, frames: u32, progress: bool) -> Result<Flight, String> {
+        let land = Terrain::procedural(side, SEED, DEFAULT_VERTICAL_SCALE);
+        let semi = land
+            .semi_regular()
+            .ok_or("the terrain is not 2^k + 1 samples square")?;
+        let start = Instant::now();
+        let sbytes = semi.to_bytes().map_err(|e| e.to_string())?;
+        let wavelet_build_s = start.elapsed().as_secs_f64();
+        drop(semi);
+        let mut full = land.mesh();
+        let (_, hbytes, forest_build_s) =
+            build_with_progress(&full, &BuildOptions::default(), progress)
+                .map_err(|e| format!("terrain: {e}"))?;
+        full.reorder_for_locality();
+        let fly_over = FlyOver::new(&land, frames, WIDTH, HEIGHT);
+        Ok(Flight {
+            full,
+            cameras: (0..frames).map(|i| fly_over.camera(i)).collect(),
+            drawn: Style {
+                vertex_colors: true,
+                ..style(Shading::Gouraud, false)
+            },
+            sbytes,
+            hbytes,
+            wavelet_build_s,
+            forest_build_s,
+        })
+    }
+
+    /// The two files, read.
+    fn views(&self) -> Result<(SemiRegularView<'_>, HierarchyView<'_>), String> {
+        Ok((
+            SemiRegularView::parse(&self.sbytes).map_err(|e| e.to_string())?,
+            HierarchyView::parse(&self.hbytes).map_err(|e| e.to_string())?,
+        ))
+    }
+}
+
 /// One engine's frame.
 #[derive(Clone, Copy, Debug, Default)]
 struct EngineFrame {
@@ -85,27 +137,18 @@ pub fn terrain_engines(out: &Path, setup: Setup) -> Result<Vec<String>, String> 
         samples: side,
         frames: count,
     } = setup;
-    let land = Terrain::procedural(side, SEED, DEFAULT_VERTICAL_SCALE);
     let samples = (side * side) as f64;
-    let semi = land
-        .semi_regular()
-        .ok_or("the terrain is not 2^k + 1 samples square")?;
-    let start = Instant::now();
-    let sbytes = semi.to_bytes().map_err(|e| e.to_string())?;
-    let wavelet_build_s = start.elapsed().as_secs_f64();
-    let s = SemiRegularView::parse(&sbytes).map_err(|e| e.to_string())?;
-    let mut full = land.mesh();
-    let (_, hbytes, forest_build_s) = build_with_progress(&full, &BuildOptions::default(), false)
-        .map_err(|e| format!("terrain: {e}"))?;
-    let h = HierarchyView::parse(&hbytes).map_err(|e| e.to_string())?;
-    full.reorder_for_locality();
-    let fly_over = FlyOver::new(&land, count, WIDTH, HEIGHT);
-    let cameras: Vec<Camera> = (0..count).map(|i| fly_over.camera(i)).collect();
-    let drawn = Style {
-        vertex_colors: true,
-        ..style(Shading::Gouraud, false)
-    };
-
+    let flight = Flight::new(side, count, false)?;
+    let (s, h) = flight.views()?;
+    let Flight {
+        full,
+        cameras,
+        drawn,
+        sbytes,
+        hbytes,
+        wavelet_build_s,
+        forest_build_s,
+    } = &flight;
     let mut frame = Frame::new(WIDTH, HEIGHT).map_err(|e| e.to_string())?;
     let mut wavelet = DemoWaveletCut::boxed();
     wavelet.reset(&s).map_err(|e| e.to_string())?;
@@ -114,7 +157,7 @@ pub fn terrain_engines(out: &Path, setup: Setup) -> Result<Vec<String>, String> 
     let (wavelet_policy, forest_policy) = (QRefine::new(1.0), QRefine::new(0.1));
     let mut frames: Vec<[EngineFrame; 2]> = Vec::with_capacity(cameras.len());
     let (mut wavelet_before, mut forest_before) = (Vec::new(), Vec::new());
-    for camera in &cameras {
+    for camera in cameras {
         frame
             .draw(&full.as_raster_mesh(), &drawn.params(camera))
             .map_err(|e| e.to_string())?;
@@ -131,7 +174,7 @@ pub fn terrain_engines(out: &Path, setup: Setup) -> Result<Vec<String>, String> 
         .map_err(|e| e.to_string())?;
         let adapt_us = start.elapsed().as_secs_f64() * 1e6;
         frame
-            .draw_styled(&WaveletMesh::new(&wavelet, &s, true), camera, &drawn)
+            .draw_styled(&WaveletMesh::new(&wavelet, &s, true), camera, drawn)
             .map_err(|e| e.to_string())?;
         let now = triangle_set(
             wavelet
@@ -156,7 +199,7 @@ pub fn terrain_engines(out: &Path, setup: Setup) -> Result<Vec<String>, String> 
             .map_err(|e| e.to_string())?;
         let adapt_us = start.elapsed().as_secs_f64() * 1e6;
         frame
-            .draw_cut(&forest, &h, camera, &drawn)
+            .draw_cut(&forest, &h, camera, drawn)
             .map_err(|e| e.to_string())?;
         let nodes = forest.nodes();
         let now = triangle_set(
@@ -287,28 +330,18 @@ type BigForestCut = Cut<200_000, 400_000, 100_000, u32>;
 /// more than 16 levels of 255 in a channel.
 pub fn tolerances(out: &Path, samples: usize, frames: u32) -> Result<Vec<String>, String> {
     std::fs::create_dir_all(out).map_err(|e| format!("{}: {e}", out.display()))?;
-    let land = Terrain::procedural(samples, SEED, DEFAULT_VERTICAL_SCALE);
-    let semi = land
-        .semi_regular()
-        .ok_or("the terrain is not 2^k + 1 samples square")?;
-    let sbytes = semi.to_bytes().map_err(|e| e.to_string())?;
-    drop(semi);
-    let s = SemiRegularView::parse(&sbytes).map_err(|e| e.to_string())?;
-    let mut full = land.mesh();
     let show = std::io::IsTerminal::is_terminal(&std::io::stderr());
-    let (_, hbytes, _) = build_with_progress(&full, &BuildOptions::default(), show)
-        .map_err(|e| format!("terrain: {e}"))?;
-    let h = HierarchyView::parse(&hbytes).map_err(|e| e.to_string())?;
-    full.reorder_for_locality();
-    let fly_over = FlyOver::new(&land, frames, WIDTH, HEIGHT);
-    let cameras: Vec<Camera> = (0..frames).map(|i| fly_over.camera(i)).collect();
-    let drawn = Style {
-        vertex_colors: true,
-        ..style(Shading::Gouraud, false)
-    };
+    let flight = Flight::new(samples, frames, show)?;
+    let (s, h) = flight.views()?;
+    let Flight {
+        full,
+        cameras,
+        drawn,
+        ..
+    } = &flight;
     let mut frame = Frame::new(WIDTH, HEIGHT).map_err(|e| e.to_string())?;
     let mut references = Vec::with_capacity(cameras.len());
-    for camera in &cameras {
+    for camera in cameras {
         frame
             .draw(&full.as_raster_mesh(), &drawn.params(camera))
             .map_err(|e| e.to_string())?;
@@ -329,13 +362,13 @@ pub fn tolerances(out: &Path, samples: usize, frames: u32) -> Result<Vec<String>
             let w = vdlod::adapt_wavelets(&mut wavelet, &s, camera, &policy, &Budget::default())
                 .map_err(|e| e.to_string())?;
             frame
-                .draw_styled(&WaveletMesh::new(&wavelet, &s, true), camera, &drawn)
+                .draw_styled(&WaveletMesh::new(&wavelet, &s, true), camera, drawn)
                 .map_err(|e| e.to_string())?;
             rows[0].push(Measured::of(&w, frame.pixels(), reference));
             let f = vdlod::adapt(&mut forest, &h, camera, &policy, &Budget::default())
                 .map_err(|e| e.to_string())?;
             frame
-                .draw_cut(&forest, &h, camera, &drawn)
+                .draw_cut(&forest, &h, camera, drawn)
                 .map_err(|e| e.to_string())?;
             rows[1].push(Measured::of(&f, frame.pixels(), reference));
         }
