@@ -17,9 +17,13 @@
 //!    frame and of the bunny simplified uniformly by meshoptimizer (`meshopt` 0.7) to the same
 //!    triangle count, over 20 frames of the peer orbit.
 //! 4. **Memory**: the cut's bytes for the capacities used.
+//! 5. **Policies**: the importance paper's per-triangle test ([`Importance`] at its default
+//!    threshold) against [`QRefine`] at 0.3 px (about as many triangles) over the same orbit,
+//!    interleaved (QRefine, importance, QRefine): median microseconds, mean triangles, and the
+//!    time per triangle as a ratio.
 //!
 //! Run: `../shared/peers/run.sh` once (builds the peers), then `cargo bench --bench lod`
-//! (`-- adaptation`, `-- quality` or `-- full` for one section).
+//! (`-- adaptation`, `-- quality`, `-- full` or `-- policies` for one section).
 
 use std::path::PathBuf;
 use std::process::Command;
@@ -29,7 +33,7 @@ use meshopt::{SimplifyOptions, VertexDataAdapter};
 use vdlod_core::adapt::Budget;
 use vdlod_core::cut::Cut;
 use vdlod_core::format::HierarchyView;
-use vdlod_core::policy::{MergeTree, QRefine, ScreenError};
+use vdlod_core::policy::{Frustum, Importance, MergeTree, Policy, QRefine, ScreenError};
 use vdlod_demo::camera::{merge_tree_orbit, peer_orbit};
 use vdlod_demo::frame::Frame;
 use vdlod_demo::hierarchy::build_with_progress;
@@ -73,15 +77,23 @@ fn adapt_orbit(
     tolerance: f32,
     revolutions: u32,
 ) -> Adapt {
+    adapt_orbit_with(h, mesh, &QRefine::new(tolerance), revolutions)
+}
+
+fn adapt_orbit_with(
+    h: &HierarchyView<'_>,
+    mesh: &IndexedMesh,
+    policy: &impl Policy,
+    revolutions: u32,
+) -> Adapt {
     let orbit = peer_orbit(&mesh.bounds(), FRAMES, W, H);
     let mut cut = BunnyCut::boxed();
     cut.reset(h).expect("base mesh fits");
-    let policy = QRefine::new(tolerance);
     let mut out = Adapt::default();
     for i in 0..FRAMES * revolutions {
         let view = orbit.camera(i).view();
         let start = Instant::now();
-        let s = cut.adapt(h, &view, &policy, &Budget::default());
+        let s = cut.adapt(h, &view, policy, &Budget::default());
         let us = start.elapsed().as_secs_f64() * 1e6;
         if i == 0 {
             out.first_us = us;
@@ -190,6 +202,36 @@ fn adaptation(h: &HierarchyView<'_>, mesh: &IndexedMesh) {
             ))
             .collect::<Vec<_>>()
             .join(", ")
+    );
+}
+
+fn policies(h: &HierarchyView<'_>, mesh: &IndexedMesh) {
+    println!("\n## 5. Policies, bunny, peer orbit (640x480, 60 deg, 200 frames)\n");
+    let screen = QRefine::new(0.3);
+    let importance = (
+        Frustum,
+        Importance::for_model(Importance::DEFAULT_THRESHOLD, h),
+    );
+    let before = adapt_orbit_with(h, mesh, &screen, 1);
+    let judged = adapt_orbit_with(h, mesh, &importance, 1);
+    let after = adapt_orbit_with(h, mesh, &screen, 1);
+    let us = median(before.us.iter().chain(&after.us).copied().collect());
+    let tris = mean(&[before.tris, after.tris].concat());
+    let (i_us, i_tris) = (median(judged.us), mean(&judged.tris));
+    println!("| policy | median us | mean tris | ns per triangle |");
+    println!("|---|---|---|---|");
+    println!(
+        "| QRefine 0.3 px | {us:.0} | {tris:.0} | {:.0} |",
+        us * 1e3 / tris
+    );
+    println!(
+        "| importance, threshold {} | {i_us:.0} | {i_tris:.0} | {:.0} |",
+        Importance::DEFAULT_THRESHOLD,
+        i_us * 1e3 / i_tris
+    );
+    println!(
+        "\nThe importance test takes {:.1}x QRefine's time per triangle (it walks every vertex's triangles).",
+        (i_us / i_tris) / (us / tris)
     );
 }
 
@@ -368,6 +410,9 @@ fn main() {
         }
         if wanted("full") {
             full_vs_adapted(&mesh);
+        }
+        if wanted("policies") {
+            policies(&h, &mesh);
         }
     }
 }
