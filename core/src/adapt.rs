@@ -305,7 +305,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                         error: 0.0,
                     }
                 } else {
-                    self.judged(h, base + k, policy.demand(&bounds[k], view), view, policy)
+                    self.judged(h, base + k, &bounds[k], view, policy)
                 };
             }
             // The parent of a pair matters unless the first child is to be split or both were
@@ -392,15 +392,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             // clears the mark lists the pair again (`list_unblocked`).
             return;
         }
-        let d = policy.demand(parent_bounds, view);
-        let e = pair_error(self.judged_pair(
-            h,
-            (i, j),
-            (parent_bounds.center, parent_bounds.radius),
-            d,
-            view,
-            policy,
-        ));
+        let e = pair_error(self.judged_pair(h, (i, j), parent_bounds, view, policy));
         if e > t {
             // The parent is wanted: a collapse under way blends back.
             if (self.v.flags[i] | self.v.flags[j]) & COLLAPSING != 0 {
@@ -477,12 +469,11 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             if blending && (fa | fb) & BLENDING != 0 {
                 continue;
             }
-            if !blending && policy.judges_triangles() {
-                // Collapses before this one may have made the triangles it would leave larger:
-                // judge them as they are now, so no collapse makes what the next frame splits.
-                let pb = h.bounds(p);
-                let d = policy.demand(&pb, view);
-                let d = self.judged_pair(h, (a, b), (pb.center, pb.radius), d, view, policy);
+            if !blending && frame.stats.ecols > 0 && policy.judges_triangles() {
+                // Collapses since the pair was listed may have made the triangles it would
+                // leave larger: judge them as they are now, so no collapse makes what the next
+                // frame splits.
+                let d = self.judged_pair(h, (a, b), &h.bounds(p), view, policy);
                 if pair_error(d) > frame.threshold {
                     continue;
                 }
@@ -539,10 +530,8 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             m as usize
         };
         let p = h.parent(self.v.node[first]);
-        let b = h.bounds(p);
-        let d = policy.demand(&b, view);
         let pair = (first, self.v.mate(first) as usize);
-        let error = pair_error(self.judged_pair(h, pair, (b.center, b.radius), d, view, policy));
+        let error = pair_error(self.judged_pair(h, pair, &h.bounds(p), view, policy));
         if error <= frame.threshold {
             self.list_pair(error, p, first, &mut frame.stats);
         }
@@ -593,11 +582,8 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         self.pairs.clear();
         for i in 0..self.v.len() {
             if let Some(p) = self.pair_parent(h, i) {
-                let b = h.bounds(p);
-                let d = policy.demand(&b, view);
                 let pair = (i, self.v.mate(i) as usize);
-                let e =
-                    pair_error(self.judged_pair(h, pair, (b.center, b.radius), d, view, policy));
+                let e = pair_error(self.judged_pair(h, pair, &h.bounds(p), view, policy));
                 if !self.list_pair(e, p, i, stats) {
                     break;
                 }
@@ -669,8 +655,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                     let Some(cs) = self.slot(c) else {
                         continue;
                     };
-                    let d = policy.demand(&h.bounds(c), view);
-                    let d = self.judged(h, cs as usize, d, view, policy);
+                    let d = self.judged(h, cs as usize, &h.bounds(c), view, policy);
                     let flags = &mut self.v.flags[cs as usize];
                     *flags = (*flags & !VISIBLE) | d.visible as u8;
                     if d.error > t

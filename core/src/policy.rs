@@ -72,6 +72,19 @@ impl Demand {
         visible: false,
         error: 0.0,
     };
+
+    /// This demand raised by `triangles`, the largest demand of the triangles a vertex stands
+    /// for ([`Policy::triangle`]): a triangle in view speaks for a vertex whose own bounds the
+    /// frustum culled.
+    #[must_use]
+    pub fn raised(self, triangles: f32) -> Demand {
+        let own = if self.visible { self.error } else { 0.0 };
+        let error = own.max(triangles);
+        Demand {
+            visible: self.visible || error > 0.0,
+            error,
+        }
+    }
 }
 
 /// A camera for one frame, reduced to what the policies test against.
@@ -644,12 +657,17 @@ impl Importance {
         }
     }
 
+    /// The policy for a model in the box `(min, max)`, sized by its diagonal.
+    #[must_use]
+    pub fn for_box(threshold: f32, (min, max): ([f32; 3], [f32; 3])) -> Importance {
+        let d = sub(max, min);
+        Importance::new(threshold, libm::sqrtf(dot(d, d)))
+    }
+
     /// The policy for the model `h` holds, sized by its bounding box.
     #[must_use]
     pub fn for_model(threshold: f32, h: &crate::format::HierarchyView<'_>) -> Importance {
-        let (min, max) = h.bounding_box();
-        let d = sub(max, min);
-        Importance::new(threshold, libm::sqrtf(dot(d, d)))
+        Importance::for_box(threshold, h.bounding_box())
     }
 
     /// The paper's importance of the triangle with corners `c` seen from `view`, in this

@@ -299,10 +299,9 @@ impl Policy for DemoPolicy {
     }
 }
 
-/// The policy for `choice` on a model in the box `(min, max)` (its diagonal sizes the
+/// The policy for `choice` on a model in the box `bounding_box` (its diagonal sizes the
 /// importance test).
-pub fn make_policy(choice: PolicyChoice, (min, max): ([f32; 3], [f32; 3])) -> DemoPolicy {
-    let size = libm::sqrtf((0..3).map(|k| (max[k] - min[k]) * (max[k] - min[k])).sum());
+pub fn make_policy(choice: PolicyChoice, bounding_box: ([f32; 3], [f32; 3])) -> DemoPolicy {
     match choice {
         PolicyChoice::Screen {
             silhouette,
@@ -317,7 +316,7 @@ pub fn make_policy(choice: PolicyChoice, (min, max): ([f32; 3], [f32; 3])) -> De
             near: f32::INFINITY,
         }),
         PolicyChoice::Importance { threshold } => {
-            DemoPolicy::Importance((Frustum, Importance::new(threshold, size)))
+            DemoPolicy::Importance((Frustum, Importance::for_box(threshold, bounding_box)))
         }
     }
 }

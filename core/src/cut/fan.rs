@@ -1,4 +1,4 @@
-//! Walks around a vertex: the triangles of its fan, proven complete.
+//! Walks around a vertex: the triangles of its fan, proven complete, or just visited.
 //!
 //! Every operation renames corners around one or two vertices, so it must reach every triangle
 //! that uses them. A walk steps from triangle to neighbouring triangle around the vertex; it is
@@ -101,6 +101,36 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             };
         }
         out.len() == degree
+    }
+
+    /// Calls `visit` with each triangle around slot `v`, walking at most as many steps as the
+    /// vertex has triangles (so a fan a crafted file broke ends the walk, not the program).
+    pub(crate) fn for_each_around(&self, v: u32, mut visit: impl FnMut(u32)) {
+        if v as usize >= self.v.len() {
+            return;
+        }
+        let start = self.v.fan(v as usize);
+        let mut left = self.v.degree[v as usize];
+        if start == NIL {
+            return;
+        }
+        let mut f = start;
+        while left > 0 {
+            visit(f);
+            left -= 1;
+            match self.ccw(f, v) {
+                Some(g) if g == start => return,
+                Some(g) if g != NIL => f = g,
+                _ => break,
+            }
+        }
+        // A border: the rest lies clockwise of the start.
+        let mut g = self.cw(start, v).unwrap_or(NIL);
+        while g != NIL && left > 0 {
+            visit(g);
+            left -= 1;
+            g = self.cw(g, v).unwrap_or(NIL);
+        }
     }
 
     /// Whether walking `v`'s fan finds every triangle that uses `v`, each once.

@@ -10,41 +10,11 @@
 //! when the frustum culled a corner's own bounds.
 
 use super::slot::SlotIndex;
-use super::{Cut, NIL};
+use super::Cut;
 use crate::format::HierarchyView;
-use crate::policy::{Demand, Policy, View};
+use crate::policy::{Bounds, Demand, Policy, View};
 
 impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, I> {
-    /// Calls `visit` with each triangle around slot `v`, walking at most as many steps as the
-    /// vertex has triangles (so a fan a crafted file broke ends the walk, not the program).
-    fn for_each_around(&self, v: u32, mut visit: impl FnMut(u32)) {
-        if v as usize >= self.v.len() {
-            return;
-        }
-        let start = self.v.fan(v as usize);
-        let mut left = self.v.degree[v as usize];
-        if start == NIL {
-            return;
-        }
-        let mut f = start;
-        while left > 0 {
-            visit(f);
-            left -= 1;
-            match self.ccw(f, v) {
-                Some(g) if g == start => return,
-                Some(g) if g != NIL => f = g,
-                _ => break,
-            }
-        }
-        // A border: the rest lies clockwise of the start.
-        let mut g = self.cw(start, v).unwrap_or(NIL);
-        while g != NIL && left > 0 {
-            visit(g);
-            left -= 1;
-            g = self.cw(g, v).unwrap_or(NIL);
-        }
-    }
-
     /// The position of slot `s`'s node, as the file stores it.
     #[inline]
     fn node_position(&self, h: &HierarchyView<'_>, s: u32) -> [f32; 3] {
@@ -78,62 +48,54 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         policy.triangle(&corners.map(|c| c.0), reach, view)
     }
 
-    /// `d` raised to `error`; a triangle in view speaks for a vertex whose own bounds the
-    /// frustum culled.
-    fn raised(d: Demand, error: f32) -> Demand {
-        Demand {
-            visible: d.visible || error > 0.0,
-            error,
-        }
-    }
-
-    /// `d`, the policy's demand for slot `s`'s own bounds, raised by the triangles around it.
+    /// The policy's demand for slot `s`, whose node has bounds `b`, raised by the triangles
+    /// around it.
     #[inline]
     pub(crate) fn judged<P: Policy>(
         &self,
         h: &HierarchyView<'_>,
         s: usize,
-        d: Demand,
+        b: &Bounds,
         view: &View,
         policy: &P,
     ) -> Demand {
+        let d = policy.demand(b, view);
         if !policy.judges_triangles() {
             return d;
         }
-        let mut error = if d.visible { d.error } else { 0.0 };
+        let mut triangles = 0.0f32;
         self.for_each_around(s as u32, |f| {
-            error = error.max(self.judge_triangle(h, f, None, view, policy));
+            triangles = triangles.max(self.judge_triangle(h, f, None, view, policy));
         });
-        Self::raised(d, error)
+        d.raised(triangles)
     }
 
-    /// `d`, the policy's demand for the parent of the pair at slots `a` and `b` (at `parent`,
-    /// its region within `parent_reach`), raised by the triangles the pair's collapse would
-    /// leave around the parent.
+    /// The policy's demand for the parent (bounds `b`) of the pair at slots `a` and `b`, raised
+    /// by the triangles the pair's collapse would leave around the parent.
     #[inline]
     pub(crate) fn judged_pair<P: Policy>(
         &self,
         h: &HierarchyView<'_>,
         (a, b): (usize, usize),
-        (parent, parent_reach): ([f32; 3], f32),
-        d: Demand,
+        parent: &Bounds,
         view: &View,
         policy: &P,
     ) -> Demand {
+        let d = policy.demand(parent, view);
         if !policy.judges_triangles() {
             return d;
         }
         let (a, b) = (a as u32, b as u32);
-        let mut error = if d.visible { d.error } else { 0.0 };
+        let mut triangles = 0.0f32;
         for (x, other) in [(a, b), (b, a)] {
             self.for_each_around(x, |f| {
                 // A triangle on both is removed by the collapse.
                 if !self.t.at(f).contains(&other) {
-                    let moved = Some((x, parent, parent_reach));
-                    error = error.max(self.judge_triangle(h, f, moved, view, policy));
+                    let moved = Some((x, parent.center, parent.radius));
+                    triangles = triangles.max(self.judge_triangle(h, f, moved, view, policy));
                 }
             });
         }
-        Self::raised(d, error)
+        d.raised(triangles)
     }
 }

@@ -376,21 +376,17 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         let (Some(a), Some(c)) = (at(x), at(y)) else {
             return d;
         };
-        let mut error = if d.visible { d.error } else { 0.0 };
         // Counter-clockwise: `x, y, left` and `y, x, right` (a border edge has one side).
-        for corners in [
+        let triangles = [
             at(x.left_of(y)).map(|l| [a, c, l]),
             at(x.right_of(y)).map(|r| [c, a, r]),
         ]
         .into_iter()
         .flatten()
-        {
-            error = error.max(policy.triangle(&corners, b.radius, view));
-        }
-        Demand {
-            visible: d.visible || error > 0.0,
-            error,
-        }
+        .fold(0.0f32, |e, corners| {
+            e.max(policy.triangle(&corners, b.radius, view))
+        });
+        d.raised(triangles)
     }
 
     /// The policy's verdict on wavelet vertex `id` at threshold `t`: wanted, and how much.
