@@ -95,7 +95,9 @@ impl Surface {
         }
         let dims_for = |cell: f64| extent.map(|e| ((e / cell) as usize).clamp(0, 1 << 20) + 1);
         let mut dims = dims_for(cell);
-        while (dims[0] * dims[1] * dims[2]) as f64 > CELLS_PER_TRIANGLE * n + 64.0 {
+        // Counted in floating point: the product of three clamped sides overflows a 32-bit usize.
+        let cells_of = |d: [usize; 3]| d[0] as f64 * d[1] as f64 * d[2] as f64;
+        while cells_of(dims) > CELLS_PER_TRIANGLE * n + 64.0 {
             cell *= 1.25;
             dims = dims_for(cell);
         }
