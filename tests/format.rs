@@ -31,20 +31,25 @@ fn cow_bytes() -> &'static [u8] {
 fn walk(view: &HierarchyView<'_>) {
     for i in 0..view.nodes() {
         let n = view.node(i);
-        assert!(n.parent == NONE || (n.parent > i && n.parent < view.nodes()));
+        assert!(n.parent == NONE || n.parent < i);
+        assert_eq!(n.parent == NONE, i < view.roots());
         assert!(n.radius >= 0.0 && n.position.iter().all(|c| c.is_finite()));
     }
-    for p in view.leaves()..view.nodes() {
+    let mut parents = 0;
+    for p in view.parent_nodes() {
+        parents += 1;
         let s = view.split(p);
+        assert!(s.children[1] == s.children[0] + 1);
         assert!(s
             .children
             .iter()
-            .all(|&c| c < p && view.node(c).parent == p));
+            .all(|&c| c > p && c < view.nodes() && view.node(c).parent == p));
         assert!(s
             .neighbours
             .iter()
-            .all(|&f| f == NONE || view.face_creator(f).is_none_or(|q| q > p)));
+            .all(|&f| f == NONE || view.face_creator(f).is_none_or(|q| !view.is_below(q, p))));
     }
+    assert_eq!(parents, view.nodes() - view.leaves());
     for t in 0..view.base_triangles() {
         assert!(view
             .base_triangle(t)
@@ -73,7 +78,7 @@ fn fly(view: &HierarchyView<'_>) {
         };
         let _ = cut.adapt(view, &v, &QRefine::new(0.5 + a), &budget);
     }
-    for p in view.leaves()..view.nodes().min(view.leaves() + 2000) {
+    for p in view.parent_nodes().take(2000) {
         let _ = cut.collapse(view, p);
     }
 }

@@ -313,7 +313,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             for (k, p) in parents[..n].iter_mut().enumerate() {
                 let i = base + k;
                 let m = self.v.mate(i);
-                let splits = demands[k].error > t && self.v.node[i] >= h.leaves();
+                let splits = demands[k].error > t && h.is_parent(self.v.node[i]);
                 *p = if self.v.flags[i] & FIRST_CHILD != 0
                     && m != NIL
                     && !splits
@@ -370,7 +370,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             // The pair was broken up (a forced split took the sibling): blend back.
             self.start_blend(h, i, false);
         }
-        if d.error > t && node >= h.leaves() {
+        if d.error > t && h.is_parent(node) {
             if self.v.flags[i] & COLLAPSING != 0 {
                 // Wanted again: reverse the collapse's blend; no split this frame.
                 self.start_blend(h, i, false);
@@ -659,7 +659,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                     let flags = &mut self.v.flags[cs as usize];
                     *flags = (*flags & !VISIBLE) | d.visible as u8;
                     if d.error > t
-                        && c >= h.leaves()
+                        && h.is_parent(c)
                         && self.candidates.heap_push((d.error.to_bits(), c)).is_err()
                     {
                         frame.stats.queue_overflow = true;

@@ -1,4 +1,4 @@
-//! The hierarchy file format (version 3), read in place from `&[u8]` without allocating.
+//! The hierarchy file format (version 4), read in place from `&[u8]` without allocating.
 //!
 //! A device keeps the bytes in flash (`include_bytes!`) and reads them through a [`HierarchyView`]:
 //! [`HierarchyView::parse`] checks everything once (sizes, magic, version, checksum, every index in
@@ -6,27 +6,36 @@
 //! hostile or corrupted bytes give a [`FormatError`], never a panic; afterwards every accessor is a
 //! bounds-safe little-endian read.
 //!
-//! Version 3 is laid out for size (about 37 bytes per input vertex, against 100 for version 2):
-//! positions are 16-bit fractions of the model's bounding box, bounds are 8-bit logarithms in
-//! units of the box's diagonal (so a model built at any scale gives the same file but for the
-//! header, and the same cut), node and triangle ids are bit-packed at the width the counts need,
-//! leaves carry no bounds (they never split), a split's wings are not stored (the cut reads them
-//! off its neighbours) and neither are depths (walked when asked for).
+//! The format is laid out for size (about 31 bytes per input vertex, against 37 for version 3
+//! and 100 for version 2): positions are 16-bit fractions of the model's bounding box, bounds are
+//! 8-bit logarithms in units of the box's diagonal (so a model built at any scale gives the same
+//! file but for the header, and the same cut), triangle ids are bit-packed at the width the counts
+//! need, leaves carry no bounds (they never split), a split's wings are not stored (the cut reads
+//! them off its neighbours) and neither are depths (walked when asked for).
 //!
-//! All little-endian, sections back to back in this order; `w_n` = the bits that hold a node id
-//! below `nodes` and all-ones as "none" (`bit_width(nodes)`), `w_f` the same for triangle ids
-//! below `faces` = `base_triangles + 2 (nodes - leaves)`:
+//! **Numbering.** Nodes are numbered breadth first, coarse to fine: the `roots = 2 leaves - nodes`
+//! roots are `0..roots`, and the children of the `k`-th parent (in id order) are the sibling pair
+//! `roots + 2k` and `roots + 2k + 1`. So a parent's children are never stored (they follow from
+//! how many parents come before it, counted with the kind bits below), a parent is stored once
+//! per pair, records of siblings are adjacent, and every node has a larger id than its parent.
+//! Leaves are wherever the numbering puts them; an input vertex's id is not its input index
+//! (the builder reports the mapping: `Hierarchy::file_ids`).
+//!
+//! All little-endian, sections back to back in this order; `parents = nodes - leaves`, `w_n` =
+//! the bits that hold a node id below `nodes` and all-ones as "none" (`id_width(nodes)`), `w_f`
+//! the same for triangle ids below `faces = base_triangles + 2 parents`:
 //!
 //! | section | size | content |
 //! |---|---|---|
 //! | header | 64 | see below |
-//! | nodes | 8 per leaf, then 12 per parent | position `3 x u16` (`origin + q * extent / 65535`); normal octahedral `2 x i8` (also the axis of the cone of normals); for a parent then the codes of its radius, spheroid `a`, spheroid `b` ([`decode_length`]) and the cone's sine (`ceil(255 sin)`; 255: no useful cone), 8 bits each, so that everything the refinement test reads of a vertex is one record |
+//! | kinds | 12 per block of 64 nodes | the number of parents among the nodes before the block (`u32`), then one bit per node of the block, set for a parent (`u64`; bits past `nodes` zero) |
+//! | nodes | 8 per leaf, 12 per parent, in id order (node `i` at `8 i + 4 rank(i)`, `rank(i)` the parents below `i`) | position `3 x u16` (`origin + q * extent / 65535`); normal octahedral `2 x i8` (also the axis of the cone of normals); for a parent then the codes of its radius, spheroid `a`, spheroid `b` ([`decode_length`]) and the cone's sine (`ceil(255 sin)`; 255: no useful cone), 8 bits each, so that everything the refinement test reads of a vertex is one record |
 //! | colours | 3 per node, only with flag bit 0 | `3 x u8` |
-//! | parents | `w_n` bits per node, padded to a byte | parent id, all ones for a root |
-//! | splits | `2 w_n + 4 w_f` bits per parent, padded to a byte | children `c0`, `c1` (`w_n` bits each); neighbour triangles `n0..n3` (`w_f` bits each, all ones for none) |
+//! | parents | `w_n` bits per sibling pair, padded to a byte | the pair's parent |
+//! | splits | `4 w_f` bits per parent, padded to a byte | neighbour triangles `n0..n3` (`w_f` bits each, all ones for none) |
 //! | base triangles | 12 each | `3 x u32` root ids, counter-clockwise |
 //!
-//! Header: offset 0 magic `VDLH`; 4 version `u16` = 3; 6 flags `u16` (bit 0: colours); 8
+//! Header: offset 0 magic `VDLH`; 4 version `u16` = 4; 6 flags `u16` (bit 0: colours); 8
 //! `leaves`, 12 `nodes`, 16 `base_triangles` (`u32` each); 20 CRC-32 of everything after the
 //! header ([`CRC_OFFSET`]); 24 bounding-box origin `3 x f32`; 36 extent `3 x f32` (non-negative);
 //! 48 the length unit of the bounds, `f32` (the box's diagonal); 52 to 63 zero.
@@ -34,23 +43,22 @@
 //! Bits are packed least significant first: field `k` of a section starts at bit `k * width`,
 //! and bit `b` is bit `b % 8` of byte `b / 8`.
 //!
-//! Nodes `0..leaves` are the input vertices; nodes `leaves..nodes` are parents, each with a larger
-//! id than its children, so parent links can never form a cycle.
-//!
-//! Triangles have ids too ([`split_face`]): base triangle `k` is `k`, and the split of parent `p`
-//! adds triangle `base + 2 (p - leaves)` = `(c0, c1, w0)` and, when it has a second triangle (a
-//! neighbour `n2` or `n3`), the next id = `(c1, c0, w1)`. A split record's neighbours are the
-//! triangles across those two triangles' outer edges (`c1-w0`, `w0-c0`, `c0-w1`, `w1-c1`), the
-//! `fn0..fn3` of Hoppe's "View-dependent refinement of progressive meshes" (1997): a split is
-//! legal when its neighbours exist, which is what the runtime cut checks and, when they do not,
-//! forces (each neighbour is a base triangle or made by a coarser split, so forcing ends).
+//! Triangles have ids too ([`HierarchyView::split_face`]): base triangle `k` is `k`, and the
+//! split of the `k`-th parent adds triangle `base + 2k` = `(c0, c1, w0)` and, when it has a
+//! second triangle (a neighbour `n2` or `n3`), the next id = `(c1, c0, w1)`. A split record's
+//! neighbours are the triangles across those two triangles' outer edges (`c1-w0`, `w0-c0`,
+//! `c0-w1`, `w1-c1`), the `fn0..fn3` of Hoppe's "View-dependent refinement of progressive meshes"
+//! (1997): a split is legal when its neighbours exist, which is what the runtime cut checks and,
+//! when they do not, forces. `parse` checks that no neighbour is made by the split itself or by a
+//! split below it; the builder's files do every split legally in the reverse of its collapse
+//! order, and the cut's forcing refuses a crafted file whose splits wait on each other.
 
 use core::fmt;
 
 /// First four bytes of a hierarchy file.
 pub const MAGIC: [u8; 4] = *b"VDLH";
 /// The version this crate reads and writes.
-pub const VERSION: u16 = 3;
+pub const VERSION: u16 = 4;
 /// Header size in bytes.
 pub const HEADER_SIZE: usize = 64;
 /// Offset of the CRC-32 in the header.
@@ -63,6 +71,10 @@ pub const BOX_OFFSET: usize = 24;
 pub const NODE_SIZE: usize = 8;
 /// Bytes per parent record (a node record and four bound codes).
 pub const PARENT_SIZE: usize = 12;
+/// Nodes per block of kind bits.
+pub const KIND_BLOCK: u32 = 64;
+/// Bytes per block of kind bits: the parents before the block (`u32`) and the block's bits.
+pub const KIND_SIZE: usize = 12;
 /// Bytes per colour record.
 pub const COLOR_SIZE: usize = 3;
 /// Bytes per base triangle.
@@ -408,8 +420,8 @@ pub const fn id_width(count: u32) -> u32 {
 
 /// The bits of one split record.
 #[must_use]
-pub const fn split_bits(node_width: u32, face_width: u32) -> u64 {
-    2 * node_width as u64 + 4 * face_width as u64
+pub const fn split_bits(face_width: u32) -> u64 {
+    4 * face_width as u64
 }
 
 /// Encodes a unit vector as octahedral coordinates in `[-127, 127]` (nearest).
@@ -452,12 +464,13 @@ pub struct HierarchyView<'a> {
     flags: u16,
     leaves: u32,
     nodes: u32,
+    /// Nodes `0..roots` are the roots.
+    roots: u32,
     base_triangles: u32,
     /// Bits of a node id and of a triangle id.
     node_width: u32,
     face_width: u32,
-    /// Byte offsets of the node, colour, parent, split and base-triangle sections, and of the
-    /// parents' records inside the node section.
+    /// Byte offsets of the kind, node, colour, parent, split and base-triangle sections.
     offsets: [usize; 6],
     /// The positions' box and the bounds' unit.
     model: ModelBox,
@@ -538,16 +551,6 @@ impl SplitView {
     }
 }
 
-/// The id of a triangle a split adds: the first (`second == false`) or the second of parent
-/// `parent`'s split, in a hierarchy with `base` base triangles and `leaves` leaves. Wraps for
-/// ids out of range (a [`HierarchyView`] never stores those).
-#[inline]
-#[must_use]
-pub fn split_face(base: u32, leaves: u32, parent: u32, second: bool) -> u32 {
-    base.wrapping_add(parent.wrapping_sub(leaves).wrapping_mul(2))
-        .wrapping_add(second as u32)
-}
-
 /// Offset of record `index` of `size` bytes in a section at `base`; `usize::MAX` (which reads as
 /// nothing) when it overflows, as it can on 16- and 32-bit targets for out-of-range ids.
 #[inline]
@@ -571,6 +574,14 @@ pub(crate) fn u32_at(b: &[u8], o: usize) -> u32 {
     match b.get(o..o.saturating_add(4)) {
         Some(s) => u32::from_le_bytes([s[0], s[1], s[2], s[3]]),
         None => NONE,
+    }
+}
+
+#[inline]
+fn u64_at(b: &[u8], o: usize) -> u64 {
+    match b.get(o..o.saturating_add(8)) {
+        Some(s) => u64::from_le_bytes([s[0], s[1], s[2], s[3], s[4], s[5], s[6], s[7]]),
+        None => 0,
     }
 }
 
@@ -630,21 +641,23 @@ fn id(raw: u32, width: u32) -> u32 {
 }
 
 impl<'a> HierarchyView<'a> {
-    /// Byte offsets of the sections (nodes, colours, parents, splits, base triangles) and the
-    /// end, for the counts of a header.
-    fn layout(leaves: u32, nodes: u32, base: u32, colors: bool) -> [u64; 6] {
+    /// Byte offsets of the sections (kinds, nodes, colours, parents, splits, base triangles) and
+    /// the end, for the counts of a header.
+    fn layout(leaves: u32, nodes: u32, base: u32, colors: bool) -> [u64; 7] {
+        let parents = (nodes - leaves) as u64;
         let (wn, wf) = (id_width(nodes), id_width(faces_of(leaves, nodes, base)));
-        let n = HEADER_SIZE as u64;
-        let c = n + leaves as u64 * NODE_SIZE as u64 + (nodes - leaves) as u64 * PARENT_SIZE as u64;
+        let k = HEADER_SIZE as u64;
+        let n = k + (nodes as u64).div_ceil(KIND_BLOCK as u64) * KIND_SIZE as u64;
+        let c = n + leaves as u64 * NODE_SIZE as u64 + parents * PARENT_SIZE as u64;
         let p = c + if colors {
             nodes as u64 * COLOR_SIZE as u64
         } else {
             0
         };
-        let s = p + (nodes as u64 * wn as u64).div_ceil(8);
-        let b = s + ((nodes - leaves) as u64 * split_bits(wn, wf)).div_ceil(8);
+        let s = p + (parents * wn as u64).div_ceil(8);
+        let b = s + (parents * split_bits(wf)).div_ceil(8);
         let end = b + base as u64 * TRIANGLE_SIZE as u64;
-        [n, c, p, s, b, end]
+        [k, n, c, p, s, b, end]
     }
 
     /// Validates `bytes` and returns a view of them.
@@ -675,7 +688,7 @@ impl<'a> HierarchyView<'a> {
         }
         let model = ModelBox::read(bytes, BOX_OFFSET).ok_or(FormatError::BadBox)?;
         let layout = Self::layout(leaves, nodes, base, flags & FLAG_COLORS != 0);
-        let end = layout[5];
+        let end = layout[6];
         let actual = bytes.len() as u64;
         if actual < end {
             return Err(FormatError::Truncated {
@@ -700,60 +713,75 @@ impl<'a> HierarchyView<'a> {
             flags,
             leaves,
             nodes,
+            roots: leaves - (nodes - leaves),
             base_triangles: base,
             node_width: id_width(nodes),
             face_width: id_width(faces_of(leaves, nodes, base)),
-            offsets: [
-                layout[0] as usize,
-                layout[1] as usize,
-                layout[2] as usize,
-                layout[3] as usize,
-                layout[4] as usize,
-                HEADER_SIZE + leaves as usize * NODE_SIZE,
-            ],
+            offsets: core::array::from_fn(|k| layout[k] as usize),
             model,
         };
-        view.check_nodes()?;
+        view.check_kinds()?;
+        view.check_pairs()?;
         view.check_splits()?;
         view.check_base()?;
         Ok(view)
     }
 
-    fn check_nodes(&self) -> Result<(), FormatError> {
-        for i in 0..self.nodes {
-            let bad = |what| Err(FormatError::BadNode { node: i, what });
-            let p = self.parent(i);
-            if p != NONE {
-                if p <= i || p >= self.nodes || p < self.leaves {
-                    return bad("parent out of range");
-                }
-                if !self.split(p).children.contains(&i) {
-                    return bad("parent does not list it as a child");
-                }
+    /// Every block's count is the parents before it, bits past the last node are clear, and
+    /// there are `nodes - leaves` parents in all.
+    fn check_kinds(&self) -> Result<(), FormatError> {
+        let blocks = self.nodes.div_ceil(KIND_BLOCK);
+        let mut before = 0u32;
+        for b in 0..blocks {
+            let o = self.offsets[0] + b as usize * KIND_SIZE;
+            let bits = u64_at(self.bytes, o + 4);
+            let first = b * KIND_BLOCK;
+            let used = (self.nodes - first).min(KIND_BLOCK);
+            let stray = used < KIND_BLOCK && bits >> used != 0;
+            if u32_at(self.bytes, o) != before || stray {
+                return Err(FormatError::BadNode {
+                    node: first,
+                    what: "the kind bits or their counts are inconsistent",
+                });
             }
+            before += bits.count_ones();
+        }
+        if before != self.nodes - self.leaves {
+            return Err(FormatError::BadCounts);
+        }
+        Ok(())
+    }
+
+    /// The `k`-th parent is the stored parent of pair `k`, and comes before its children.
+    fn check_pairs(&self) -> Result<(), FormatError> {
+        let mut k = 0u32;
+        for p in 0..self.nodes {
+            if !self.is_parent(p) {
+                continue;
+            }
+            let child = self.roots + 2 * k;
+            if p >= child || self.parent(child) != p {
+                return Err(FormatError::BadNode {
+                    node: p,
+                    what: "parent out of range or not the parent its children name",
+                });
+            }
+            k += 1;
         }
         Ok(())
     }
 
     fn check_splits(&self) -> Result<(), FormatError> {
         let faces = self.faces();
-        for p in self.leaves..self.nodes {
+        for p in self.parent_nodes() {
             let bad = |what| Err(FormatError::BadNode { node: p, what });
-            let s = self.split(p);
-            let [a, b] = s.children;
-            if a >= p || b >= p || a == b {
-                return bad("children out of range");
-            }
-            if self.parent(a) != p || self.parent(b) != p {
-                return bad("children do not point back");
-            }
-            // Each neighbour exists before this split: a base triangle or one a coarser split
-            // (larger id) adds; none across a missing triangle. (One triangle can be the
-            // neighbour of both added ones, when a child has three neighbours.)
-            let n = s.neighbours;
+            // Each neighbour is a base triangle or made by a split that is neither this one nor
+            // below it; none across a missing triangle. (One triangle can be the neighbour of
+            // both added ones, when a child has three neighbours.)
+            let n = self.split(p).neighbours;
             for &f in n.iter().filter(|&&f| f != NONE) {
-                if f >= faces || self.face_creator(f).is_some_and(|q| q <= p) {
-                    return bad("neighbour triangle out of range or not older than the split");
+                if f >= faces || self.face_creator(f).is_some_and(|q| self.is_below(q, p)) {
+                    return bad("neighbour triangle out of range or made by this split or below");
                 }
             }
             if n[0] == n[1] || (n[2] == n[3] && n[2] != NONE) {
@@ -766,12 +794,20 @@ impl<'a> HierarchyView<'a> {
         Ok(())
     }
 
+    /// Whether node `q` is `p` or a descendant of `p` (walks up from `q`: a parent's id is
+    /// smaller than its children's).
+    #[must_use]
+    pub fn is_below(&self, mut q: u32, p: u32) -> bool {
+        while q != NONE && q > p {
+            q = self.parent(q);
+        }
+        q == p
+    }
+
     fn check_base(&self) -> Result<(), FormatError> {
         for t in 0..self.base_triangles {
             let tri = self.base_triangle(t);
-            let ok = tri
-                .iter()
-                .all(|&v| v < self.nodes && self.parent(v) == NONE)
+            let ok = tri.iter().all(|&v| v < self.roots)
                 && tri[0] != tri[1]
                 && tri[1] != tri[2]
                 && tri[0] != tri[2];
@@ -802,7 +838,8 @@ impl<'a> HierarchyView<'a> {
         (center, radius)
     }
 
-    /// Input vertices: nodes `0..leaves()`.
+    /// How many leaves (input vertices) there are; which ids they have, [`HierarchyView::is_parent`]
+    /// says.
     #[must_use]
     pub fn leaves(&self) -> u32 {
         self.leaves
@@ -812,6 +849,13 @@ impl<'a> HierarchyView<'a> {
     #[must_use]
     pub fn nodes(&self) -> u32 {
         self.nodes
+    }
+
+    /// The roots, nodes `0..roots()`: the vertices of the base mesh (and input vertices no
+    /// triangle used).
+    #[must_use]
+    pub fn roots(&self) -> u32 {
+        self.roots
     }
 
     /// Triangles of the base mesh.
@@ -826,31 +870,79 @@ impl<'a> HierarchyView<'a> {
         faces_of(self.leaves, self.nodes, self.base_triangles)
     }
 
+    /// Whether node `i` is a parent (it splits), and how many parents have smaller ids.
+    #[inline(always)]
+    fn kind(&self, i: u32) -> (bool, u32) {
+        let o = record(self.offsets[0], i / KIND_BLOCK, KIND_SIZE);
+        let before = u32_at(self.bytes, o);
+        let bits = u64_at(self.bytes, o.saturating_add(4));
+        let at = i % KIND_BLOCK;
+        let below = bits & ((1u64 << at) - 1);
+        (
+            i < self.nodes && (bits >> at) & 1 != 0,
+            before.wrapping_add(below.count_ones()),
+        )
+    }
+
+    /// Whether node `i` is a parent, i.e. it has a split (false for leaves and ids out of range).
+    #[inline]
+    #[must_use]
+    pub fn is_parent(&self, i: u32) -> bool {
+        self.kind(i).0
+    }
+
+    /// Node `i`'s place among the leaves (`0..leaves()`, in id order), or `None` for a parent or
+    /// an id out of range: what numbers the vertices of a full-detail mesh.
+    #[must_use]
+    pub fn leaf_index(&self, i: u32) -> Option<u32> {
+        let (parent, rank) = self.kind(i);
+        (i < self.nodes && !parent).then(|| i - rank)
+    }
+
+    /// Every parent in id order: coarse to fine, each after its own parent.
+    pub fn parent_nodes(&self) -> impl Iterator<Item = u32> + '_ {
+        (0..self.nodes).filter(|&i| self.is_parent(i))
+    }
+
+    /// Every leaf in id order.
+    pub fn leaf_nodes(&self) -> impl Iterator<Item = u32> + '_ {
+        (0..self.nodes).filter(|&i| !self.is_parent(i))
+    }
+
     /// The parent whose split adds triangle `face`, or `None` for a base triangle (and for ids out
     /// of range).
     #[inline]
     #[must_use]
     pub fn face_creator(&self, face: u32) -> Option<u32> {
-        let k = face.checked_sub(self.base_triangles)?;
-        let p = self.leaves.checked_add(k / 2)?;
-        (p < self.nodes).then_some(p)
+        let k = face.checked_sub(self.base_triangles)? / 2;
+        (k < self.nodes - self.leaves).then(|| self.pair_parent(k))
     }
 
-    /// The id of a triangle parent `p`'s split adds (see [`split_face`]).
+    /// The id of a triangle parent `p`'s split adds: the first (`second == false`) or the second
+    /// (see the module doc). Meaningless (but no panic) when `p` is not a parent.
     #[inline]
     #[must_use]
     pub fn split_face(&self, p: u32, second: bool) -> u32 {
-        split_face(self.base_triangles, self.leaves, p, second)
+        let rank = self.kind(p).1;
+        self.base_triangles
+            .wrapping_add(rank.wrapping_mul(2))
+            .wrapping_add(second as u32)
     }
 
     /// Node `i`'s parent, or [`NONE`] (also for ids out of range).
     #[inline]
     #[must_use]
     pub fn parent(&self, i: u32) -> u32 {
-        if i >= self.nodes {
+        if i < self.roots || i >= self.nodes {
             return NONE;
         }
-        let bit = self.offsets[2] as u64 * 8 + i as u64 * self.node_width as u64;
+        self.pair_parent((i - self.roots) / 2)
+    }
+
+    /// The parent of sibling pair `k` (`k < nodes - leaves`).
+    #[inline(always)]
+    fn pair_parent(&self, k: u32) -> u32 {
+        let bit = self.offsets[3] as u64 * 8 + k as u64 * self.node_width as u64;
         id(bits_at(self.bytes, bit, self.node_width), self.node_width)
     }
 
@@ -873,18 +965,27 @@ impl<'a> HierarchyView<'a> {
         self.bytes.get(o..end)?.try_into().ok()
     }
 
+    /// Where node `i`'s record starts, whether it is a parent's, and the parents before it
+    /// (`usize::MAX` for ids out of range).
+    #[inline(always)]
+    fn locate(&self, i: u32) -> (usize, bool, u32) {
+        let (parent, rank) = self.kind(i);
+        if i >= self.nodes {
+            return (usize::MAX, false, rank);
+        }
+        // In range: `parse` proved the section inside the file, so no overflow.
+        let o =
+            self.offsets[1] + i as usize * NODE_SIZE + rank as usize * (PARENT_SIZE - NODE_SIZE);
+        (o, parent, rank)
+    }
+
     /// The first byte of node `i`'s record (0 out of range): reading it brings the record into
     /// the cache. A caller that touches a batch of nodes before decoding them has the processor
     /// fetch all their records at once instead of one after the other.
     #[inline(always)]
     #[must_use]
     pub fn touch(&self, i: u32) -> u8 {
-        let o = if i < self.leaves {
-            record(self.offsets[0], i, NODE_SIZE)
-        } else {
-            record(self.offsets[5], i.wrapping_sub(self.leaves), PARENT_SIZE)
-        };
-        self.bytes.get(o).copied().unwrap_or(0)
+        self.bytes.get(self.locate(i).0).copied().unwrap_or(0)
     }
 
     /// Node `i`'s [`Digest`] (zeros out of range).
@@ -914,18 +1015,6 @@ impl<'a> HierarchyView<'a> {
         self.model.length(code)
     }
 
-    /// Leaf `i`'s position.
-    #[inline]
-    fn leaf_position(&self, i: u32) -> [f32; 3] {
-        let at = if i < self.leaves {
-            record(self.offsets[0], i, NODE_SIZE)
-        } else {
-            usize::MAX
-        };
-        let r: [u8; 6] = self.fixed(at).unwrap_or([0; 6]);
-        self.model.position(&r)
-    }
-
     /// Node `i`'s record: position, normal and (for a parent) its bound codes (radius, `a`, `b`,
     /// cone sine); a leaf's codes (and anything out of range) are zeros and no cone.
     #[inline]
@@ -939,33 +1028,15 @@ impl<'a> HierarchyView<'a> {
     /// out of range all zeros but no cone.
     #[inline]
     fn record_bytes(&self, i: u32) -> [u8; PARENT_SIZE] {
-        if let Some(r) = self.parent_record(i) {
-            return r;
+        let (o, parent, _) = self.locate(i);
+        if parent {
+            return self.fixed(o).unwrap_or([0; PARENT_SIZE]);
         }
         let mut r = [0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 255];
-        if i < self.leaves {
-            if let Some(leaf) = self.fixed::<NODE_SIZE>(record(self.offsets[0], i, NODE_SIZE)) {
-                r[..NODE_SIZE].copy_from_slice(&leaf);
-            }
+        if let Some(leaf) = self.fixed::<NODE_SIZE>(o) {
+            r[..NODE_SIZE].copy_from_slice(&leaf);
         }
         r
-    }
-
-    /// Parent `i`'s 12-byte record (`None` for a leaf or an id out of range).
-    #[inline(always)]
-    fn parent_record(&self, i: u32) -> Option<[u8; PARENT_SIZE]> {
-        if i < self.leaves || i >= self.nodes {
-            return None;
-        }
-        // In range: `parse` proved the section inside the file, so no overflow.
-        let o = self.offsets[5] + (i - self.leaves) as usize * PARENT_SIZE;
-        self.fixed(o)
-    }
-
-    #[inline]
-    fn split_bit(&self, p: u32) -> u64 {
-        let k = p.wrapping_sub(self.leaves) as u64;
-        self.offsets[3] as u64 * 8 + k * split_bits(self.node_width, self.face_width)
     }
 
     /// Node `i` (`i < nodes()`; out-of-range ids read as zeros with no parent, never panic).
@@ -999,7 +1070,7 @@ impl<'a> HierarchyView<'a> {
         if !self.has_colors() {
             return [255; 3];
         }
-        self.fixed(record(self.offsets[1], i, COLOR_SIZE))
+        self.fixed(record(self.offsets[2], i, COLOR_SIZE))
             .unwrap_or([0; 3])
     }
 
@@ -1021,15 +1092,20 @@ impl<'a> HierarchyView<'a> {
     #[inline]
     #[must_use]
     pub fn bounds(&self, i: u32) -> crate::policy::Bounds {
-        let Some(r) = self.parent_record(i) else {
-            return crate::policy::Bounds {
-                center: self.leaf_position(i),
-                radius: 0.0,
-                axis: [0.0, 0.0, 1.0],
-                cone_sin: 1.0,
-                a2: 0.0,
-                b2: 0.0,
-            };
+        let (o, parent, _) = self.locate(i);
+        let r: [u8; PARENT_SIZE] = match parent {
+            true => self.fixed(o).unwrap_or([0; PARENT_SIZE]),
+            false => {
+                let leaf: [u8; 6] = self.fixed(o).unwrap_or([0; 6]);
+                return crate::policy::Bounds {
+                    center: self.model.position(&leaf),
+                    radius: 0.0,
+                    axis: [0.0, 0.0, 1.0],
+                    cone_sin: 1.0,
+                    a2: 0.0,
+                    b2: 0.0,
+                };
+            }
         };
         let (a, b) = (self.length(r[9]), self.length(r[10]));
         crate::policy::Bounds {
@@ -1042,36 +1118,29 @@ impl<'a> HierarchyView<'a> {
         }
     }
 
-    /// The split record of parent `p` (`leaves() <= p < nodes()`; anything else reads as
-    /// [`NONE`]s).
+    /// The split record of parent `p` (anything else reads as [`NONE`]s).
     #[inline]
     #[must_use]
     pub fn split(&self, p: u32) -> SplitView {
-        if p < self.leaves || p >= self.nodes {
+        let (parent, rank) = self.kind(p);
+        if !parent {
             return SplitView {
                 children: [NONE; 2],
                 neighbours: [NONE; 4],
             };
         }
-        let (wn, wf) = (self.node_width, self.face_width);
-        let at = self.split_bit(p);
-        if 2 * wn + 4 * wf + 7 <= 128 {
-            // The whole record in one 16-byte window (every hierarchy below a million nodes).
+        let wf = self.face_width;
+        let at = self.offsets[4] as u64 * 8 + rank as u64 * split_bits(wf);
+        let neighbours = if 4 * wf + 7 <= 128 {
+            // The whole record in one 16-byte window (every hierarchy below a billion faces).
             let w = window(self.bytes, at);
-            let field = |offset: u32, width: u32| id((w >> offset) as u32 & low(width), width);
-            return SplitView {
-                children: [field(0, wn), field(wn, wn)],
-                neighbours: [0, 1, 2, 3].map(|k| field(2 * wn + k * wf, wf)),
-            };
-        }
-        let node = |k: u64| id(bits_at(self.bytes, at + k * wn as u64, wn), wn);
-        let face = |k: u64| {
-            let bit = at + 2 * wn as u64 + k * wf as u64;
-            id(bits_at(self.bytes, bit, wf), wf)
+            [0, 1, 2, 3].map(|k| id((w >> (k * wf)) as u32 & low(wf), wf))
+        } else {
+            [0, 1, 2, 3].map(|k| id(bits_at(self.bytes, at + k as u64 * wf as u64, wf), wf))
         };
         SplitView {
-            children: [node(0), node(1)],
-            neighbours: [face(0), face(1), face(2), face(3)],
+            children: self.pair(rank),
+            neighbours,
         }
     }
 
@@ -1080,21 +1149,23 @@ impl<'a> HierarchyView<'a> {
     #[inline]
     #[must_use]
     pub fn children(&self, p: u32) -> [u32; 2] {
-        if p < self.leaves || p >= self.nodes {
-            return [NONE; 2];
+        match self.kind(p) {
+            (true, rank) => self.pair(rank),
+            _ => [NONE; 2],
         }
-        let wn = self.node_width;
-        let w = window(self.bytes, self.split_bit(p));
-        [
-            id(w as u32 & low(wn), wn),
-            id((w >> wn) as u32 & low(wn), wn),
-        ]
+    }
+
+    /// Sibling pair `k`.
+    #[inline(always)]
+    fn pair(&self, k: u32) -> [u32; 2] {
+        let c0 = self.roots.wrapping_add(k.wrapping_mul(2));
+        [c0, c0.wrapping_add(1)]
     }
 
     /// Base triangle `t`.
     #[must_use]
     pub fn base_triangle(&self, t: u32) -> [u32; 3] {
-        let o = record(self.offsets[4], t, TRIANGLE_SIZE);
+        let o = record(self.offsets[5], t, TRIANGLE_SIZE);
         [0, 4, 8].map(|k| u32_at(self.bytes, o.saturating_add(k)))
     }
 }

@@ -37,7 +37,7 @@ fuzz_target!(|data: &[u8]| {
         };
         let _ = cut.adapt(&view, &v, &QRefine::new(0.25 + a), &budget);
     }
-    for p in view.leaves()..view.nodes().min(view.leaves() + 512) {
+    for p in view.parent_nodes().take(512) {
         let _ = cut.collapse(&view, p);
     }
 });

@@ -11,15 +11,15 @@ fn check(data: &[u8]) {
     if let Ok(view) = HierarchyView::parse(data) {
         for i in 0..view.nodes() {
             let n = view.node(i);
-            assert!(n.parent == NONE || n.parent > i);
+            assert!(n.parent == NONE || n.parent < i);
         }
-        for p in view.leaves()..view.nodes() {
+        for p in view.parent_nodes() {
             let s = view.split(p);
-            assert!(s.children.iter().all(|&c| c < p));
+            assert!(s.children.iter().all(|&c| c > p && view.parent(c) == p));
             assert!(s
                 .neighbours
                 .iter()
-                .all(|&f| f == NONE || view.face_creator(f).is_none_or(|q| q > p)));
+                .all(|&f| f == NONE || view.face_creator(f).is_none_or(|q| !view.is_below(q, p))));
         }
         for t in 0..view.base_triangles() {
             assert!(view.base_triangle(t).iter().all(|&v| v < view.nodes()));

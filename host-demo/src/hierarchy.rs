@@ -5,7 +5,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use vdlod_core::build::{build, BuildOptions, Hierarchy, InputMesh, Progress};
-use vdlod_core::format::{HierarchyView, NONE};
+use vdlod_core::format::HierarchyView;
 
 use crate::mesh::IndexedMesh;
 
@@ -50,15 +50,14 @@ impl fmt::Display for Summary {
 pub fn summarize(view: &HierarchyView<'_>) -> Summary {
     let mut max_depth = 0u32;
     let mut sum = 0u64;
-    for i in 0..view.leaves() {
+    for i in view.leaf_nodes() {
         let d = view.depth(i) as u32;
         max_depth = max_depth.max(d);
         sum += d as u64;
     }
-    let base_vertices = (0..view.nodes())
-        .filter(|&i| view.parent(i) == NONE)
-        .count() as u32;
-    let border_splits = (view.leaves()..view.nodes())
+    let base_vertices = view.roots();
+    let border_splits = view
+        .parent_nodes()
         .filter(|&p| !view.split(p).second())
         .count() as u32;
     let splits = view.nodes() - view.leaves();

@@ -93,6 +93,8 @@ fn cameras() -> [(&'static str, Camera); 2] {
 struct Built {
     bytes: Vec<u8>,
     seconds: f64,
+    /// The parents (file ids) in the reverse of the order the builder collapsed them.
+    replay: Vec<u32>,
 }
 
 fn build(mesh: &IndexedMesh, cost: Cost, base_vertices: u32) -> Result<Built, String> {
@@ -101,17 +103,30 @@ fn build(mesh: &IndexedMesh, cost: Cost, base_vertices: u32) -> Result<Built, St
         base_vertices,
         ..BuildOptions::default()
     };
-    let (_, bytes, seconds) =
+    let (hierarchy, bytes, seconds) =
         build_with_progress(mesh, &opts, false).map_err(|e| format!("terrain: {e}"))?;
-    Ok(Built { bytes, seconds })
+    let ids = hierarchy.file_ids();
+    let replay = (hierarchy.leaves as usize..ids.len())
+        .rev()
+        .map(|p| ids[p])
+        .collect();
+    Ok(Built {
+        bytes,
+        seconds,
+        replay,
+    })
 }
 
 /// The mesh the builder had when `triangles` were left: the splits replayed from the base mesh
 /// in the reverse of the order the collapses were made, until there are at least `triangles`.
-fn reduced(h: &HierarchyView<'_>, triangles: usize) -> Result<Box<TerrainCut>, String> {
+fn reduced(
+    h: &HierarchyView<'_>,
+    replay: &[u32],
+    triangles: usize,
+) -> Result<Box<TerrainCut>, String> {
     let mut cut = TerrainCut::boxed();
     cut.reset(h).map_err(|e| e.to_string())?;
-    for p in (h.leaves()..h.nodes()).rev() {
+    for &p in replay {
         if cut.triangles().len() >= triangles {
             break;
         }
@@ -256,7 +271,7 @@ pub fn terrain(out: &Path) -> Result<Vec<String>, String> {
         let h = HierarchyView::parse(&built.bytes).map_err(|e| e.to_string())?;
         for percent in [25usize, 10] {
             let want = total * percent / 100;
-            let cut = reduced(&h, want)?;
+            let cut = reduced(&h, &built.replay, want)?;
             if percent == 10 {
                 ten_percent_vertices[ci] = cut.vertex_count() as u32;
             }

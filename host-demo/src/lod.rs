@@ -9,7 +9,7 @@ use std::time::Instant;
 use vdlod::{Style, WaveletMesh};
 use vdlod_core::adapt::{Budget, FrameStats};
 use vdlod_core::cut::{Coloring, Cut, SlotIndex};
-use vdlod_core::format::HierarchyView;
+use vdlod_core::format::{HierarchyView, NONE};
 use vdlod_core::policy::{
     Bounds as NodeBounds, Demand, Frustum, Importance, MergeTree, Policy, QRefine, ScreenError,
     View,
@@ -63,7 +63,7 @@ pub fn cut_size(h: &HierarchyView<'_>, max_triangles: u32) -> (u64, u64) {
     let triangles = full
         .min(max_triangles as u64)
         .max(h.base_triangles() as u64);
-    let roots = h.nodes() as u64 - 2 * (h.nodes() - h.leaves()) as u64;
+    let roots = h.roots() as u64;
     let vertices = (h.leaves() as u64).min(triangles + 2 * roots + 2);
     (vertices, triangles)
 }
@@ -207,12 +207,14 @@ fn full_detail_with<const V: usize, const F: usize, const Q: usize, I: SlotIndex
 ) -> Result<IndexedMesh, String> {
     cut.reset(h).map_err(|e| e.to_string())?;
     while cut.refine_everything(h) > 0 {}
-    let positions: Vec<[f32; 3]> = (0..h.leaves()).map(|i| h.node(i).position).collect();
+    let leaves: Vec<u32> = h.leaf_nodes().collect();
+    let positions: Vec<[f32; 3]> = leaves.iter().map(|&i| h.node(i).position).collect();
     let nodes = cut.nodes();
+    // Vertices numbered by leaf index (NONE for a corner that is not a leaf).
     let triangles: Vec<[u32; 3]> = cut
         .triangles()
         .iter()
-        .map(|t| t.map(|s| nodes[s.index()]))
+        .map(|t| t.map(|s| h.leaf_index(nodes[s.index()]).unwrap_or(NONE)))
         .collect();
     cut.check(h).map_err(|d| {
         format!(
@@ -220,7 +222,7 @@ fn full_detail_with<const V: usize, const F: usize, const Q: usize, I: SlotIndex
             d.what, d.slot
         )
     })?;
-    if triangles.iter().flatten().any(|&v| v >= h.leaves()) {
+    if triangles.iter().flatten().any(|&v| v == NONE) {
         return Err(if cut.vertex_count() >= V || triangles.len() + 2 > F {
             format!("full detail needs more than the largest cut's {V} vertices and {F} triangles")
         } else {
@@ -231,7 +233,7 @@ fn full_detail_with<const V: usize, const F: usize, const Q: usize, I: SlotIndex
     }
     let colors = h
         .has_colors()
-        .then(|| (0..h.leaves()).map(|i| h.node(i).color).collect());
+        .then(|| leaves.iter().map(|&i| h.node(i).color).collect());
     let mut mesh = IndexedMesh {
         normals: vertex_normals(&positions, &triangles),
         positions,
@@ -246,7 +248,7 @@ fn full_detail_with<const V: usize, const F: usize, const Q: usize, I: SlotIndex
 pub fn leaf_bounds(h: &HierarchyView<'_>) -> Bounds {
     let mut min = glam::Vec3::splat(f32::INFINITY);
     let mut max = glam::Vec3::splat(f32::NEG_INFINITY);
-    for i in 0..h.leaves() {
+    for i in h.leaf_nodes() {
         let p = glam::Vec3::from(h.node(i).position);
         min = min.min(p);
         max = max.max(p);

@@ -419,7 +419,7 @@ fn info_rejects_what_orbit_rejects() {
         triangles: &cow.triangles,
     };
     let mut h = build(&input, &Default::default(), &mut |_| {}).unwrap();
-    // Swap the neighbours of the first added triangle of the finest split that has both.
+    // Swap the neighbours of the first added triangle of the first split that has both.
     let p = (h.leaves as usize..h.nodes.len())
         .find(|&p| h.nodes[p].neighbours[0] != NONE && h.nodes[p].neighbours[1] != NONE)
         .unwrap();

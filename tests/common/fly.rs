@@ -14,14 +14,18 @@ use vdlod_core::policy::{BackFace, Frustum, ScreenError, View};
 use vdlod_demo::mesh::IndexedMesh;
 
 pub fn hierarchy_bytes(mesh: &IndexedMesh) -> Vec<u8> {
+    hierarchy_and_ids(mesh).0
+}
+
+/// The file, and the node id it gives each input vertex.
+pub fn hierarchy_and_ids(mesh: &IndexedMesh) -> (Vec<u8>, Vec<u32>) {
     let input = InputMesh {
         positions: &mesh.positions,
         colors: mesh.colors.as_deref(),
         triangles: &mesh.triangles,
     };
-    build(&input, &BuildOptions::default(), &mut |_| {})
-        .unwrap()
-        .to_bytes(false)
+    let h = build(&input, &BuildOptions::default(), &mut |_| {}).unwrap();
+    (h.to_bytes(false), h.file_ids())
 }
 
 pub fn node_triangles<const V: usize, const F: usize, const Q: usize, I: SlotIndex>(

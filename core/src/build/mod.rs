@@ -128,7 +128,8 @@ pub struct Node {
 /// A built vertex forest.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Hierarchy {
-    /// The input's vertex count: nodes `0..leaves` are the input vertices, in input order.
+    /// The input's vertex count: nodes `0..leaves` are the input vertices, in input order (in
+    /// the file they are numbered otherwise: [`Hierarchy::file_ids`]).
     pub leaves: u32,
     /// All nodes: the leaves, then the parents in the order they were formed.
     pub nodes: Vec<Node>,
@@ -163,14 +164,20 @@ impl Hierarchy {
     /// The id of a triangle: base triangle `k` is `k`; the split of parent `p` adds triangles
     /// `base + 2 (p - leaves)` (`children[0], children[1], wings[0]`) and the next id
     /// (`children[1], children[0], wings[1]`, absent on a border). Every triangle of every cut
-    /// has one id for as long as it exists, whatever its corners are renamed to.
+    /// has one id for as long as it exists, whatever its corners are renamed to. (These are the
+    /// build's ids; the file renumbers nodes and triangles: see [`Hierarchy::file_ids`].)
     pub fn face_id(&self, parent: u32, second: bool) -> u32 {
-        crate::format::split_face(
-            self.base_triangles.len() as u32,
-            self.leaves,
-            parent,
-            second,
-        )
+        (self.base_triangles.len() as u32)
+            .wrapping_add(parent.wrapping_sub(self.leaves).wrapping_mul(2))
+            .wrapping_add(second as u32)
+    }
+
+    /// The parent whose split adds triangle `face` ([`Hierarchy::face_id`]'s inverse), or `None`
+    /// for a base triangle and ids out of range.
+    pub fn face_creator(&self, face: u32) -> Option<u32> {
+        let k = face.checked_sub(self.base_triangles.len() as u32)? / 2;
+        let p = self.leaves.checked_add(k)?;
+        ((p as usize) < self.nodes.len()).then_some(p)
     }
 
     /// The roots: the vertices of the base mesh (including input vertices no triangle used).

@@ -274,13 +274,22 @@ fn bytes_round_trip_through_the_format() {
         }
     }
     let quantum = (0..3).map(|k| hi[k] - lo[k]).fold(0.0f32, f32::max) / 65535.0;
+    // The file numbers the nodes breadth first: `ids` maps the build's ids to the file's.
+    let ids = h.file_ids();
+    let id = |i: u32| if i == NONE { NONE } else { ids[i as usize] };
+    let mut seen = ids.clone();
+    seen.sort_unstable();
+    assert!(seen.iter().enumerate().all(|(k, &i)| i == k as u32));
     for (i, n) in h.nodes.iter().enumerate() {
-        let v = view.node(i as u32);
+        let f = id(i as u32);
+        let v = view.node(f);
         for k in 0..3 {
             assert!((v.position[k] - n.position[k]).abs() <= quantum, "node {i}");
         }
-        assert_eq!(v.parent, n.parent);
+        assert_eq!(v.parent, id(n.parent));
+        assert!(n.parent == NONE || n.parent > i as u32 && v.parent < f);
         assert_eq!(v.depth, n.depth);
+        assert_eq!(view.is_parent(f), i as u32 >= h.leaves);
         if (i as u32) < h.leaves {
             continue; // leaves carry no bounds
         }
@@ -295,21 +304,28 @@ fn bytes_round_trip_through_the_format() {
         );
         assert!(close(v.spheroid[0], n.spheroid[0]) && close(v.spheroid[1], n.spheroid[1]));
         assert!(v.cone_sin >= n.cone_sin.min(1.0));
-        if n.parent != NONE {
-            let s = view.split(n.parent);
-            assert!(s.children.contains(&(i as u32)));
-        }
-    }
-    for p in h.leaves..h.nodes.len() as u32 {
-        let s = view.split(p);
-        let n = &h.nodes[p as usize];
-        assert_eq!((s.children, s.neighbours), (n.children, n.neighbours));
+        // Siblings are adjacent, in the build's order.
+        let s = view.split(f);
+        assert_eq!(s.children, n.children.map(id));
+        assert_eq!(s.children[1], s.children[0] + 1);
         assert_eq!(s.second(), n.wings[1] != NONE);
+        // The split's triangles and neighbours keep their meaning under the renumbering.
+        for second in [false, true] {
+            assert_eq!(view.face_creator(view.split_face(f, second)), Some(f));
+        }
+        for (k, &g) in n.neighbours.iter().enumerate() {
+            let read = s.neighbours[k];
+            assert_eq!(read == NONE, g == NONE);
+            let creator = h.face_creator(g);
+            assert_eq!(view.face_creator(read), creator.map(id), "node {i}");
+        }
     }
     let base: Vec<[u32; 3]> = (0..view.base_triangles())
         .map(|k| view.base_triangle(k))
         .collect();
-    assert_eq!(base, h.base_triangles);
+    let mapped: Vec<[u32; 3]> = h.base_triangles.iter().map(|t| t.map(id)).collect();
+    assert_eq!(base, mapped);
+    assert!(base.iter().flatten().all(|&r| r < view.roots()));
 
     // Out-of-range ids read as nothing, never panic (the offsets would overflow on small targets).
     for id in [u32::MAX, u32::MAX - 1] {
@@ -317,7 +333,8 @@ fn bytes_round_trip_through_the_format() {
         assert_eq!(view.split(id).children, [NONE; 2]);
         assert_eq!(view.base_triangle(id), [NONE; 3]);
     }
-    assert_eq!(view.split(0).children, [NONE; 2]); // a leaf has no split record
+    let leaf = view.leaf_nodes().next().unwrap();
+    assert_eq!(view.split(leaf).children, [NONE; 2]); // a leaf has no split record
 
     // One flipped bit anywhere after the header breaks the checksum.
     let mut bad = bytes.clone();

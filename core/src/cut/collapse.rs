@@ -31,7 +31,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         node: u32,
         fans: &mut PairFans,
     ) -> Result<CollapsePlan, Refused> {
-        if node < h.leaves() || node >= h.nodes() {
+        if !h.is_parent(node) {
             return Err(Refused::NoSuchOperation);
         }
         let s = h.split(node);

@@ -587,7 +587,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         let mut i = 0;
         while i < n.min(self.v.len()) {
             let v = self.v.node[i];
-            if v >= h.leaves() {
+            if h.is_parent(v) {
                 if let Ok(k) = self.force_split(h, v, 0, &mut |_, _| Ok(())) {
                     done += k;
                 }

@@ -34,7 +34,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         moved: &mut Fan,
     ) -> Result<SplitPlan, Refused> {
         let ps = self.slot(node).ok_or(Refused::NotActive)?;
-        if node < h.leaves() {
+        if !h.is_parent(node) {
             return Err(Refused::NoSuchOperation);
         }
         let s = h.split(node);

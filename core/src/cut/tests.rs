@@ -31,7 +31,7 @@ fn positions<const V: usize, const F: usize, const Q: usize, I: SlotIndex>(
         .collect()
 }
 
-/// A name, a hierarchy file, and the triangles it was built from.
+/// A name, a hierarchy file, and the triangles it was built from (in the file's node ids).
 type Case = (&'static str, Vec<u8>, Vec<[u32; 3]>);
 
 fn meshes() -> Vec<Case> {
@@ -47,6 +47,8 @@ fn meshes() -> Vec<Case> {
             ..BuildOptions::default()
         };
         let h = build_it(&p, &t, opts);
+        let ids = h.file_ids();
+        let t = t.iter().map(|tri| tri.map(|v| ids[v as usize])).collect();
         out.push((name, h.to_bytes(false), t));
     }
     out
@@ -67,9 +69,10 @@ fn full_refinement_gives_the_input_and_full_coarsening_the_base() {
         }
         assert_eq!(node_triangles(&cut), sorted(input.clone()), "{name}");
         // Collapse finest first until nothing is left to collapse.
+        let parents: Vec<u32> = h.parent_nodes().collect();
         loop {
             let mut done = 0;
-            for p in h.leaves()..h.nodes() {
+            for &p in parents.iter().rev() {
                 if cut.collapse(&h, p).is_ok() {
                     done += 1;
                     cut.check(&h).unwrap_or_else(|d| panic!("{name}: {d:?}"));
@@ -121,12 +124,15 @@ fn random_splits_and_collapses_keep_a_valid_manifold() {
 #[test]
 fn forced_splits_bring_what_a_split_needs() {
     let (p, t) = sphere(3);
-    let bytes = build_it(&p, &t, BuildOptions::default()).to_bytes(false);
+    let built = build_it(&p, &t, BuildOptions::default());
+    let bytes = built.to_bytes(false);
+    let ids = built.file_ids();
+    let t = t.iter().map(|tri| tri.map(|v| ids[v as usize])).collect();
     let h = HierarchyView::parse(&bytes).unwrap();
     let mut cut: Box<Small> = Cut::boxed();
     cut.reset(&h).unwrap();
     // Every leaf's parent can be reached from the base mesh by forcing alone.
-    for leaf in 0..h.leaves() {
+    for leaf in h.leaf_nodes() {
         let mut v = leaf;
         while !cut.is_active(v) {
             let mut a = h.parent(v);
@@ -275,7 +281,7 @@ mod adapt {
         let mut max_unsplit = 0f32;
         let mut min_collapsible = f32::MAX;
         for (i, &n) in cut.nodes().iter().enumerate() {
-            if n >= h.leaves() {
+            if h.is_parent(n) {
                 max_unsplit = max_unsplit.max(policy.demand(&h.bounds(n), &view).error);
             }
             if let Some(p) = cut.pair_parent(&h, i) {
@@ -364,7 +370,7 @@ mod adapt {
                 .fold(0.0, f32::max);
             if policy.triangle(&c, reach, &view) > 1.0 {
                 important += 1;
-                assert!(nodes.iter().all(|&n| n < h.leaves()), "{nodes:?}");
+                assert!(nodes.iter().all(|&n| !h.is_parent(n)), "{nodes:?}");
             }
         }
         assert!(
