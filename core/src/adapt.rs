@@ -68,7 +68,7 @@ use crate::cut::{
     Cut, Pair, PairFans, Refused, SlotIndex, BLENDING, BLOCKED, COLLAPSING, FIRST_CHILD, VISIBLE,
     WAS_VISIBLE,
 };
-use crate::format::{HierarchyView, NONE};
+use crate::format::{HierarchyView, Record, NONE};
 use crate::policy::{Bounds, Demand, Policy, View};
 
 /// Limits on one frame's cut.
@@ -268,6 +268,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         let mut quick = [false; BATCH];
         let mut demands = [Demand::NONE; BATCH];
         let mut parents = [NONE; BATCH];
+        let mut records = [Record::default(); BATCH];
         let mut parent_bounds = [Bounds::default(); BATCH];
         let mut base = 0;
         while base < self.v.len() {
@@ -281,19 +282,24 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 bounds[k].radius = h.length(digest.radius);
             }
             let nodes = &self.v.node[base..base + n];
-            let touched = nodes
-                .iter()
-                .zip(&quick)
-                .filter(|(_, &q)| !q)
-                .fold(0u8, |acc, (&node, _)| acc ^ h.touch(node));
-            core::hint::black_box(touched);
-            for ((b, &node), _) in bounds
+            let mut touched = 0u8;
+            for ((r, &node), _) in records
                 .iter_mut()
                 .zip(nodes)
                 .zip(&quick)
                 .filter(|(_, &q)| !q)
             {
-                *b = h.bounds(node);
+                *r = h.record(node);
+                touched ^= h.touch_record(*r);
+            }
+            core::hint::black_box(touched);
+            for ((b, r), _) in bounds
+                .iter_mut()
+                .zip(&records)
+                .zip(&quick)
+                .filter(|(_, &q)| !q)
+            {
+                *b = h.bounds_at(*r);
             }
             for k in 0..n {
                 demands[k] = if quick[k] {
@@ -324,14 +330,19 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                     NONE
                 };
             }
-            let touched = parents[..n]
-                .iter()
-                .filter(|&&p| p != NONE)
-                .fold(0u8, |acc, &p| acc ^ h.touch(p));
+            let mut touched = 0u8;
+            for (r, &p) in records
+                .iter_mut()
+                .zip(&parents[..n])
+                .filter(|(_, &p)| p != NONE)
+            {
+                *r = h.record(p);
+                touched ^= h.touch_record(*r);
+            }
             core::hint::black_box(touched);
-            for (b, &p) in parent_bounds.iter_mut().zip(&parents[..n]) {
+            for ((b, r), &p) in parent_bounds.iter_mut().zip(&records).zip(&parents[..n]) {
                 if p != NONE {
-                    *b = h.bounds(p);
+                    *b = h.bounds_at(*r);
                 }
             }
             for k in 0..n {
@@ -480,7 +491,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             }
             let seen = e >= 0.0 && (fa | fb) & WAS_VISIBLE != 0;
             let split = h.split(p);
-            let legal = self.collapse_legal_at(h, p, &split, a as u32, b as u32, &mut fans);
+            let legal = self.collapse_legal_at(&split, a as u32, b as u32, &mut fans);
             if legal.is_err() && !blending {
                 self.block(a, b);
                 continue;

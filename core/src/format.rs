@@ -532,11 +532,23 @@ impl Digest {
     };
 }
 
+/// Where a node's record is in a [`HierarchyView`] ([`HierarchyView::record`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Record {
+    /// Byte offset (`usize::MAX` for a node out of range).
+    offset: usize,
+    /// Whether it is a parent's record.
+    parent: bool,
+}
+
 /// One parent's split record.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct SplitView {
     /// The two children.
     pub children: [u32; 2],
+    /// The ids of the triangles the split adds (the second means nothing unless
+    /// [`SplitView::second`]).
+    pub faces: [u32; 2],
     /// Triangles across the added triangles' outer edges (`c1-w0`, `w0-c0`, `c0-w1`, `w1-c1`),
     /// or [`NONE`].
     pub neighbours: [u32; 4],
@@ -874,8 +886,9 @@ impl<'a> HierarchyView<'a> {
     #[inline(always)]
     fn kind(&self, i: u32) -> (bool, u32) {
         let o = record(self.offsets[0], i / KIND_BLOCK, KIND_SIZE);
-        let before = u32_at(self.bytes, o);
-        let bits = u64_at(self.bytes, o.saturating_add(4));
+        let b: [u8; KIND_SIZE] = self.fixed(o).unwrap_or([0; KIND_SIZE]);
+        let before = u32::from_le_bytes([b[0], b[1], b[2], b[3]]);
+        let bits = u64::from_le_bytes([b[4], b[5], b[6], b[7], b[8], b[9], b[10], b[11]]);
         let at = i % KIND_BLOCK;
         let below = bits & ((1u64 << at) - 1);
         (
@@ -939,6 +952,18 @@ impl<'a> HierarchyView<'a> {
         self.pair_parent((i - self.roots) / 2)
     }
 
+    /// Node `i`'s sibling and whether `i` is the first child (`(NONE, false)` for roots and
+    /// ids out of range): siblings are adjacent, so this reads nothing.
+    #[inline]
+    #[must_use]
+    pub fn sibling(&self, i: u32) -> (u32, bool) {
+        if i < self.roots || i >= self.nodes {
+            return (NONE, false);
+        }
+        let k = i - self.roots;
+        (self.roots + (k ^ 1), k & 1 == 0)
+    }
+
     /// The parent of sibling pair `k` (`k < nodes - leaves`).
     #[inline(always)]
     fn pair_parent(&self, k: u32) -> u32 {
@@ -965,18 +990,22 @@ impl<'a> HierarchyView<'a> {
         self.bytes.get(o..end)?.try_into().ok()
     }
 
-    /// Where node `i`'s record starts, whether it is a parent's, and the parents before it
-    /// (`usize::MAX` for ids out of range).
+    /// Where node `i`'s record is: counting the parents before it costs a little, so a caller
+    /// that reads a record twice (touches it, then decodes it) finds it once.
     #[inline(always)]
-    fn locate(&self, i: u32) -> (usize, bool, u32) {
+    #[must_use]
+    pub fn record(&self, i: u32) -> Record {
         let (parent, rank) = self.kind(i);
         if i >= self.nodes {
-            return (usize::MAX, false, rank);
+            return Record {
+                offset: usize::MAX,
+                parent: false,
+            };
         }
         // In range: `parse` proved the section inside the file, so no overflow.
-        let o =
+        let offset =
             self.offsets[1] + i as usize * NODE_SIZE + rank as usize * (PARENT_SIZE - NODE_SIZE);
-        (o, parent, rank)
+        Record { offset, parent }
     }
 
     /// The first byte of node `i`'s record (0 out of range): reading it brings the record into
@@ -985,7 +1014,14 @@ impl<'a> HierarchyView<'a> {
     #[inline(always)]
     #[must_use]
     pub fn touch(&self, i: u32) -> u8 {
-        self.bytes.get(self.locate(i).0).copied().unwrap_or(0)
+        self.touch_record(self.record(i))
+    }
+
+    /// [`HierarchyView::touch`] of a located record.
+    #[inline(always)]
+    #[must_use]
+    pub fn touch_record(&self, r: Record) -> u8 {
+        self.bytes.get(r.offset).copied().unwrap_or(0)
     }
 
     /// Node `i`'s [`Digest`] (zeros out of range).
@@ -1028,7 +1064,7 @@ impl<'a> HierarchyView<'a> {
     /// out of range all zeros but no cone.
     #[inline]
     fn record_bytes(&self, i: u32) -> [u8; PARENT_SIZE] {
-        let (o, parent, _) = self.locate(i);
+        let Record { offset: o, parent } = self.record(i);
         if parent {
             return self.fixed(o).unwrap_or([0; PARENT_SIZE]);
         }
@@ -1092,7 +1128,14 @@ impl<'a> HierarchyView<'a> {
     #[inline]
     #[must_use]
     pub fn bounds(&self, i: u32) -> crate::policy::Bounds {
-        let (o, parent, _) = self.locate(i);
+        self.bounds_at(self.record(i))
+    }
+
+    /// [`HierarchyView::bounds`] of a located record.
+    #[inline]
+    #[must_use]
+    pub fn bounds_at(&self, at: Record) -> crate::policy::Bounds {
+        let Record { offset: o, parent } = at;
         let r: [u8; PARENT_SIZE] = match parent {
             true => self.fixed(o).unwrap_or([0; PARENT_SIZE]),
             false => {
@@ -1126,6 +1169,7 @@ impl<'a> HierarchyView<'a> {
         if !parent {
             return SplitView {
                 children: [NONE; 2],
+                faces: [NONE; 2],
                 neighbours: [NONE; 4],
             };
         }
@@ -1138,8 +1182,10 @@ impl<'a> HierarchyView<'a> {
         } else {
             [0, 1, 2, 3].map(|k| id(bits_at(self.bytes, at + k as u64 * wf as u64, wf), wf))
         };
+        let first = self.base_triangles.wrapping_add(rank.wrapping_mul(2));
         SplitView {
             children: self.pair(rank),
+            faces: [first, first.wrapping_add(1)],
             neighbours,
         }
     }

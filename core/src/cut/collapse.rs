@@ -31,21 +31,19 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         node: u32,
         fans: &mut PairFans,
     ) -> Result<CollapsePlan, Refused> {
-        if !h.is_parent(node) {
-            return Err(Refused::NoSuchOperation);
-        }
         let s = h.split(node);
         let [c0, c1] = s.children;
+        if c0 == NONE {
+            return Err(Refused::NoSuchOperation);
+        }
         let a = self.slot(c0).ok_or(Refused::NotActive)?;
         let b = self.slot(c1).ok_or(Refused::NotActive)?;
-        self.collapse_legal_at(h, node, &s, a, b, fans)
+        self.collapse_legal_at(&s, a, b, fans)
     }
 
     /// [`Cut::collapse_legal`] with the children's slots `a` and `b` known.
     pub(crate) fn collapse_legal_at(
         &self,
-        h: &HierarchyView<'_>,
-        node: u32,
         s: &SplitView,
         a: u32,
         b: u32,
@@ -55,7 +53,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         if !self.complete_fan(a, fan_a) {
             return Err(Refused::Inconsistent);
         }
-        let id = h.split_face(node, false);
+        let id = s.faces[0];
         let fl = fan_a
             .iter()
             .copied()
@@ -83,7 +81,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             let Some(t) = self.t.get(fr) else {
                 return Err(Refused::Illegal);
             };
-            if self.t.id[fr as usize] != h.split_face(node, true) {
+            if self.t.id[fr as usize] != s.faces[1] {
                 return Err(Refused::Illegal);
             }
             let j = corner(t, b).ok_or(Refused::Inconsistent)?;

@@ -459,13 +459,10 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         if p == NONE {
             return;
         }
-        let [c0, c1] = h.children(p);
-        let sibling = if c0 == node {
+        let (sibling, first) = h.sibling(node);
+        if first {
             self.v.flags[i] |= FIRST_CHILD;
-            c1
-        } else {
-            c0
-        };
+        }
         if let Some(m) = self.slot(sibling) {
             self.v.set_mate(i, m);
             self.v.set_mate(m as usize, s);

@@ -12,6 +12,9 @@ pub(crate) struct SplitPlan {
     parent: u32,
     /// The neighbour triangles' slots (`fn0..fn3`, `NIL` where the file has none).
     neighbours: [u32; 4],
+    /// The children's node ids and the ids of the triangles the split adds.
+    children: [u32; 2],
+    faces: [u32; 2],
     /// The wing vertices' slots (the second `NIL` on a border).
     wings: [u32; 2],
 }
@@ -34,10 +37,10 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         moved: &mut Fan,
     ) -> Result<SplitPlan, Refused> {
         let ps = self.slot(node).ok_or(Refused::NotActive)?;
-        if !h.is_parent(node) {
+        let s = h.split(node);
+        if s.children[0] == NONE {
             return Err(Refused::NoSuchOperation);
         }
-        let s = h.split(node);
         let n = s.neighbours;
         let second = s.second();
         // The neighbour triangles must all be around the vertex (whose fan must be whole).
@@ -134,6 +137,8 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         Ok(SplitPlan {
             parent: ps,
             neighbours: ns,
+            children: s.children,
+            faces: s.faces,
             wings: [wl, wr],
         })
     }
@@ -149,10 +154,11 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         moved: &Fan,
         frames: u16,
     ) -> [u32; 2] {
-        let [c0, c1] = h.children(node);
         let SplitPlan {
             parent: ps,
             neighbours: ns,
+            children: [c0, c1],
+            faces,
             wings: [wl, wr],
         } = *plan;
         let second = wr != NIL;
@@ -190,14 +196,10 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         let fl = self.t.len() as u32;
         let fr = if second { fl + 1 } else { NIL };
         // `split_legal` proved room for both.
-        let first = self
-            .t
-            .push([ps, c1s, wl], [fr, ns[0], ns[1]], h.split_face(node, false));
+        let first = self.t.push([ps, c1s, wl], [fr, ns[0], ns[1]], faces[0]);
         debug_assert_eq!(first, Some(fl), "room for a split's triangles was proven");
         if second {
-            let pushed = self
-                .t
-                .push([c1s, ps, wr], [fl, ns[2], ns[3]], h.split_face(node, true));
+            let pushed = self.t.push([c1s, ps, wr], [fl, ns[2], ns[3]], faces[1]);
             debug_assert_eq!(pushed, Some(fr), "room for a split's triangles was proven");
         }
         self.point_edge(ns[0], wl, c1s, fl);
