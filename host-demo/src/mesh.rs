@@ -123,6 +123,7 @@ impl IndexedMesh {
             colors: self.colors.as_deref(),
             triangles: &self.triangles,
             face_colors: None,
+            uvs: None,
         }
     }
 }

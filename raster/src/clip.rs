@@ -76,24 +76,23 @@ pub fn outcode(p: Vec4) -> u8 {
     }
 }
 
-/// A clip-space vertex carrying its colour through clipping.
+/// A clip-space vertex carrying its colour and texture coordinates through clipping.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ClipVertex {
     /// Homogeneous position.
     pub pos: Vec4,
     /// Colour in `0.0..=255.0`.
     pub rgb: [f32; 3],
+    /// Texture coordinates (zeros for an untextured draw).
+    pub uv: [f32; 2],
 }
 
 impl ClipVertex {
     fn lerp(a: &ClipVertex, b: &ClipVertex, t: f32) -> ClipVertex {
-        let mut rgb = [0.0; 3];
-        for (c, (x, y)) in rgb.iter_mut().zip(a.rgb.iter().zip(b.rgb.iter())) {
-            *c = x + (y - x) * t;
-        }
         ClipVertex {
             pos: a.pos + (b.pos - a.pos) * t,
-            rgb,
+            rgb: core::array::from_fn(|k| a.rgb[k] + (b.rgb[k] - a.rgb[k]) * t),
+            uv: core::array::from_fn(|k| a.uv[k] + (b.uv[k] - a.uv[k]) * t),
         }
     }
 }
@@ -152,7 +151,7 @@ fn snap_to_plane(plane: u8, p: &mut Vec4) {
 /// ```
 /// use glam::Vec4;
 /// use vdlod_raster::clip::{clip_triangle, outcode, ClipVertex};
-/// let v = |x: f32, z: f32| ClipVertex { pos: Vec4::new(x, 0.0, z, 1.0), rgb: [0.0; 3] };
+/// let v = |x: f32, z: f32| ClipVertex { pos: Vec4::new(x, 0.0, z, 1.0), ..ClipVertex::default() };
 /// let tri = [v(0.0, -1.0), v(1.0, 0.5), v(-1.0, 0.5)]; // first vertex behind the near plane
 /// let planes = tri.iter().fold(0, |acc, v| acc | outcode(v.pos));
 /// let poly = clip_triangle(&tri, planes);
@@ -203,6 +202,7 @@ mod tests {
         ClipVertex {
             pos: Vec4::new(x, y, z, w),
             rgb: [x, y, z],
+            uv: [x, y],
         }
     }
 

@@ -12,6 +12,8 @@
 //! Triangles that span several bands are set up once per band, and the few that need clipping are
 //! clipped again in each.
 
+mod textured;
+
 use core::fmt;
 
 use glam::{Mat3, Mat4, Vec3};
@@ -21,7 +23,7 @@ use crate::edge::{
     fill_triangle, pixel_bounds, scan, signed_area2, signed_area2_xy, Coverage, Facing, Fragment,
     ScreenVertex, SUBPIXEL_BITS,
 };
-use crate::mesh::{MeshSource, VertexIndex};
+use crate::mesh::{MeshSource, Uv, VertexIndex};
 use crate::target::{check_frame, Depth, Pixel, Target, TargetError};
 use crate::vertex::{
     shade_vertices, to_clip, Light, PreparedLighting, ShadedVertex, VertexLighting, Viewport,
@@ -126,6 +128,8 @@ pub enum DrawError {
     },
     /// Gouraud shading needs vertex normals.
     MissingNormals,
+    /// A textured draw needs texture coordinates.
+    MissingUvs,
     /// The frame size given to [`shade`] is zero or too large.
     Frame(TargetError),
     /// The row bins of [`ShadedMesh::bin`] are fewer than the triangles.
@@ -165,6 +169,7 @@ impl fmt::Display for DrawError {
                 actual,
             } => write!(f, "{attribute} has {actual} entries, expected {expected}"),
             DrawError::MissingNormals => write!(f, "Gouraud shading needs vertex normals"),
+            DrawError::MissingUvs => write!(f, "a textured draw needs texture coordinates"),
             DrawError::Frame(e) => write!(f, "{e}"),
             DrawError::BinsTooSmall { needed, available } => write!(
                 f,
@@ -408,8 +413,9 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
                     self.mesh,
                     tri,
                     [[0.0; 3]; 3],
+                    [[0.0; 2]; 3],
                     union,
-                    |s| {
+                    |s, _| {
                         if facing.draws(signed_area2(s)) {
                             stats.rasterized += 1;
                         } else {
@@ -512,12 +518,32 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
                 scan(target, &s, area.abs(), bounds, depth_test::<P, D>);
             } else if needs_clipping(&v, union, &mut stats) {
                 let colors = triangle_colors(mesh, params, prepared, t, tri, &v);
-                for_each_clipped(viewport, params, mesh, tri, colors, union, |s| {
+                let uvs = [[0.0; 2]; 3];
+                for_each_clipped(viewport, params, mesh, tri, colors, uvs, union, |s, _| {
                     fill(target, &mut stats, s)
                 });
             }
         }
+        self.draw_wireframe::<P, D, BINNED>(target, rows);
+        stats
+    }
 
+    /// The wireframe overlay, when [`DrawParams::wireframe`] asks for it (binned as
+    /// [`ShadedMesh::draw_triangles`] is).
+    fn draw_wireframe<P: Pixel, D: Depth, const BINNED: bool>(
+        &self,
+        target: &mut Target<'_, P, D>,
+        rows: &[[u16; 2]],
+    ) {
+        let (mesh, params, scratch) = (self.mesh, self.params, self.vertices);
+        let viewport = &self.viewport;
+        let (top, bottom) = (target.window.y, target.window.y + target.window.height - 1);
+        let misses = |t: usize| {
+            BINNED && {
+                let [first, last] = rows[t].map(usize::from);
+                last < top || first > bottom
+            }
+        };
         if let Some(wire) = params.wireframe {
             let color = P::from_rgb(wire[0], wire[1], wire[2]);
             for (t, tri) in mesh.triangles().iter().enumerate() {
@@ -541,13 +567,20 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
                 if union == 0 {
                     edges(&v.map(|v| v.screen()));
                 } else {
-                    for_each_clipped(viewport, params, mesh, tri, [[0.0; 3]; 3], union, |s| {
-                        edges(s)
-                    });
+                    let none = ([[0.0; 3]; 3], [[0.0; 2]; 3]);
+                    for_each_clipped(
+                        viewport,
+                        params,
+                        mesh,
+                        tri,
+                        none.0,
+                        none.1,
+                        union,
+                        |s, _| edges(s),
+                    );
                 }
             }
         }
-        stats
     }
 }
 
@@ -620,30 +653,42 @@ fn triangle_colors<M: MeshSource>(
     }
 }
 
-/// Clips a triangle with its corner colours and calls `f` with each projected piece.
+/// Clips a triangle with its corner colours and texture coordinates (zeros when not textured)
+/// and calls `f` with each projected piece and its corners' `[u / w, v / w, 1 / w]`.
+#[allow(clippy::too_many_arguments)]
 fn for_each_clipped<M: MeshSource>(
     viewport: &Viewport,
     params: &DrawParams,
     mesh: &M,
     tri: &[u32; 3],
     colors: [[f32; 3]; 3],
+    uvs: [Uv; 3],
     planes: u8,
-    mut f: impl FnMut(&[ScreenVertex; 3]),
+    mut f: impl FnMut(&[ScreenVertex; 3], &[[f32; 3]; 3]),
 ) {
     let tri: [ClipVertex; 3] = core::array::from_fn(|k| ClipVertex {
         pos: to_clip(&params.mvp, Vec3::from(mesh.position(tri[k] as usize))),
         rgb: colors[k],
+        uv: uvs[k],
     });
     let poly = clip_triangle(&tri, planes);
     let verts = poly.vertices();
     if verts.len() < 3 {
         return;
     }
-    let first = viewport.project(verts[0].pos, verts[0].rgb);
-    let mut prev = viewport.project(verts[1].pos, verts[1].rgb);
+    let corner = |cv: &ClipVertex| {
+        // Clipped to the near plane and the guard band: `w` is positive.
+        let inv_w = 1.0 / cv.pos.w;
+        (
+            viewport.project(cv.pos, cv.rgb),
+            [cv.uv[0] * inv_w, cv.uv[1] * inv_w, inv_w],
+        )
+    };
+    let first = corner(&verts[0]);
+    let mut prev = corner(&verts[1]);
     for cv in &verts[2..] {
-        let cur = viewport.project(cv.pos, cv.rgb);
-        f(&[first, prev, cur]);
+        let cur = corner(cv);
+        f(&[first.0, prev.0, cur.0], &[first.1, prev.1, cur.1]);
         prev = cur;
     }
 }

@@ -256,10 +256,77 @@ pub(crate) fn scan<P: Pixel, D: Depth, F>(
     target: &mut Target<'_, P, D>,
     v: &[ScreenVertex; 3],
     area: i64,
-    [x0, x1, y0, y1]: [i64; 4],
+    bounds: [i64; 4],
     mut plot: F,
 ) where
     F: FnMut(&mut P, &mut D, Fragment<'_>),
+{
+    let attrs = Attrs::new(v, area);
+    pixels(target, v, bounds, |c, d, e1, e2| {
+        plot(c, d, attrs.at(e1, e2))
+    });
+}
+
+/// Texture coordinates over a triangle, perspective-correct: `u / w`, `v / w` and `1 / w` are
+/// affine in screen space, so they are stepped like depth and colour, and `(u, v)` is their
+/// quotient at each pixel.
+#[derive(Clone, Copy)]
+struct TexCoords {
+    base: [f32; 3],
+    d1: [f32; 3],
+    d2: [f32; 3],
+}
+
+impl TexCoords {
+    #[inline(always)]
+    fn new(q: &[[f32; 3]; 3], area: i64) -> TexCoords {
+        let inv = 1.0 / area as f32;
+        TexCoords {
+            base: q[0],
+            d1: core::array::from_fn(|k| (q[1][k] - q[0][k]) * inv),
+            d2: core::array::from_fn(|k| (q[2][k] - q[0][k]) * inv),
+        }
+    }
+
+    #[inline(always)]
+    fn at(&self, e1: i64, e2: i64) -> [f32; 2] {
+        let (w1, w2) = (e1 as f32, e2 as f32);
+        let c = |k: usize| self.base[k] + w1 * self.d1[k] + w2 * self.d2[k];
+        let inv_w = c(2);
+        [c(0) / inv_w, c(1) / inv_w]
+    }
+}
+
+/// [`scan`] for a textured triangle: `q` holds each corner's `[u / w, v / w, 1 / w]` (`w` its
+/// clip-space w), and `plot` also receives the pixel's `(u, v)`.
+#[inline(always)]
+pub(crate) fn scan_textured<P: Pixel, D: Depth, F>(
+    target: &mut Target<'_, P, D>,
+    v: &[ScreenVertex; 3],
+    q: &[[f32; 3]; 3],
+    area: i64,
+    bounds: [i64; 4],
+    mut plot: F,
+) where
+    F: FnMut(&mut P, &mut D, Fragment<'_>, [f32; 2]),
+{
+    let attrs = Attrs::new(v, area);
+    let uv = TexCoords::new(q, area);
+    pixels(target, v, bounds, |c, d, e1, e2| {
+        plot(c, d, attrs.at(e1, e2), uv.at(e1, e2))
+    });
+}
+
+/// The covered pixels of a clockwise triangle within `bounds`, each visited with the edge
+/// functions opposite vertices 1 and 2 (the barycentric weights times the area).
+#[inline(always)]
+fn pixels<P: Pixel, D: Depth, F>(
+    target: &mut Target<'_, P, D>,
+    v: &[ScreenVertex; 3],
+    [x0, x1, y0, y1]: [i64; 4],
+    mut visit: F,
+) where
+    F: FnMut(&mut P, &mut D, i64, i64),
 {
     let px = (x0 << SUBPIXEL_BITS) + HALF;
     let py = (y0 << SUBPIXEL_BITS) + HALF;
@@ -268,7 +335,6 @@ pub(crate) fn scan<P: Pixel, D: Depth, F>(
         Edge::new(&v[2], &v[0], px, py),
         Edge::new(&v[0], &v[1], px, py),
     ];
-    let attrs = Attrs::new(v, area);
     let (x0, x1) = (x0 as usize, x1 as usize);
     let (span, stride) = (x1 - x0, target.stride);
     let mut first = target.index(x0, y0 as usize);
@@ -282,7 +348,7 @@ pub(crate) fn scan<P: Pixel, D: Depth, F>(
         for (c, d) in crow.iter_mut().zip(drow.iter_mut()) {
             if (e0 | e1 | e2) >= 0 {
                 entered = true;
-                plot(c, d, attrs.at(e1, e2));
+                visit(c, d, e1, e2);
             } else if entered {
                 break; // a triangle meets each row in one span
             }

@@ -13,7 +13,9 @@
 //! - [`edge`]: fixed-point edge functions with the top-left fill rule, depth and colour stepping;
 //! - [`wire`]: the wireframe overlay;
 //! - [`target`]: caller-owned buffers, whole frames or bands of them, pixel formats ([`Rgba8`],
-//!   [`Rgb565`], [`Rgb565Be`]) and depth types (`u32`, `u16`).
+//!   [`Rgb565`], [`Rgb565Be`]) and depth types (`u32`, `u16`);
+//! - [`texture`]: texels in a caller-provided slice, sampled nearest or bilinear in fixed point,
+//!   for [`ShadedMesh::draw_textured`] (perspective-correct).
 //!
 //! [`shade`] and [`ShadedMesh::draw`] compose them for an indexed mesh ([`Mesh`], or any
 //! [`MeshSource`]); [`draw_indexed`] does both for a whole frame.
@@ -49,6 +51,7 @@ mod draw;
 pub mod edge;
 mod mesh;
 pub mod target;
+pub mod texture;
 pub mod vertex;
 pub mod wire;
 
@@ -57,7 +60,7 @@ pub use display::{flush, flush_with};
 pub use draw::{
     draw_indexed, shade, BinnedMesh, DrawError, DrawParams, DrawStats, ShadedMesh, Shading,
 };
-pub use mesh::{Mesh, MeshSource, SourceVertex, VertexBatch, VertexIndex, BATCH};
+pub use mesh::{Mesh, MeshSource, SourceVertex, Uv, VertexBatch, VertexIndex, BATCH};
 pub use target::{
     Depth, Pixel, Rgb565, Rgb565Be, Rgba8, Target, TargetError, Window, DEPTH_CLEAR, MAX_DIMENSION,
 };

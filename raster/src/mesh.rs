@@ -40,6 +40,9 @@ pub struct SourceVertex {
     pub color: [u8; 3],
 }
 
+/// Texture coordinates of a vertex (see [`crate::texture`] for their meaning).
+pub type Uv = [f32; 2];
+
 /// Vertices per [`VertexBatch`]: two AVX or four SSE/NEON registers per attribute.
 pub const BATCH: usize = 8;
 
@@ -95,6 +98,16 @@ pub trait MeshSource {
     fn face_colors(&self) -> Option<&[[u8; 3]]> {
         None
     }
+    /// Whether the vertices have texture coordinates ([`crate::ShadedMesh::draw_textured`]
+    /// needs them).
+    fn has_uvs(&self) -> bool {
+        false
+    }
+    /// Vertex `i`'s texture coordinates (zeros without them).
+    fn uv(&self, i: usize) -> Uv {
+        let _ = i;
+        [0.0; 2]
+    }
     /// Checks what the source itself can get wrong (attribute arrays of the wrong length).
     fn check(&self) -> Result<(), DrawError> {
         Ok(())
@@ -116,6 +129,8 @@ pub struct Mesh<'a, I: VertexIndex = u32> {
     /// Per-triangle colours that replace the vertex or base colour (for example a false colour by
     /// hierarchy depth); lighting still applies.
     pub face_colors: Option<&'a [[u8; 3]]>,
+    /// Per-vertex texture coordinates, for [`crate::ShadedMesh::draw_textured`].
+    pub uvs: Option<&'a [Uv]>,
 }
 
 impl<I: VertexIndex> Default for Mesh<'_, I> {
@@ -126,6 +141,7 @@ impl<I: VertexIndex> Default for Mesh<'_, I> {
             colors: None,
             triangles: &[],
             face_colors: None,
+            uvs: None,
         }
     }
 }
@@ -204,6 +220,14 @@ impl<I: VertexIndex> MeshSource for Mesh<'_, I> {
         self.face_colors
     }
 
+    fn has_uvs(&self) -> bool {
+        self.uvs.is_some()
+    }
+
+    fn uv(&self, i: usize) -> Uv {
+        self.uvs.map_or([0.0; 2], |u| u[i])
+    }
+
     fn check(&self) -> Result<(), DrawError> {
         let n = self.positions.len();
         if let Some(normals) = self.normals {
@@ -211,6 +235,9 @@ impl<I: VertexIndex> MeshSource for Mesh<'_, I> {
         }
         if let Some(colors) = self.colors {
             check_len("colors", n, colors.len())?;
+        }
+        if let Some(uvs) = self.uvs {
+            check_len("uvs", n, uvs.len())?;
         }
         if let Some(faces) = self.face_colors {
             check_len("face_colors", self.triangles.len(), faces.len())?;
