@@ -12,9 +12,10 @@ use vdlod_core::adapt::{Budget, FrameStats};
 use vdlod_core::cut::{Cut, SlotIndex};
 use vdlod_core::format::HierarchyView;
 use vdlod_core::policy::Policy;
+use vdlod_raster::texture::Texture;
 use vdlod_raster::{
     shade, Depth, DrawError, DrawParams, DrawStats, Light, MeshSource, Pixel, ShadedVertex,
-    Shading, SourceVertex, Target, TargetError, VertexIndex, Window,
+    Shading, SourceVertex, Target, TargetError, Uv, VertexIndex, Window,
 };
 
 use crate::camera::{Camera, CameraError};
@@ -25,6 +26,7 @@ pub struct CutMesh<'a, 'h, const V: usize, const F: usize, const Q: usize, I: Sl
     cut: &'a Cut<V, F, Q, I>,
     h: &'a HierarchyView<'h>,
     colors: bool,
+    uvs: Option<&'a [Uv]>,
 }
 
 impl<'a, 'h, const V: usize, const F: usize, const Q: usize, I: SlotIndex>
@@ -34,7 +36,23 @@ impl<'a, 'h, const V: usize, const F: usize, const Q: usize, I: SlotIndex>
     /// (the file's, or a false colour, see [`vdlod_core::cut::Coloring`]), else in the draw's base
     /// colour.
     pub fn new(cut: &'a Cut<V, F, Q, I>, h: &'a HierarchyView<'h>, colors: bool) -> Self {
-        CutMesh { cut, h, colors }
+        CutMesh {
+            cut,
+            h,
+            colors,
+            uvs: None,
+        }
+    }
+
+    /// With texture coordinates for [`draw_mesh_textured`], one per node of the hierarchy (by
+    /// node id; a node past the end reads zeros). The file has none: a vertex hierarchy gives a
+    /// parent whatever coordinates its builder chose (the mean of its children's, say), which is
+    /// why a texture slides over a vertex forest's cut and not over a wavelet cut.
+    pub fn with_uvs(self, uvs: &'a [Uv]) -> Self {
+        CutMesh {
+            uvs: Some(uvs),
+            ..self
+        }
     }
 }
 
@@ -67,6 +85,19 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex + VertexIndex>
 
     fn has_colors(&self) -> bool {
         self.colors
+    }
+
+    fn has_uvs(&self) -> bool {
+        self.uvs.is_some()
+    }
+
+    #[inline]
+    fn uv(&self, i: usize) -> Uv {
+        let node = self.cut.nodes().get(i).copied().unwrap_or(u32::MAX);
+        self.uvs
+            .and_then(|u| u.get(node as usize))
+            .copied()
+            .unwrap_or([0.0; 2])
     }
 }
 
@@ -239,6 +270,23 @@ pub fn draw_mesh<P: Pixel, D: Depth, M: MeshSource>(
     let params = style.params(camera);
     let shaded = shade(mesh, &params, camera.width, camera.height, scratch)?;
     Ok(shaded.draw(target)?)
+}
+
+/// [`draw_mesh`] with `texture` mapped by the mesh's texture coordinates (perspective-correct;
+/// see [`vdlod_raster::ShadedMesh::draw_textured`]): each pixel is the texel times the lit
+/// colour, so a white [`Style::base_color`] without vertex colours shows the texture as it is.
+pub fn draw_mesh_textured<P: Pixel, D: Depth, M: MeshSource, T: Pixel>(
+    target: &mut Target<'_, P, D>,
+    mesh: &M,
+    camera: &Camera,
+    style: &Style,
+    texture: &Texture<'_, T>,
+    scratch: &mut [ShadedVertex],
+) -> Result<DrawStats, FrameError> {
+    camera.check()?;
+    let params = style.params(camera);
+    let shaded = shade(mesh, &params, camera.width, camera.height, scratch)?;
+    Ok(shaded.draw_textured(target, texture)?)
 }
 
 /// Band buffers: one colour and one depth buffer of `rows` full-width rows, reused for every

@@ -23,7 +23,8 @@ mod wavelet;
 
 pub use camera::{Camera, CameraError, Orbit};
 pub use frame::{
-    adapt, draw, draw_bands, draw_mesh, draw_mesh_bands, Bands, CutMesh, FrameError, Style,
+    adapt, draw, draw_bands, draw_mesh, draw_mesh_bands, draw_mesh_textured, Bands, CutMesh,
+    FrameError, Style,
 };
 pub use glam;
 pub use vdlod_core as core;

@@ -7,7 +7,7 @@ use vdlod_core::adapt::{Budget, FrameStats};
 use vdlod_core::cut::SlotIndex;
 use vdlod_core::policy::Policy;
 use vdlod_core::wavelet::{SemiRegularView, WaveletCut};
-use vdlod_raster::{MeshSource, SourceVertex, VertexIndex};
+use vdlod_raster::{MeshSource, SourceVertex, Uv, VertexIndex};
 
 use crate::camera::Camera;
 use crate::frame::FrameError;
@@ -28,6 +28,7 @@ pub struct WaveletMesh<
     cut: &'a WaveletCut<W, T, V, Q, I>,
     s: &'a SemiRegularView<'s>,
     colors: bool,
+    base_uvs: Option<&'a [Uv]>,
 }
 
 impl<'a, 's, const W: usize, const T: usize, const V: usize, const Q: usize, I: SlotIndex>
@@ -39,7 +40,24 @@ impl<'a, 's, const W: usize, const T: usize, const V: usize, const Q: usize, I: 
         s: &'a SemiRegularView<'s>,
         colors: bool,
     ) -> Self {
-        WaveletMesh { cut, s, colors }
+        WaveletMesh {
+            cut,
+            s,
+            colors,
+            base_uvs: None,
+        }
+    }
+
+    /// With texture coordinates over the parametric domain: `base_uvs` gives one per base
+    /// vertex, and every vertex of every level gets the barycentric mix of its base face's
+    /// corners, the weights of its lattice point (the wavelet paper, §3.1). Whatever the cut,
+    /// a vertex keeps its coordinates, so the texture never slides. (One pair per base vertex:
+    /// a base mesh whose chart has seams needs its seams cut in the base mesh.)
+    pub fn with_uvs(self, base_uvs: &'a [Uv]) -> Self {
+        WaveletMesh {
+            base_uvs: Some(base_uvs),
+            ..self
+        }
     }
 }
 
@@ -77,6 +95,32 @@ impl<
 
     fn has_colors(&self) -> bool {
         self.colors
+    }
+
+    fn has_uvs(&self) -> bool {
+        self.base_uvs.is_some()
+    }
+
+    #[inline]
+    fn uv(&self, i: usize) -> Uv {
+        let Some(uvs) = self.base_uvs else {
+            return [0.0; 2];
+        };
+        let id = self.cut.vertex_id(i);
+        // A base vertex has its own; a wavelet's point is in the frame of a base face.
+        let Some(p) = self.s.point(id) else {
+            return uvs.get(id as usize).copied().unwrap_or([0.0; 2]);
+        };
+        let corners = self.s.corners(p.face);
+        let n = self.s.steps() as f32;
+        let mut uv = [0.0f32; 2];
+        for (k, &c) in corners.iter().enumerate() {
+            let base = uvs.get(c as usize).copied().unwrap_or([0.0; 2]);
+            let w = p.w[k] as f32 / n;
+            uv[0] += w * base[0];
+            uv[1] += w * base[1];
+        }
+        uv
     }
 }
 

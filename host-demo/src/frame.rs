@@ -8,8 +8,10 @@ use std::path::Path;
 use vdlod::{Camera, CutMesh, Style};
 use vdlod_core::cut::{Cut, SlotIndex};
 use vdlod_core::format::HierarchyView;
+use vdlod_raster::texture::Texture;
 use vdlod_raster::{
-    draw_indexed, DrawParams, DrawStats, MeshSource, Rgba8, ShadedVertex, Target, VertexIndex,
+    draw_indexed, DrawParams, DrawStats, MeshSource, Pixel, Rgba8, ShadedVertex, Target,
+    VertexIndex,
 };
 
 /// Background colour of demo frames.
@@ -152,6 +154,25 @@ impl Frame {
             let mut target = self.target()?;
             target.clear(BACKGROUND);
             vdlod::draw_mesh(&mut target, mesh, camera, style, &mut scratch)
+                .map_err(FrameError::from)
+        };
+        self.scratch = scratch;
+        result
+    }
+
+    /// [`Frame::draw_styled`] with `texture` mapped by the mesh's texture coordinates.
+    pub fn draw_textured<M: MeshSource, T: Pixel>(
+        &mut self,
+        mesh: &M,
+        camera: &Camera,
+        style: &Style,
+        texture: &Texture<'_, T>,
+    ) -> Result<DrawStats, FrameError> {
+        let mut scratch = self.take_scratch(mesh.vertex_count());
+        let result = {
+            let mut target = self.target()?;
+            target.clear(BACKGROUND);
+            vdlod::draw_mesh_textured(&mut target, mesh, camera, style, texture, &mut scratch)
                 .map_err(FrameError::from)
         };
         self.scratch = scratch;

@@ -174,9 +174,10 @@ fn draw_full(
 }
 
 /// A picture of the sheet: its caption and pixels (`WIDTH` x `HEIGHT`).
-struct Panel {
-    caption: String,
-    pixels: Vec<Rgba8>,
+/// A picture of a figure sheet, with its caption.
+pub(crate) struct Panel {
+    pub(crate) caption: String,
+    pub(crate) pixels: Vec<Rgba8>,
 }
 
 /// A `SAMPLES`-square image scaled up to a panel, nearest sample.
@@ -203,22 +204,26 @@ fn save(out: &Path, name: &str, width: usize, height: usize, px: &[Rgba8]) -> Re
     std::fs::write(&path, png).map_err(|e| format!("{}: cannot write: {e}", path.display()))
 }
 
-/// The panels in `columns` columns, each captioned, as one PNG.
-fn sheet(panels: &[Panel], columns: usize) -> Result<Vec<u8>, String> {
+/// The panels (each `width x height`) in `columns` columns, each captioned, as one PNG.
+pub(crate) fn sheet(
+    panels: &[Panel],
+    columns: usize,
+    [width, height]: [usize; 2],
+) -> Result<Vec<u8>, String> {
     let rows = panels.len().div_ceil(columns);
-    let (w, h) = (WIDTH * columns, HEIGHT * rows);
+    let (w, h) = (width * columns, height * rows);
     let mut pixels = vec![crate::frame::BACKGROUND; w * h];
     for (k, p) in panels.iter().enumerate() {
-        let (x0, y0) = ((k % columns) * WIDTH, (k / columns) * HEIGHT);
-        for y in 0..HEIGHT {
-            let row = &p.pixels[y * WIDTH..(y + 1) * WIDTH];
-            pixels[(y0 + y) * w + x0..(y0 + y) * w + x0 + WIDTH].copy_from_slice(row);
+        let (x0, y0) = ((k % columns) * width, (k / columns) * height);
+        for y in 0..height {
+            let row = &p.pixels[y * width..(y + 1) * width];
+            pixels[(y0 + y) * w + x0..(y0 + y) * w + x0 + width].copy_from_slice(row);
         }
     }
     let bytes = encode_png(w, h, &pixels).map_err(|e| e.to_string())?;
     let mut pixmap = tiny_skia::Pixmap::decode_png(&bytes).map_err(|e| e.to_string())?;
     for (k, p) in panels.iter().enumerate() {
-        let (x0, y0) = ((k % columns) * WIDTH, (k / columns) * HEIGHT);
+        let (x0, y0) = ((k % columns) * width, (k / columns) * height);
         let text = p.caption.as_str();
         let (x, y) = (x0 as f32 + 6.0, y0 as f32 + 6.0);
         label::draw(&mut pixmap, text, x, y, 2.0, (235, 235, 235));
@@ -367,7 +372,7 @@ pub fn terrain(out: &Path) -> Result<Vec<String>, String> {
     }
     let columns = top_row.len();
     top_row.extend(side_row);
-    let png = sheet(&top_row, columns)?;
+    let png = sheet(&top_row, columns, [WIDTH, HEIGHT])?;
     let path = out.join("figure.png");
     std::fs::write(&path, png).map_err(|e| format!("{}: cannot write: {e}", path.display()))?;
     Ok(lines)

@@ -16,6 +16,7 @@ pub mod render;
 pub mod repair;
 pub mod terrain;
 pub mod terrain_engines;
+pub mod textures;
 pub mod wavelet;
 
 /// The value of `key` in one of the `key=value` summary lines `vdlod-demo reproduce` prints

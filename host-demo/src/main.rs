@@ -22,6 +22,7 @@ use vdlod_demo::mesh::{self, load_obj_bytes, IndexedMesh, LoadOptions, Up, BUNNY
 use vdlod_demo::render::{render_orbit, RenderOptions};
 use vdlod_demo::terrain::{self, FlyOver, Terrain};
 use vdlod_demo::terrain_engines;
+use vdlod_demo::textures;
 use vdlod_demo::wavelet;
 use vdlod_raster::Shading;
 
@@ -224,6 +225,10 @@ enum Experiment {
     /// 4 px): triangles and the share of pixels differing from full detail (takes minutes and
     /// about 1.5 GB).
     TerrainTolerances,
+    /// The wavelet paper, §3.1: textures over the parametric domain. Both engines at equal
+    /// triangles on the 257 x 257 terrain's fly-over, drawn with its colours as a texture, with a
+    /// checker, and with colours per vertex: PSNR against full detail, and pictures.
+    Textures,
 }
 
 #[derive(clap::Args)]
@@ -937,6 +942,10 @@ fn reproduce(args: ReproduceArgs) -> Result<(), String> {
         Experiment::TerrainTolerances => (
             "terrain-tolerances",
             terrain_engines::tolerances(&args.out.join("terrain-tolerances"), 1025, 36)?,
+        ),
+        Experiment::Textures => (
+            "textures",
+            textures::textures(&args.out.join("textures"), textures::Setup::REPRODUCE)?,
         ),
     };
     for line in lines {
