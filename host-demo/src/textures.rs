@@ -198,7 +198,8 @@ pub fn textures(out: &Path, setup: Setup) -> Result<Vec<String>, String> {
                 };
                 drawn.map_err(|e| e.to_string())?;
                 *score = psnr(frame.pixels(), &references[k]).min(99.0);
-                if i == setup.pictured && k < 2 || i == setup.pictured && engine == 0 {
+                // The pictures: both engines textured, the wavelet engine also coloured per vertex.
+                if i == setup.pictured && (k < 2 || engine == 0) {
                     let name = ["wavelets", "vertex forest"][engine];
                     panels.push((
                         engine * 3 + k,
