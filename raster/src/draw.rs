@@ -20,8 +20,8 @@ use glam::{Mat3, Mat4, Vec3};
 
 use crate::clip::{self, clip_triangle, ClipVertex};
 use crate::edge::{
-    fill_triangle, pixel_bounds, scan, signed_area2, signed_area2_xy, Coverage, Facing, Fragment,
-    ScreenVertex, SUBPIXEL_BITS,
+    pixel_bounds, scan, signed_area2, signed_area2_xy, Facing, Fragment, ScreenVertex,
+    SUBPIXEL_BITS,
 };
 use crate::mesh::{MeshSource, Uv, VertexIndex};
 use crate::target::{check_frame, Depth, Pixel, Target, TargetError};
@@ -297,7 +297,8 @@ impl<M: MeshSource> BinnedMesh<'_, M> {
         target: &mut Target<'_, P, D>,
     ) -> Result<DrawStats, DrawError> {
         self.shaded.check_frame(target)?;
-        self.shaded.draw_triangles::<P, D, true>(target, self.rows);
+        self.shaded
+            .draw_triangles::<P, D, true, false, _>(target, self.rows, plain::<P, D>);
         Ok(self.stats)
     }
 }
@@ -440,7 +441,7 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
         target: &mut Target<'_, P, D>,
     ) -> Result<DrawStats, DrawError> {
         self.check_frame(target)?;
-        Ok(self.draw_triangles::<P, D, false>(target, &[]))
+        Ok(self.draw_triangles::<P, D, false, false, _>(target, &[], plain::<P, D>))
     }
 
     fn check_frame<P: Pixel, D: Depth>(&self, target: &Target<'_, P, D>) -> Result<(), DrawError> {
@@ -456,12 +457,18 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
 
     /// The triangle loop and the wireframe pass; with `BINNED`, triangles whose `rows` miss the
     /// target's window are skipped (two copies of the loop, so that a whole-frame draw pays
-    /// nothing for the bins, and a device that always bins carries one).
-    fn draw_triangles<P: Pixel, D: Depth, const BINNED: bool>(
+    /// nothing for the bins, and a device that always bins carries one). `fill` fills each
+    /// triangle kept, clockwise on screen, with its area and pixel bounds; with `TEXTURED` it
+    /// also gets each corner's `[u / w, v / w, 1 / w]` (zeros without).
+    fn draw_triangles<P: Pixel, D: Depth, const BINNED: bool, const TEXTURED: bool, F>(
         &self,
         target: &mut Target<'_, P, D>,
         rows: &[[u16; 2]],
-    ) -> DrawStats {
+        mut fill: F,
+    ) -> DrawStats
+    where
+        F: FnMut(&mut Target<'_, P, D>, &[ScreenVertex; 3], &[[f32; 3]; 3], i64, [i64; 4]),
+    {
         let (mesh, params, scratch) = (self.mesh, self.params, self.vertices);
         let viewport = &self.viewport;
         let prepared = self.lighting.as_ref();
@@ -470,14 +477,6 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
             submitted: mesh.triangles().len() as u32,
             ..DrawStats::default()
         };
-        let fill =
-            |target: &mut Target<'_, P, D>, stats: &mut DrawStats, tri: &[ScreenVertex; 3]| {
-                let coverage = fill_triangle(target, tri, facing, depth_test::<P, D>);
-                match coverage {
-                    Coverage::Scanned => stats.rasterized += 1,
-                    Coverage::Culled => stats.culled += 1,
-                }
-            };
         let (top, bottom) = (target.window.y, target.window.y + target.window.height - 1);
         let misses = |t: usize| {
             BINNED && {
@@ -493,6 +492,10 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
             // References, not copies: a culled triangle reads only positions and outcodes.
             let v = tri.map(|i| &scratch[i as usize]);
             let union = v[0].outcode | v[1].outcode | v[2].outcode;
+            let uvs = |mesh: &M| match TEXTURED {
+                true => tri.map(|i| mesh.uv(i as usize)),
+                false => [[0.0; 2]; 3],
+            };
             if union == 0 {
                 // Cull before any colour work: half the triangles of a closed mesh face away.
                 let xy = v.map(|v| [v.x, v.y]);
@@ -507,6 +510,16 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
                     continue;
                 };
                 let colors = triangle_colors(mesh, params, prepared, t, tri, &v);
+                let mut q = [[0.0f32; 3]; 3];
+                if TEXTURED {
+                    let uv = uvs(mesh);
+                    for (k, q) in q.iter_mut().enumerate() {
+                        let p = Vec3::from(mesh.position(tri[k] as usize));
+                        // Inside the clipping volume: `w` is positive.
+                        let inv_w = 1.0 / to_clip(&params.mvp, p).w;
+                        *q = [uv[k][0] * inv_w, uv[k][1] * inv_w, inv_w];
+                    }
+                }
                 // Clockwise on screen, as the pixel loop wants it.
                 let order = if area < 0 { [0, 2, 1] } else { [0, 1, 2] };
                 let s = order.map(|k| ScreenVertex {
@@ -515,12 +528,23 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
                     z: v[k].z,
                     rgb: colors[k],
                 });
-                scan(target, &s, area.abs(), bounds, depth_test::<P, D>);
+                fill(target, &s, &order.map(|k| q[k]), area.abs(), bounds);
             } else if needs_clipping(&v, union, &mut stats) {
                 let colors = triangle_colors(mesh, params, prepared, t, tri, &v);
-                let uvs = [[0.0; 2]; 3];
-                for_each_clipped(viewport, params, mesh, tri, colors, uvs, union, |s, _| {
-                    fill(target, &mut stats, s)
+                let uv = uvs(mesh);
+                for_each_clipped(viewport, params, mesh, tri, colors, uv, union, |s, q| {
+                    let area = signed_area2(s);
+                    if !facing.draws(area) {
+                        stats.culled += 1;
+                        return;
+                    }
+                    stats.rasterized += 1;
+                    let Some(bounds) = pixel_bounds(s.map(|v| [v.x, v.y]), &target.window) else {
+                        return;
+                    };
+                    let order = if area < 0 { [0, 2, 1] } else { [0, 1, 2] };
+                    let (s, q) = (order.map(|k| s[k]), order.map(|k| q[k]));
+                    fill(target, &s, &q, area.abs(), bounds);
                 });
             }
         }
@@ -599,6 +623,18 @@ fn needs_clipping(v: &[&ShadedVertex; 3], union: u8, stats: &mut DrawStats) -> b
         stats.clipped += 1;
         true
     }
+}
+
+/// The untextured fill: Gouraud or flat colours, strict-less depth test.
+#[inline(always)]
+fn plain<P: Pixel, D: Depth>(
+    target: &mut Target<'_, P, D>,
+    s: &[ScreenVertex; 3],
+    _: &[[f32; 3]; 3],
+    area: i64,
+    bounds: [i64; 4],
+) {
+    scan(target, s, area, bounds, depth_test::<P, D>);
 }
 
 /// Writes a fragment nearer than what the pixel holds (strict less: the first of equal depths wins).

@@ -1,19 +1,15 @@
-//! The textured triangle loop: [`ShadedMesh::draw_textured`].
+//! Textured drawing: [`ShadedMesh::draw_textured`].
 //!
-//! The same pipeline as [`ShadedMesh::draw`] (cull, clip, fill with a strict-less depth test,
-//! wireframe after), with each corner's texture coordinates divided by its clip-space `w` so that
-//! the texture is mapped perspective-correctly, and each fragment's colour the texel at its
-//! `(u, v)` modulated by its lit colour (so a white mesh colour shows the texture as it is, lit).
+//! The triangle loop of [`ShadedMesh::draw`] (cull, clip, strict-less depth test, wireframe
+//! after), told to divide each corner's texture coordinates by its clip-space `w` (so that the
+//! texture is mapped perspective-correctly), with a fill that colours each fragment with the texel
+//! at its `(u, v)` modulated by its lit colour (so a white mesh shows the texture as it is, lit).
 
-use glam::Vec3;
-
-use super::{for_each_clipped, needs_clipping, triangle_colors, DrawError, DrawStats, ShadedMesh};
-use crate::edge::ScreenVertex;
-use crate::edge::{pixel_bounds, scan_textured, signed_area2, signed_area2_xy, Facing, Fragment};
-use crate::mesh::{MeshSource, VertexIndex};
+use super::{DrawError, DrawStats, ShadedMesh};
+use crate::edge::{scan_textured, Fragment, ScreenVertex};
+use crate::mesh::MeshSource;
 use crate::target::{Depth, Pixel, Target};
 use crate::texture::{modulate, Texture};
-use crate::vertex::to_clip;
 
 impl<M: MeshSource> ShadedMesh<'_, M> {
     /// Draws the triangles with `texture` mapped by the mesh's texture coordinates
@@ -56,12 +52,6 @@ impl<M: MeshSource> ShadedMesh<'_, M> {
         if !self.mesh.has_uvs() {
             return Err(DrawError::MissingUvs);
         }
-        let (mesh, params, scratch) = (self.mesh, self.params, self.vertices);
-        let facing = Facing::culling(params.cull_back_faces);
-        let mut stats = DrawStats {
-            submitted: mesh.triangles().len() as u32,
-            ..DrawStats::default()
-        };
         let plot = |c: &mut P, d: &mut D, f: Fragment<'_>, uv: [f32; 2]| {
             let z = D::from_depth(f.z);
             if z < *d {
@@ -74,57 +64,12 @@ impl<M: MeshSource> ShadedMesh<'_, M> {
                 );
             }
         };
-        for (t, tri) in mesh.triangles().iter().enumerate() {
-            let tri = &tri.map(VertexIndex::to_u32);
-            let v = tri.map(|i| &scratch[i as usize]);
-            let union = v[0].outcode | v[1].outcode | v[2].outcode;
-            let uvs = tri.map(|i| mesh.uv(i as usize));
-            if union == 0 {
-                let xy = v.map(|v| [v.x, v.y]);
-                let area = signed_area2_xy(xy);
-                if !facing.draws(area) {
-                    stats.culled += 1;
-                    continue;
-                }
-                stats.rasterized += 1;
-                let Some(bounds) = pixel_bounds(xy, &target.window) else {
-                    continue;
-                };
-                let colors = triangle_colors(mesh, params, self.lighting.as_ref(), t, tri, &v);
-                let q: [[f32; 3]; 3] = core::array::from_fn(|k| {
-                    let p = Vec3::from(mesh.position(tri[k] as usize));
-                    // Inside the clipping volume: `w` is positive.
-                    let inv_w = 1.0 / to_clip(&params.mvp, p).w;
-                    [uvs[k][0] * inv_w, uvs[k][1] * inv_w, inv_w]
-                });
-                let order = if area < 0 { [0, 2, 1] } else { [0, 1, 2] };
-                let s = order.map(|k| ScreenVertex {
-                    x: v[k].x,
-                    y: v[k].y,
-                    z: v[k].z,
-                    rgb: colors[k],
-                });
-                scan_textured(target, &s, &order.map(|k| q[k]), area.abs(), bounds, plot);
-            } else if needs_clipping(&v, union, &mut stats) {
-                let colors = triangle_colors(mesh, params, self.lighting.as_ref(), t, tri, &v);
-                let viewport = &self.viewport;
-                for_each_clipped(viewport, params, mesh, tri, colors, uvs, union, |s, q| {
-                    let area = signed_area2(s);
-                    if !facing.draws(area) {
-                        stats.culled += 1;
-                        return;
-                    }
-                    stats.rasterized += 1;
-                    let Some(bounds) = pixel_bounds(s.map(|v| [v.x, v.y]), &target.window) else {
-                        return;
-                    };
-                    let order = if area < 0 { [0, 2, 1] } else { [0, 1, 2] };
-                    let (s, q) = (order.map(|k| s[k]), order.map(|k| q[k]));
-                    scan_textured(target, &s, &q, area.abs(), bounds, plot);
-                });
-            }
-        }
-        self.draw_wireframe::<P, D, false>(target, &[]);
-        Ok(stats)
+        let fill =
+            |target: &mut Target<'_, P, D>,
+             s: &[ScreenVertex; 3],
+             q: &[[f32; 3]; 3],
+             area: i64,
+             bounds: [i64; 4]| { scan_textured(target, s, q, area, bounds, plot) };
+        Ok(self.draw_triangles::<P, D, false, true, _>(target, &[], fill))
     }
 }
