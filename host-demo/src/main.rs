@@ -945,7 +945,7 @@ fn reproduce(args: ReproduceArgs) -> Result<(), String> {
         ),
         Experiment::Textures => (
             "textures",
-            textures::textures(&args.out.join("textures"), textures::Setup::REPRODUCE)?,
+            textures::textures(&args.out.join("textures"), textures::REPRODUCE, 20)?,
         ),
     };
     for line in lines {

@@ -66,22 +66,73 @@ impl Setup {
 
 /// The forest's cut: up to 32,000 triangles (the wavelet engine's, [`DemoWaveletCut`], holds
 /// 60,000).
-type ForestCut = Cut<16_000, 32_000, 2_000>;
+pub(crate) type ForestCut = Cut<16_000, 32_000, 2_000>;
+
+/// Both engines' cuts, adapted at equal triangles: the wavelet engine at 1 px, then the forest
+/// at 0.1 px under a budget of the wavelet engine's count.
+pub(crate) struct Engines {
+    pub(crate) wavelet: Box<DemoWaveletCut>,
+    pub(crate) forest: Box<ForestCut>,
+}
+
+impl Engines {
+    /// Both cuts at their base meshes.
+    pub(crate) fn new(s: &SemiRegularView<'_>, h: &HierarchyView<'_>) -> Result<Engines, String> {
+        let mut wavelet = DemoWaveletCut::boxed();
+        wavelet.reset(s).map_err(|e| e.to_string())?;
+        let mut forest = ForestCut::boxed();
+        forest.reset(h).map_err(|e| e.to_string())?;
+        Ok(Engines { wavelet, forest })
+    }
+
+    /// The wavelet engine to `camera`.
+    pub(crate) fn adapt_wavelet(
+        &mut self,
+        s: &SemiRegularView<'_>,
+        camera: &Camera,
+    ) -> Result<FrameStats, String> {
+        let policy = QRefine::new(1.0);
+        vdlod::adapt_wavelets(&mut self.wavelet, s, camera, &policy, &Budget::default())
+            .map_err(|e| e.to_string())
+    }
+
+    /// The forest to `camera`, at most `triangles`.
+    pub(crate) fn adapt_forest(
+        &mut self,
+        h: &HierarchyView<'_>,
+        camera: &Camera,
+        triangles: u32,
+    ) -> Result<FrameStats, String> {
+        let budget = Budget {
+            max_triangles: triangles,
+            ..Budget::default()
+        };
+        vdlod::adapt(&mut self.forest, h, camera, &QRefine::new(0.1), &budget)
+            .map_err(|e| e.to_string())
+    }
+}
 
 /// What both engines fly: the procedural terrain of `side` samples a side as a semi-regular file
 /// and as a hierarchy, its full-detail mesh, and the fly-over's cameras.
-struct Flight {
-    full: IndexedMesh,
-    cameras: Vec<Camera>,
-    drawn: Style,
-    sbytes: Vec<u8>,
-    hbytes: Vec<u8>,
-    wavelet_build_s: f64,
-    forest_build_s: f64,
+pub(crate) struct Flight {
+    pub(crate) land: Terrain,
+    pub(crate) full: IndexedMesh,
+    pub(crate) cameras: Vec<Camera>,
+    pub(crate) drawn: Style,
+    pub(crate) sbytes: Vec<u8>,
+    pub(crate) hbytes: Vec<u8>,
+    pub(crate) wavelet_build_s: f64,
+    pub(crate) forest_build_s: f64,
 }
 
 impl Flight {
-    fn new(side: usize, frames: u32, progress: bool) -> Result<Flight, String> {
+    /// The flight of the `side`-square terrain in `frames` frames of `size` pixels.
+    pub(crate) fn new(
+        side: usize,
+        frames: u32,
+        [width, height]: [usize; 2],
+        progress: bool,
+    ) -> Result<Flight, String> {
         let land = Terrain::procedural(side, SEED, DEFAULT_VERTICAL_SCALE);
         let semi = land
             .semi_regular()
@@ -95,7 +146,7 @@ impl Flight {
             build_with_progress(&full, &BuildOptions::default(), progress)
                 .map_err(|e| format!("terrain: {e}"))?;
         full.reorder_for_locality();
-        let fly_over = FlyOver::new(&land, frames, WIDTH, HEIGHT);
+        let fly_over = FlyOver::new(&land, frames, width, height);
         Ok(Flight {
             full,
             cameras: (0..frames).map(|i| fly_over.camera(i)).collect(),
@@ -107,11 +158,12 @@ impl Flight {
             hbytes,
             wavelet_build_s,
             forest_build_s,
+            land,
         })
     }
 
     /// The two files, read.
-    fn views(&self) -> Result<(SemiRegularView<'_>, HierarchyView<'_>), String> {
+    pub(crate) fn views(&self) -> Result<(SemiRegularView<'_>, HierarchyView<'_>), String> {
         Ok((
             SemiRegularView::parse(&self.sbytes).map_err(|e| e.to_string())?,
             HierarchyView::parse(&self.hbytes).map_err(|e| e.to_string())?,
@@ -138,7 +190,7 @@ pub fn terrain_engines(out: &Path, setup: Setup) -> Result<Vec<String>, String> 
         frames: count,
     } = setup;
     let samples = (side * side) as f64;
-    let flight = Flight::new(side, count, false)?;
+    let flight = Flight::new(side, count, [WIDTH, HEIGHT], false)?;
     let (s, h) = flight.views()?;
     let Flight {
         full,
@@ -148,13 +200,10 @@ pub fn terrain_engines(out: &Path, setup: Setup) -> Result<Vec<String>, String> 
         hbytes,
         wavelet_build_s,
         forest_build_s,
+        ..
     } = &flight;
     let mut frame = Frame::new(WIDTH, HEIGHT).map_err(|e| e.to_string())?;
-    let mut wavelet = DemoWaveletCut::boxed();
-    wavelet.reset(&s).map_err(|e| e.to_string())?;
-    let mut forest = ForestCut::boxed();
-    forest.reset(&h).map_err(|e| e.to_string())?;
-    let (wavelet_policy, forest_policy) = (QRefine::new(1.0), QRefine::new(0.1));
+    let mut engines = Engines::new(&s, &h)?;
     let mut frames: Vec<[EngineFrame; 2]> = Vec::with_capacity(cameras.len());
     let (mut wavelet_before, mut forest_before) = (Vec::new(), Vec::new());
     for camera in cameras {
@@ -164,17 +213,11 @@ pub fn terrain_engines(out: &Path, setup: Setup) -> Result<Vec<String>, String> 
         let reference = frame.pixels().to_vec();
 
         let start = Instant::now();
-        let stats = vdlod::adapt_wavelets(
-            &mut wavelet,
-            &s,
-            camera,
-            &wavelet_policy,
-            &Budget::default(),
-        )
-        .map_err(|e| e.to_string())?;
+        let stats = engines.adapt_wavelet(&s, camera)?;
         let adapt_us = start.elapsed().as_secs_f64() * 1e6;
+        let wavelet = &engines.wavelet;
         frame
-            .draw_styled(&WaveletMesh::new(&wavelet, &s, true), camera, drawn)
+            .draw_styled(&WaveletMesh::new(wavelet, &s, true), camera, drawn)
             .map_err(|e| e.to_string())?;
         let now = triangle_set(
             wavelet
@@ -190,16 +233,12 @@ pub fn terrain_engines(out: &Path, setup: Setup) -> Result<Vec<String>, String> 
         };
         wavelet_before = now;
 
-        let budget = Budget {
-            max_triangles: stats.triangles,
-            ..Budget::default()
-        };
         let start = Instant::now();
-        let stats = vdlod::adapt(&mut forest, &h, camera, &forest_policy, &budget)
-            .map_err(|e| e.to_string())?;
+        let stats = engines.adapt_forest(&h, camera, stats.triangles)?;
         let adapt_us = start.elapsed().as_secs_f64() * 1e6;
+        let forest = &engines.forest;
         frame
-            .draw_cut(&forest, &h, camera, drawn)
+            .draw_cut(forest, &h, camera, drawn)
             .map_err(|e| e.to_string())?;
         let nodes = forest.nodes();
         let now = triangle_set(
@@ -331,7 +370,7 @@ type BigForestCut = Cut<200_000, 400_000, 100_000, u32>;
 pub fn tolerances(out: &Path, samples: usize, frames: u32) -> Result<Vec<String>, String> {
     std::fs::create_dir_all(out).map_err(|e| format!("{}: {e}", out.display()))?;
     let show = std::io::IsTerminal::is_terminal(&std::io::stderr());
-    let flight = Flight::new(samples, frames, show)?;
+    let flight = Flight::new(samples, frames, [WIDTH, HEIGHT], show)?;
     let (s, h) = flight.views()?;
     let Flight {
         full,

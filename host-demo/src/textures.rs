@@ -19,52 +19,26 @@ use std::path::Path;
 use std::time::Instant;
 
 use vdlod::{CutMesh, Style, WaveletMesh};
-use vdlod_core::adapt::Budget;
-use vdlod_core::build::BuildOptions;
-use vdlod_core::cut::Cut;
-use vdlod_core::format::HierarchyView;
-use vdlod_core::policy::QRefine;
-use vdlod_core::wavelet::SemiRegularView;
 use vdlod_raster::texture::{Filter, Texture, Wrap};
 use vdlod_raster::{Rgba8, Shading, Uv};
 
 use crate::frame::Frame;
-use crate::hierarchy::build_with_progress;
 use crate::importance::{sheet, Panel};
 use crate::lod::psnr;
 use crate::render::style;
-use crate::terrain::{FlyOver, Terrain, DEFAULT_VERTICAL_SCALE};
-use crate::wavelet::{mean, DemoWaveletCut};
+use crate::terrain_engines::{Engines, Flight, Setup};
+use crate::wavelet::mean;
 
-/// The terrain's seed (the `terrain` command's default).
-const SEED: u32 = 1;
 const WIDTH: usize = 480;
 const HEIGHT: usize = 360;
 /// Checker cells along each side of the terrain.
 const CELLS: usize = 16;
 
-/// The forest's cut (as `reproduce terrain-engines` flies it).
-type ForestCut = Cut<16_000, 32_000, 2_000>;
-
-/// What the experiment flies.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Setup {
-    /// Samples along each side of the procedural terrain: `2^k + 1`.
-    pub samples: usize,
-    /// Frames of the fly-over's loop.
-    pub frames: u32,
-    /// The frame whose pictures go into the sheet.
-    pub pictured: u32,
-}
-
-impl Setup {
-    /// `reproduce textures`: the `terrain` command's default terrain, its loop in 120 frames.
-    pub const REPRODUCE: Setup = Setup {
-        samples: 257,
-        frames: 120,
-        pictured: 20,
-    };
-}
+/// `reproduce textures`: the `terrain` command's default terrain, its loop in 120 frames.
+pub const REPRODUCE: Setup = Setup {
+    samples: 257,
+    frames: 120,
+};
 
 /// The three ways a frame is drawn.
 const KINDS: [&str; 3] = ["colormap texture", "checker texture", "colours per vertex"];
@@ -75,23 +49,20 @@ fn planar(p: [f32; 3], side: usize) -> Uv {
     [(p[0] + 0.5) / side as f32, (p[2] + 0.5) / side as f32]
 }
 
-/// Runs the experiment, writing `textures.png` into `out`; returns one summary line per engine.
-pub fn textures(out: &Path, setup: Setup) -> Result<Vec<String>, String> {
+/// Runs the experiment, writing `textures.png` (the pictures of frame `pictured`) into `out`;
+/// returns one summary line per engine.
+pub fn textures(out: &Path, setup: Setup, pictured: u32) -> Result<Vec<String>, String> {
     std::fs::create_dir_all(out).map_err(|e| format!("{}: {e}", out.display()))?;
     let side = setup.samples;
-    let land = Terrain::procedural(side, SEED, DEFAULT_VERTICAL_SCALE);
+    let flight = Flight::new(side, setup.frames, [WIDTH, HEIGHT], false)?;
+    let (s, h) = flight.views()?;
+    let Flight {
+        land,
+        full,
+        cameras,
+        ..
+    } = &flight;
     let colors = land.colors.clone().ok_or("the terrain has no colours")?;
-    let semi = land
-        .semi_regular()
-        .ok_or("the terrain is not 2^k + 1 samples square")?;
-    let sbytes = semi.to_bytes().map_err(|e| e.to_string())?;
-    drop(semi);
-    let mut full = land.mesh();
-    let (_, hbytes, _) = build_with_progress(&full, &BuildOptions::default(), false)
-        .map_err(|e| format!("terrain: {e}"))?;
-    full.reorder_for_locality();
-    let s = SemiRegularView::parse(&sbytes).map_err(|e| e.to_string())?;
-    let h = HierarchyView::parse(&hbytes).map_err(|e| e.to_string())?;
 
     // Coordinates: the full mesh's and the leaves' from where they sample the grid, the base
     // vertices' the same way, a parent's the mean of its children's (children have larger ids).
@@ -133,13 +104,8 @@ pub fn textures(out: &Path, setup: Setup) -> Result<Vec<String>, String> {
         ..style(Shading::Gouraud, false)
     };
 
-    let fly_over = FlyOver::new(&land, setup.frames, WIDTH, HEIGHT);
     let mut frame = Frame::new(WIDTH, HEIGHT).map_err(|e| e.to_string())?;
-    let mut wavelet = DemoWaveletCut::boxed();
-    wavelet.reset(&s).map_err(|e| e.to_string())?;
-    let mut forest = ForestCut::boxed();
-    forest.reset(&h).map_err(|e| e.to_string())?;
-    let (wavelet_policy, forest_policy) = (QRefine::new(1.0), QRefine::new(0.1));
+    let mut engines = Engines::new(&s, &h)?;
     // Textured meshes have no vertex colours: the texel is modulated by the light alone.
     let full_colored = full.as_raster_mesh();
     let full_textured = vdlod_raster::Mesh {
@@ -151,55 +117,43 @@ pub fn textures(out: &Path, setup: Setup) -> Result<Vec<String>, String> {
     let mut measured: [Vec<(u32, [f64; 3])>; 2] = [Vec::new(), Vec::new()];
     let mut panels = Vec::new();
     let start = Instant::now();
-    for i in 0..setup.frames {
-        let camera = fly_over.camera(i);
+    for (i, camera) in (0..).zip(cameras) {
         let mut references = Vec::new();
         frame
-            .draw_textured(&full_textured, &camera, &textured, &colormap)
+            .draw_textured(&full_textured, camera, &textured, &colormap)
             .map_err(|e| e.to_string())?;
         references.push(frame.pixels().to_vec());
         frame
-            .draw_textured(&full_textured, &camera, &textured, &checker)
+            .draw_textured(&full_textured, camera, &textured, &checker)
             .map_err(|e| e.to_string())?;
         references.push(frame.pixels().to_vec());
         frame
-            .draw_styled(&full_colored, &camera, &per_vertex)
+            .draw_styled(&full_colored, camera, &per_vertex)
             .map_err(|e| e.to_string())?;
         references.push(frame.pixels().to_vec());
 
-        let stats = vdlod::adapt_wavelets(
-            &mut wavelet,
-            &s,
-            &camera,
-            &wavelet_policy,
-            &Budget::default(),
-        )
-        .map_err(|e| e.to_string())?;
-        let budget = Budget {
-            max_triangles: stats.triangles,
-            ..Budget::default()
-        };
-        let forest_stats = vdlod::adapt(&mut forest, &h, &camera, &forest_policy, &budget)
-            .map_err(|e| e.to_string())?;
-        let wavelet_mesh = WaveletMesh::new(&wavelet, &s, false).with_uvs(&base_uvs);
-        let forest_mesh = CutMesh::new(&forest, &h, false).with_uvs(&node_uvs);
-        let wavelet_colored = WaveletMesh::new(&wavelet, &s, true);
-        let forest_colored = CutMesh::new(&forest, &h, true);
+        let stats = engines.adapt_wavelet(&s, camera)?;
+        let forest_stats = engines.adapt_forest(&h, camera, stats.triangles)?;
+        let (wavelet, forest) = (&engines.wavelet, &engines.forest);
+        let wavelet_mesh = WaveletMesh::new(wavelet, &s, false).with_uvs(&base_uvs);
+        let forest_mesh = CutMesh::new(forest, &h, false).with_uvs(&node_uvs);
+        let wavelet_colored = WaveletMesh::new(wavelet, &s, true);
+        let forest_colored = CutMesh::new(forest, &h, true);
         for (engine, triangles) in [(0, stats.triangles), (1, forest_stats.triangles)] {
             let mut scores = [0.0; 3];
             for (k, score) in scores.iter_mut().enumerate() {
                 let drawn = match (engine, k) {
-                    (0, 0) => frame.draw_textured(&wavelet_mesh, &camera, &textured, &colormap),
-                    (0, 1) => frame.draw_textured(&wavelet_mesh, &camera, &textured, &checker),
-                    (0, _) => frame.draw_styled(&wavelet_colored, &camera, &per_vertex),
-                    (_, 0) => frame.draw_textured(&forest_mesh, &camera, &textured, &colormap),
-                    (_, 1) => frame.draw_textured(&forest_mesh, &camera, &textured, &checker),
-                    (_, _) => frame.draw_styled(&forest_colored, &camera, &per_vertex),
+                    (0, 0) => frame.draw_textured(&wavelet_mesh, camera, &textured, &colormap),
+                    (0, 1) => frame.draw_textured(&wavelet_mesh, camera, &textured, &checker),
+                    (0, _) => frame.draw_styled(&wavelet_colored, camera, &per_vertex),
+                    (_, 0) => frame.draw_textured(&forest_mesh, camera, &textured, &colormap),
+                    (_, 1) => frame.draw_textured(&forest_mesh, camera, &textured, &checker),
+                    (_, _) => frame.draw_styled(&forest_colored, camera, &per_vertex),
                 };
                 drawn.map_err(|e| e.to_string())?;
                 *score = psnr(frame.pixels(), &references[k]).min(99.0);
                 // The pictures: both engines textured, the wavelet engine also coloured per vertex.
-                if i == setup.pictured && (k < 2 || engine == 0) {
+                if i == pictured && (k < 2 || engine == 0) {
                     let name = ["wavelets", "vertex forest"][engine];
                     panels.push((
                         engine * 3 + k,
@@ -215,9 +169,9 @@ pub fn textures(out: &Path, setup: Setup) -> Result<Vec<String>, String> {
             }
             measured[engine].push((triangles, scores));
         }
-        if i == setup.pictured {
+        if i == pictured {
             frame
-                .draw_textured(&full_textured, &camera, &textured, &checker)
+                .draw_textured(&full_textured, camera, &textured, &checker)
                 .map_err(|e| e.to_string())?;
             panels.push((
                 5,
@@ -255,7 +209,12 @@ pub fn textures(out: &Path, setup: Setup) -> Result<Vec<String>, String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::terrain::{Terrain, DEFAULT_VERTICAL_SCALE};
+    use crate::wavelet::DemoWaveletCut;
     use vdlod::Orbit;
+    use vdlod_core::adapt::Budget;
+    use vdlod_core::policy::QRefine;
+    use vdlod_core::wavelet::SemiRegularView;
     use vdlod_raster::MeshSource;
 
     #[test]
@@ -307,9 +266,8 @@ mod tests {
         let setup = Setup {
             samples: 33,
             frames: 6,
-            pictured: 3,
         };
-        let lines = textures(&out, setup).unwrap();
+        let lines = textures(&out, setup, 3).unwrap();
         assert_eq!(lines.len(), 2);
         for line in &lines {
             for key in [
