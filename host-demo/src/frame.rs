@@ -30,6 +30,8 @@ pub enum FrameError {
     Png(String),
     /// Writing or reading the file failed.
     Io(std::io::Error),
+    /// The texels cannot be a texture.
+    Texture(vdlod_raster::texture::TextureError),
 }
 
 impl std::fmt::Display for FrameError {
@@ -40,6 +42,7 @@ impl std::fmt::Display for FrameError {
             FrameError::Camera(e) => e.fmt(f),
             FrameError::Png(e) => write!(f, "PNG: {e}"),
             FrameError::Io(e) => e.fmt(f),
+            FrameError::Texture(e) => e.fmt(f),
         }
     }
 }

@@ -6,6 +6,7 @@
 pub mod camera;
 pub mod chart;
 pub mod frame;
+pub mod ground;
 pub mod hierarchy;
 pub mod importance;
 pub mod input;

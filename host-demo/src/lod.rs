@@ -6,7 +6,7 @@ use std::io::Write as _;
 use std::path::Path;
 use std::time::Instant;
 
-use vdlod::{Style, WaveletMesh};
+use vdlod::{CutMesh, Style, WaveletMesh};
 use vdlod_core::adapt::{Budget, FrameStats};
 use vdlod_core::cut::{Coloring, Cut, SlotIndex};
 use vdlod_core::format::{HierarchyView, NONE};
@@ -15,11 +15,12 @@ use vdlod_core::policy::{
     View,
 };
 use vdlod_core::wavelet::{SemiRegularView, WaveletCut};
-use vdlod_raster::{Rgba8, Shading, VertexIndex};
+use vdlod_raster::{MeshSource, Rgba8, Shading, VertexIndex};
 
 use crate::camera::{merge_tree_orbit, peer_orbit, Camera, Orbit};
 use crate::chart::{self, Panel, BLUE, GREY, ORANGE};
 use crate::frame::{encode_png, Frame, FrameError};
+use crate::ground::{GroundTexture, OnGround};
 use crate::label;
 use crate::mesh::{vertex_normals, Bounds, IndexedMesh};
 use crate::render::style;
@@ -120,6 +121,9 @@ pub struct OrbitOptions {
     pub observer: bool,
     /// Fly these cameras, one per frame, instead of an orbit (`frames` should be their number).
     pub path: Option<Vec<Camera>>,
+    /// Draw a terrain with its colours as a texture over the ground (the full-detail frames
+    /// too) instead of a colour per vertex.
+    pub ground: Option<GroundTexture>,
 }
 
 impl Default for OrbitOptions {
@@ -142,6 +146,7 @@ impl Default for OrbitOptions {
             peer_orbit: false,
             observer: false,
             path: None,
+            ground: None,
         }
     }
 }
@@ -571,11 +576,38 @@ trait FlightEngine {
     /// The model's bounding box.
     fn bounding_box(&self) -> ([f32; 3], [f32; 3]);
     fn adapt(&mut self, view: &View, policy: &DemoPolicy, budget: &Budget) -> FrameStats;
-    fn draw(&self, frame: &mut Frame, camera: &Camera, style: &Style) -> Result<(), FrameError>;
+    /// Draws the current mesh; with `ground`, textured by it.
+    fn draw(
+        &self,
+        frame: &mut Frame,
+        camera: &Camera,
+        style: &Style,
+        ground: Option<&GroundTexture>,
+    ) -> Result<(), FrameError>;
     /// Writes the current mesh as an OBJ file.
     fn write_obj(&self, path: &Path) -> std::io::Result<()>;
     /// The current mesh's triangles ([`triangle_set`]).
     fn triangle_set(&self) -> Vec<[u32; 3]>;
+}
+
+/// `mesh` textured by `ground` (white under the light, whatever `style`'s colours).
+fn draw_on_ground<M: MeshSource>(
+    frame: &mut Frame,
+    mesh: &M,
+    camera: &Camera,
+    style: &Style,
+    ground: &GroundTexture,
+) -> Result<(), FrameError> {
+    let texture = ground.texture().map_err(FrameError::Texture)?;
+    let on = OnGround { mesh, ground };
+    let white = Style {
+        base_color: [255; 3],
+        vertex_colors: false,
+        ..*style
+    };
+    frame
+        .draw_textured(&on, camera, &white, &texture)
+        .map(|_| ())
 }
 
 /// The vertex forest in a flight.
@@ -622,8 +654,20 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex + VertexIndex>
         self.cut.adapt(&self.h, view, policy, budget)
     }
 
-    fn draw(&self, frame: &mut Frame, camera: &Camera, style: &Style) -> Result<(), FrameError> {
-        frame.draw_cut(self.cut, &self.h, camera, style).map(|_| ())
+    fn draw(
+        &self,
+        frame: &mut Frame,
+        camera: &Camera,
+        style: &Style,
+        ground: Option<&GroundTexture>,
+    ) -> Result<(), FrameError> {
+        match ground {
+            None => frame.draw_cut(self.cut, &self.h, camera, style).map(|_| ()),
+            Some(ground) => {
+                let mesh = CutMesh::new(self.cut, &self.h, false);
+                draw_on_ground(frame, &mesh, camera, style, ground)
+            }
+        }
     }
 
     fn write_obj(&self, path: &Path) -> std::io::Result<()> {
@@ -690,9 +734,18 @@ where
         self.cut.adapt(&self.s, view, policy, budget)
     }
 
-    fn draw(&self, frame: &mut Frame, camera: &Camera, style: &Style) -> Result<(), FrameError> {
+    fn draw(
+        &self,
+        frame: &mut Frame,
+        camera: &Camera,
+        style: &Style,
+        ground: Option<&GroundTexture>,
+    ) -> Result<(), FrameError> {
         let mesh = WaveletMesh::new(self.cut, &self.s, style.vertex_colors);
-        frame.draw_styled(&mesh, camera, style).map(|_| ())
+        match ground {
+            None => frame.draw_styled(&mesh, camera, style).map(|_| ()),
+            Some(ground) => draw_on_ground(frame, &mesh, camera, style, ground),
+        }
     }
 
     fn write_obj(&self, path: &Path) -> std::io::Result<()> {
@@ -745,6 +798,7 @@ fn fly_orbit(
     let mut frame = Frame::new(opts.width, opts.height).map_err(|e| e.to_string())?;
     let mut reference = Frame::new(opts.width, opts.height).map_err(|e| e.to_string())?;
     let full_mesh = full.as_raster_mesh();
+    let ground = opts.ground.as_ref();
     let mut csv = String::from(
         "frame,triangles,vsplits,ecols,adapt_us,render_us,full_render_us,psnr_db,vertices,forced,blending,threshold,budget_limited,ops_limited,capacity_limited,queue_overflow,blend_limited,over_budget,new_triangles\n",
     );
@@ -778,13 +832,15 @@ fn fly_orbit(
         let params = drawn.params(&camera);
         let start = Instant::now();
         engine
-            .draw(&mut frame, &camera, &drawn)
+            .draw(&mut frame, &camera, &drawn, ground)
             .map_err(|e| e.to_string())?;
         let render_us = start.elapsed().as_secs_f64() * 1e6;
         let start = Instant::now();
-        reference
-            .draw(&full_mesh, &params)
-            .map_err(|e| e.to_string())?;
+        match ground {
+            None => reference.draw(&full_mesh, &params).map(|_| ()),
+            Some(ground) => draw_on_ground(&mut reference, &full_mesh, &camera, &drawn, ground),
+        }
+        .map_err(|e| e.to_string())?;
         let full_render_us = start.elapsed().as_secs_f64() * 1e6;
         let f = OrbitFrame {
             index: i,
@@ -823,7 +879,12 @@ fn fly_orbit(
                 ..style(Shading::Gouraud, opts.wireframe)
             };
             engine
-                .draw(&mut frame, &seen_from, &drawn)
+                .draw(
+                    &mut frame,
+                    &seen_from,
+                    &drawn,
+                    ground.filter(|_| !opts.depth_colors),
+                )
                 .map_err(|e| e.to_string())?;
         }
         if opts.write_frames {

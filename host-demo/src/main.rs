@@ -408,6 +408,7 @@ impl FlightArgs {
             write_frames: true,
             peer_orbit,
             observer: self.observer,
+            ground: None,
             path,
         }
     }
@@ -489,6 +490,10 @@ struct TerrainArgs {
     /// samples a side, taken as it is).
     #[arg(long, value_enum, default_value = "forest")]
     engine: EngineArg,
+    /// Draw the colours as a texture over the ground (one texel per sample; the full-detail
+    /// frames too), not as a colour per vertex: they keep their detail where the mesh is coarse.
+    #[arg(long)]
+    texture: bool,
     #[command(flatten)]
     flight: FlightArgs,
 }
@@ -735,7 +740,13 @@ fn terrain_command(args: TerrainArgs) -> Result<(), String> {
             (0..f.frames).map(|i| fly_over.camera(i)).collect()
         }
     };
-    let opts = args.flight.options(Some(path), false);
+    let mut opts = args.flight.options(Some(path), false);
+    if args.texture {
+        opts.ground = Some(
+            vdlod_demo::ground::GroundTexture::of(&land)
+                .ok_or_else(|| format!("{name}: --texture needs a colormap"))?,
+        );
+    }
     fly(&name, &bytes, &full, &opts, &args.out)
 }
 

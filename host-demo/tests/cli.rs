@@ -733,6 +733,19 @@ fn terrain_flies_the_procedural_island_and_a_path_file() {
     ] {
         assert!(dir.join(f).exists(), "{f}");
     }
+    // The colours as a texture, both engines: the frames differ from the colours per vertex.
+    for engine in ["forest", "wavelet"] {
+        let out_dir = format!("x{engine}");
+        let mut textured = vec!["terrain", "--size", "33", "--texture", "--engine", engine];
+        textured.extend_from_slice(&["-o", &out_dir]);
+        textured.extend_from_slice(&small);
+        succeed(&textured, &dir);
+        let textured = std::fs::read(dir.join(&out_dir).join("frame_0002.png")).unwrap();
+        if engine == "forest" {
+            let plain = std::fs::read(dir.join("t/frame_0002.png")).unwrap();
+            assert_ne!(textured, plain);
+        }
+    }
     // A path file: two frames looking down from above, with a header and a comment.
     std::fs::write(
         dir.join("path.csv"),
