@@ -5,9 +5,11 @@
 //! where it belongs whatever the engine and the cut: the colours keep their detail where the mesh
 //! is coarse, instead of being averaged into the few vertices left (see `reproduce textures`).
 
+use vdlod::{Camera, Style};
 use vdlod_raster::texture::{Filter, Texture, TextureError, Wrap};
 use vdlod_raster::{DrawError, MeshSource, Rgba8, SourceVertex, Uv, VertexBatch};
 
+use crate::frame::{Frame, FrameError};
 use crate::terrain::Terrain;
 
 /// One texel per sample of a terrain's colours.
@@ -108,6 +110,26 @@ impl<M: MeshSource> MeshSource for OnGround<'_, M> {
     fn check(&self) -> Result<(), DrawError> {
         self.mesh.check()
     }
+}
+
+/// `mesh` into `frame`, textured by `ground` (white under the light, whatever `style`'s colours).
+pub fn draw_on_ground<M: MeshSource>(
+    frame: &mut Frame,
+    mesh: &M,
+    camera: &Camera,
+    style: &Style,
+    ground: &GroundTexture,
+) -> Result<(), FrameError> {
+    let texture = ground.texture().map_err(FrameError::Texture)?;
+    let on = OnGround { mesh, ground };
+    let white = Style {
+        base_color: [255; 3],
+        vertex_colors: false,
+        ..*style
+    };
+    frame
+        .draw_textured(&on, camera, &white, &texture)
+        .map(|_| ())
 }
 
 #[cfg(test)]

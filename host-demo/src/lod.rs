@@ -15,12 +15,12 @@ use vdlod_core::policy::{
     View,
 };
 use vdlod_core::wavelet::{SemiRegularView, WaveletCut};
-use vdlod_raster::{MeshSource, Rgba8, Shading, VertexIndex};
+use vdlod_raster::{Rgba8, Shading, VertexIndex};
 
 use crate::camera::{merge_tree_orbit, peer_orbit, Camera, Orbit};
 use crate::chart::{self, Panel, BLUE, GREY, ORANGE};
 use crate::frame::{encode_png, Frame, FrameError};
-use crate::ground::{GroundTexture, OnGround};
+use crate::ground::{draw_on_ground, GroundTexture};
 use crate::label;
 use crate::mesh::{vertex_normals, Bounds, IndexedMesh};
 use crate::render::style;
@@ -588,26 +588,6 @@ trait FlightEngine {
     fn write_obj(&self, path: &Path) -> std::io::Result<()>;
     /// The current mesh's triangles ([`triangle_set`]).
     fn triangle_set(&self) -> Vec<[u32; 3]>;
-}
-
-/// `mesh` textured by `ground` (white under the light, whatever `style`'s colours).
-fn draw_on_ground<M: MeshSource>(
-    frame: &mut Frame,
-    mesh: &M,
-    camera: &Camera,
-    style: &Style,
-    ground: &GroundTexture,
-) -> Result<(), FrameError> {
-    let texture = ground.texture().map_err(FrameError::Texture)?;
-    let on = OnGround { mesh, ground };
-    let white = Style {
-        base_color: [255; 3],
-        vertex_colors: false,
-        ..*style
-    };
-    frame
-        .draw_textured(&on, camera, &white, &texture)
-        .map(|_| ())
 }
 
 /// The vertex forest in a flight.

@@ -9,19 +9,20 @@
 //! triangles that are new in a frame (ROAM's measure of frame-to-frame coherence), adaptation
 //! time, file bytes per height sample and cut bytes per triangle of capacity.
 //!
-//! The colormap reaches the wavelet engine as a colour per vertex (one per sample), not as a
-//! texture over the parametric domain: the wavelet engine has no textures yet.
+//! The frames are coloured per vertex (one colour per sample); `reproduce textures` draws the
+//! same flight with the colours as a texture.
 //!
 //! [`tolerances`] (`vdlod-demo reproduce terrain-tolerances`) sets both engines beside the
 //! anchor of Lindstrom et al. ("Real-time, continuous level of detail rendering of height
 //! fields", 1996): at 0.5, 1, 2 and 4 px they keep 62,497, 23,287, 8,612 and 3,385 polygons of a
 //! 13.3M-triangle terrain with under 5% of the pixels differing from full detail; here, the
-//! triangles and the share of differing pixels on our largest procedural terrain.
+//! triangles and the share of differing pixels on our largest procedural terrain, with the
+//! colours per vertex and as a texture.
 
 use std::path::Path;
 use std::time::Instant;
 
-use vdlod::{Camera, Style, WaveletMesh};
+use vdlod::{Camera, CutMesh, Style, WaveletMesh};
 use vdlod_core::adapt::{Budget, FrameStats};
 use vdlod_core::build::BuildOptions;
 use vdlod_core::cut::Cut;
@@ -32,6 +33,7 @@ use vdlod_raster::{Rgba8, Shading};
 
 use crate::chart::{self, Panel, BLUE, ORANGE};
 use crate::frame::Frame;
+use crate::ground::{draw_on_ground, GroundTexture};
 use crate::hierarchy::build_with_progress;
 use crate::lod::{new_triangles, psnr, triangle_set};
 use crate::mesh::IndexedMesh;
@@ -332,25 +334,38 @@ struct Measured {
     /// Percent of pixels with a channel more than 16 levels (of 255) away.
     differing_16: f64,
     psnr_db: f64,
+    /// The same two for the frame drawn with the colours as a texture, against full detail
+    /// drawn so.
+    textured_16: f64,
+    textured_psnr_db: f64,
     /// A capacity or queue limit was met.
     limited: bool,
 }
 
+/// Percent of `pixels` with a channel more than `by` levels away from `reference`'s.
+fn share(pixels: &[Rgba8], reference: &[Rgba8], by: u8) -> f64 {
+    let off = pixels
+        .iter()
+        .zip(reference)
+        .filter(|(x, y)| (0..3).any(|k| x.0[k].abs_diff(y.0[k]) > by))
+        .count();
+    100.0 * off as f64 / pixels.len().max(1) as f64
+}
+
 impl Measured {
-    fn of(stats: &FrameStats, pixels: &[Rgba8], reference: &[Rgba8]) -> Measured {
-        let share = |by: u8| {
-            let off = pixels
-                .iter()
-                .zip(reference)
-                .filter(|(x, y)| (0..3).any(|k| x.0[k].abs_diff(y.0[k]) > by))
-                .count();
-            100.0 * off as f64 / pixels.len().max(1) as f64
-        };
+    /// `colored` and `textured` against full detail drawn the same ways.
+    fn of(
+        stats: &FrameStats,
+        [colored, textured]: [&[Rgba8]; 2],
+        reference: &[Vec<Rgba8>; 2],
+    ) -> Measured {
         Measured {
             triangles: stats.triangles,
-            differing: share(0),
-            differing_16: share(16),
-            psnr_db: psnr(pixels, reference),
+            differing: share(colored, &reference[0], 0),
+            differing_16: share(colored, &reference[0], 16),
+            psnr_db: psnr(colored, &reference[0]),
+            textured_16: share(textured, &reference[1], 16),
+            textured_psnr_db: psnr(textured, &reference[1]),
             limited: stats.capacity_limited || stats.queue_overflow,
         }
     }
@@ -373,24 +388,31 @@ pub fn tolerances(out: &Path, samples: usize, frames: u32) -> Result<Vec<String>
     let flight = Flight::new(samples, frames, [WIDTH, HEIGHT], show)?;
     let (s, h) = flight.views()?;
     let Flight {
+        land,
         full,
         cameras,
         drawn,
         ..
     } = &flight;
+    let ground = GroundTexture::of(land).ok_or("the terrain has no colours")?;
     let mut frame = Frame::new(WIDTH, HEIGHT).map_err(|e| e.to_string())?;
+    // Full detail, coloured per vertex and textured.
     let mut references = Vec::with_capacity(cameras.len());
     for camera in cameras {
+        let full_mesh = full.as_raster_mesh();
         frame
-            .draw(&full.as_raster_mesh(), &drawn.params(camera))
+            .draw(&full_mesh, &drawn.params(camera))
             .map_err(|e| e.to_string())?;
-        references.push(frame.pixels().to_vec());
+        let colored = frame.pixels().to_vec();
+        draw_on_ground(&mut frame, &full_mesh, camera, drawn, &ground)
+            .map_err(|e| e.to_string())?;
+        references.push([colored, frame.pixels().to_vec()]);
     }
     let mut wavelet = BigWaveletCut::boxed();
     let mut forest = BigForestCut::boxed();
     let mut lines = Vec::new();
     let mut csv = String::from(
-        "engine,tolerance_px,frame,triangles,differing_pct,differing_by_16_pct,psnr_db\n",
+        "engine,tolerance_px,frame,triangles,differing_pct,differing_by_16_pct,psnr_db,textured_differing_by_16_pct,textured_psnr_db\n",
     );
     for (tau, paper) in LINDSTROM {
         let policy = QRefine::new(tau);
@@ -400,34 +422,47 @@ pub fn tolerances(out: &Path, samples: usize, frames: u32) -> Result<Vec<String>
         for (camera, reference) in cameras.iter().zip(&references) {
             let w = vdlod::adapt_wavelets(&mut wavelet, &s, camera, &policy, &Budget::default())
                 .map_err(|e| e.to_string())?;
+            let mesh = WaveletMesh::new(&wavelet, &s, true);
             frame
-                .draw_styled(&WaveletMesh::new(&wavelet, &s, true), camera, drawn)
+                .draw_styled(&mesh, camera, drawn)
                 .map_err(|e| e.to_string())?;
-            rows[0].push(Measured::of(&w, frame.pixels(), reference));
+            let colored = frame.pixels().to_vec();
+            draw_on_ground(&mut frame, &mesh, camera, drawn, &ground).map_err(|e| e.to_string())?;
+            rows[0].push(Measured::of(&w, [&colored, frame.pixels()], reference));
             let f = vdlod::adapt(&mut forest, &h, camera, &policy, &Budget::default())
                 .map_err(|e| e.to_string())?;
+            let mesh = CutMesh::new(&forest, &h, true);
             frame
-                .draw_cut(&forest, &h, camera, drawn)
+                .draw_styled(&mesh, camera, drawn)
                 .map_err(|e| e.to_string())?;
-            rows[1].push(Measured::of(&f, frame.pixels(), reference));
+            let colored = frame.pixels().to_vec();
+            draw_on_ground(&mut frame, &mesh, camera, drawn, &ground).map_err(|e| e.to_string())?;
+            rows[1].push(Measured::of(&f, [&colored, frame.pixels()], reference));
         }
         for (k, engine) in ["wavelet", "forest"].into_iter().enumerate() {
             let rows = &rows[k];
             for (i, r) in rows.iter().enumerate() {
                 csv.push_str(&format!(
-                    "{engine},{tau},{i},{},{:.3},{:.3},{:.2}\n",
-                    r.triangles, r.differing, r.differing_16, r.psnr_db
+                    "{engine},{tau},{i},{},{:.3},{:.3},{:.2},{:.3},{:.2}\n",
+                    r.triangles,
+                    r.differing,
+                    r.differing_16,
+                    r.psnr_db,
+                    r.textured_16,
+                    r.textured_psnr_db
                 ));
             }
             let limited = rows.iter().filter(|r| r.limited).count();
             lines.push(format!(
-                "experiment=terrain-tolerances engine={engine} grid={samples}x{samples} full_triangles={} frames={frames} tolerance_px={tau} triangles_mean={:.0} differing_pixels_pct_mean={:.2} differing_pixels_pct_max={:.2} differing_by_16_pct_mean={:.2} psnr_db_mean={:.2} limited_frames={limited} lindstrom_polygons={paper} lindstrom_full_triangles=13300000 lindstrom_differing_pct_below=5",
+                "experiment=terrain-tolerances engine={engine} grid={samples}x{samples} full_triangles={} frames={frames} tolerance_px={tau} triangles_mean={:.0} differing_pixels_pct_mean={:.2} differing_pixels_pct_max={:.2} differing_by_16_pct_mean={:.2} psnr_db_mean={:.2} textured_differing_by_16_pct_mean={:.2} textured_psnr_db_mean={:.2} limited_frames={limited} lindstrom_polygons={paper} lindstrom_full_triangles=13300000 lindstrom_differing_pct_below=5",
                 full.triangles.len(),
                 mean(rows.iter().map(|r| r.triangles as f64)),
                 mean(rows.iter().map(|r| r.differing)),
                 rows.iter().map(|r| r.differing).fold(0.0, f64::max),
                 mean(rows.iter().map(|r| r.differing_16)),
                 mean(rows.iter().map(|r| r.psnr_db.min(99.0))),
+                mean(rows.iter().map(|r| r.textured_16)),
+                mean(rows.iter().map(|r| r.textured_psnr_db.min(99.0))),
             ));
         }
     }
@@ -501,6 +536,9 @@ mod tests {
                 let d = field(l, "differing_pixels_pct_mean");
                 assert!((0.0..=100.0).contains(&d), "{l}");
                 assert_eq!(field(l, "limited_frames"), 0.0, "{l}");
+                let textured = field(l, "textured_differing_by_16_pct_mean");
+                assert!((0.0..=100.0).contains(&textured), "{l}");
+                assert!(field(l, "textured_psnr_db_mean") > 15.0, "{l}");
             }
         }
         assert!(out.join("terrain_tolerances.csv").exists());
