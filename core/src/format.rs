@@ -43,7 +43,7 @@
 //! Bits are packed least significant first: field `k` of a section starts at bit `k * width`,
 //! and bit `b` is bit `b % 8` of byte `b / 8`.
 //!
-//! Triangles have ids too ([`HierarchyView::split_face`]): base triangle `k` is `k`, and the
+//! Triangles have ids too ([`SplitView::faces`]): base triangle `k` is `k`, and the
 //! split of the `k`-th parent adds triangle `base + 2k` = `(c0, c1, w0)` and, when it has a
 //! second triangle (a neighbour `n2` or `n3`), the next id = `(c1, c0, w1)`. A split record's
 //! neighbours are the triangles across those two triangles' outer edges (`c1-w0`, `w0-c0`,
@@ -590,14 +590,6 @@ pub(crate) fn u32_at(b: &[u8], o: usize) -> u32 {
 }
 
 #[inline]
-fn u64_at(b: &[u8], o: usize) -> u64 {
-    match b.get(o..o.saturating_add(8)) {
-        Some(s) => u64::from_le_bytes([s[0], s[1], s[2], s[3], s[4], s[5], s[6], s[7]]),
-        None => 0,
-    }
-}
-
-#[inline]
 fn f32_at(b: &[u8], o: usize) -> f32 {
     f32::from_bits(u32_at(b, o))
 }
@@ -745,12 +737,11 @@ impl<'a> HierarchyView<'a> {
         let blocks = self.nodes.div_ceil(KIND_BLOCK);
         let mut before = 0u32;
         for b in 0..blocks {
-            let o = self.offsets[0] + b as usize * KIND_SIZE;
-            let bits = u64_at(self.bytes, o + 4);
+            let (count, bits) = self.kind_block(b);
             let first = b * KIND_BLOCK;
             let used = (self.nodes - first).min(KIND_BLOCK);
             let stray = used < KIND_BLOCK && bits >> used != 0;
-            if u32_at(self.bytes, o) != before || stray {
+            if count != before || stray {
                 return Err(FormatError::BadNode {
                     node: first,
                     what: "the kind bits or their counts are inconsistent",
@@ -766,19 +757,14 @@ impl<'a> HierarchyView<'a> {
 
     /// The `k`-th parent is the stored parent of pair `k`, and comes before its children.
     fn check_pairs(&self) -> Result<(), FormatError> {
-        let mut k = 0u32;
-        for p in 0..self.nodes {
-            if !self.is_parent(p) {
-                continue;
-            }
-            let child = self.roots + 2 * k;
+        for (k, p) in (0..).zip(self.parent_nodes()) {
+            let [child, _] = self.pair(k);
             if p >= child || self.parent(child) != p {
                 return Err(FormatError::BadNode {
                     node: p,
                     what: "parent out of range or not the parent its children name",
                 });
             }
-            k += 1;
         }
         Ok(())
     }
@@ -882,13 +868,20 @@ impl<'a> HierarchyView<'a> {
         faces_of(self.leaves, self.nodes, self.base_triangles)
     }
 
-    /// Whether node `i` is a parent (it splits), and how many parents have smaller ids.
+    /// Block `b` of the kind section: the parents before it and its bits (zeros out of range).
     #[inline(always)]
-    fn kind(&self, i: u32) -> (bool, u32) {
-        let o = record(self.offsets[0], i / KIND_BLOCK, KIND_SIZE);
+    fn kind_block(&self, b: u32) -> (u32, u64) {
+        let o = record(self.offsets[0], b, KIND_SIZE);
         let b: [u8; KIND_SIZE] = self.fixed(o).unwrap_or([0; KIND_SIZE]);
         let before = u32::from_le_bytes([b[0], b[1], b[2], b[3]]);
         let bits = u64::from_le_bytes([b[4], b[5], b[6], b[7], b[8], b[9], b[10], b[11]]);
+        (before, bits)
+    }
+
+    /// Whether node `i` is a parent (it splits), and how many parents have smaller ids.
+    #[inline(always)]
+    fn kind(&self, i: u32) -> (bool, u32) {
+        let (before, bits) = self.kind_block(i / KIND_BLOCK);
         let at = i % KIND_BLOCK;
         let below = bits & ((1u64 << at) - 1);
         (
@@ -929,17 +922,6 @@ impl<'a> HierarchyView<'a> {
     pub fn face_creator(&self, face: u32) -> Option<u32> {
         let k = face.checked_sub(self.base_triangles)? / 2;
         (k < self.nodes - self.leaves).then(|| self.pair_parent(k))
-    }
-
-    /// The id of a triangle parent `p`'s split adds: the first (`second == false`) or the second
-    /// (see the module doc). Meaningless (but no panic) when `p` is not a parent.
-    #[inline]
-    #[must_use]
-    pub fn split_face(&self, p: u32, second: bool) -> u32 {
-        let rank = self.kind(p).1;
-        self.base_triangles
-            .wrapping_add(rank.wrapping_mul(2))
-            .wrapping_add(second as u32)
     }
 
     /// Node `i`'s parent, or [`NONE`] (also for ids out of range).

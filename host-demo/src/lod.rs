@@ -590,6 +590,20 @@ trait FlightEngine {
     fn triangle_set(&self) -> Vec<[u32; 3]>;
 }
 
+/// `mesh` in `style`, or textured by `ground` when there is one.
+fn draw_either<M: vdlod_raster::MeshSource>(
+    frame: &mut Frame,
+    mesh: &M,
+    camera: &Camera,
+    style: &Style,
+    ground: Option<&GroundTexture>,
+) -> Result<(), FrameError> {
+    match ground {
+        None => frame.draw_styled(mesh, camera, style).map(|_| ()),
+        Some(ground) => draw_on_ground(frame, mesh, camera, style, ground),
+    }
+}
+
 /// The vertex forest in a flight.
 struct Forest<'a, 'h, const V: usize, const F: usize, const Q: usize, I: SlotIndex> {
     h: HierarchyView<'h>,
@@ -641,13 +655,8 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex + VertexIndex>
         style: &Style,
         ground: Option<&GroundTexture>,
     ) -> Result<(), FrameError> {
-        match ground {
-            None => frame.draw_cut(self.cut, &self.h, camera, style).map(|_| ()),
-            Some(ground) => {
-                let mesh = CutMesh::new(self.cut, &self.h, false);
-                draw_on_ground(frame, &mesh, camera, style, ground)
-            }
-        }
+        let mesh = CutMesh::new(self.cut, &self.h, style.vertex_colors);
+        draw_either(frame, &mesh, camera, style, ground)
     }
 
     fn write_obj(&self, path: &Path) -> std::io::Result<()> {
@@ -722,10 +731,7 @@ where
         ground: Option<&GroundTexture>,
     ) -> Result<(), FrameError> {
         let mesh = WaveletMesh::new(self.cut, &self.s, style.vertex_colors);
-        match ground {
-            None => frame.draw_styled(&mesh, camera, style).map(|_| ()),
-            Some(ground) => draw_on_ground(frame, &mesh, camera, style, ground),
-        }
+        draw_either(frame, &mesh, camera, style, ground)
     }
 
     fn write_obj(&self, path: &Path) -> std::io::Result<()> {
@@ -809,18 +815,14 @@ fn fly_orbit(
             vertex_colors: true_colors,
             ..style(Shading::Gouraud, false)
         };
-        let params = drawn.params(&camera);
         let start = Instant::now();
         engine
             .draw(&mut frame, &camera, &drawn, ground)
             .map_err(|e| e.to_string())?;
         let render_us = start.elapsed().as_secs_f64() * 1e6;
         let start = Instant::now();
-        match ground {
-            None => reference.draw(&full_mesh, &params).map(|_| ()),
-            Some(ground) => draw_on_ground(&mut reference, &full_mesh, &camera, &drawn, ground),
-        }
-        .map_err(|e| e.to_string())?;
+        draw_either(&mut reference, &full_mesh, &camera, &drawn, ground)
+            .map_err(|e| e.to_string())?;
         let full_render_us = start.elapsed().as_secs_f64() * 1e6;
         let f = OrbitFrame {
             index: i,

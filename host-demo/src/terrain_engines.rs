@@ -29,7 +29,7 @@ use vdlod_core::cut::Cut;
 use vdlod_core::format::HierarchyView;
 use vdlod_core::policy::QRefine;
 use vdlod_core::wavelet::{SemiRegularView, WaveletCut};
-use vdlod_raster::{Rgba8, Shading};
+use vdlod_raster::{MeshSource, Rgba8, Shading};
 
 use crate::chart::{self, Panel, BLUE, ORANGE};
 use crate::frame::Frame;
@@ -353,6 +353,22 @@ fn share(pixels: &[Rgba8], reference: &[Rgba8], by: u8) -> f64 {
 }
 
 impl Measured {
+    /// `mesh` drawn coloured per vertex and textured, against full detail drawn the same ways
+    /// (`reference`), from `camera` in `style`.
+    fn drawn<M: MeshSource>(
+        frame: &mut Frame,
+        mesh: &M,
+        (camera, style, ground, reference): (&Camera, &Style, &GroundTexture, &[Vec<Rgba8>; 2]),
+        stats: &FrameStats,
+    ) -> Result<Measured, String> {
+        frame
+            .draw_styled(mesh, camera, style)
+            .map_err(|e| e.to_string())?;
+        let colored = frame.pixels().to_vec();
+        draw_on_ground(frame, mesh, camera, style, ground).map_err(|e| e.to_string())?;
+        Ok(Measured::of(stats, [&colored, frame.pixels()], reference))
+    }
+
     /// `colored` and `textured` against full detail drawn the same ways.
     fn of(
         stats: &FrameStats,
@@ -420,24 +436,15 @@ pub fn tolerances(out: &Path, samples: usize, frames: u32) -> Result<Vec<String>
         forest.reset(&h).map_err(|e| e.to_string())?;
         let mut rows: [Vec<Measured>; 2] = [Vec::new(), Vec::new()];
         for (camera, reference) in cameras.iter().zip(&references) {
+            let drawing = (camera, drawn, &ground, reference);
             let w = vdlod::adapt_wavelets(&mut wavelet, &s, camera, &policy, &Budget::default())
                 .map_err(|e| e.to_string())?;
             let mesh = WaveletMesh::new(&wavelet, &s, true);
-            frame
-                .draw_styled(&mesh, camera, drawn)
-                .map_err(|e| e.to_string())?;
-            let colored = frame.pixels().to_vec();
-            draw_on_ground(&mut frame, &mesh, camera, drawn, &ground).map_err(|e| e.to_string())?;
-            rows[0].push(Measured::of(&w, [&colored, frame.pixels()], reference));
+            rows[0].push(Measured::drawn(&mut frame, &mesh, drawing, &w)?);
             let f = vdlod::adapt(&mut forest, &h, camera, &policy, &Budget::default())
                 .map_err(|e| e.to_string())?;
             let mesh = CutMesh::new(&forest, &h, true);
-            frame
-                .draw_styled(&mesh, camera, drawn)
-                .map_err(|e| e.to_string())?;
-            let colored = frame.pixels().to_vec();
-            draw_on_ground(&mut frame, &mesh, camera, drawn, &ground).map_err(|e| e.to_string())?;
-            rows[1].push(Measured::of(&f, [&colored, frame.pixels()], reference));
+            rows[1].push(Measured::drawn(&mut frame, &mesh, drawing, &f)?);
         }
         for (k, engine) in ["wavelet", "forest"].into_iter().enumerate() {
             let rows = &rows[k];

@@ -520,15 +520,19 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
                         *q = [uv[k][0] * inv_w, uv[k][1] * inv_w, inv_w];
                     }
                 }
-                // Clockwise on screen, as the pixel loop wants it.
-                let order = if area < 0 { [0, 2, 1] } else { [0, 1, 2] };
-                let s = order.map(|k| ScreenVertex {
+                let s: [ScreenVertex; 3] = core::array::from_fn(|k| ScreenVertex {
                     x: v[k].x,
                     y: v[k].y,
                     z: v[k].z,
                     rgb: colors[k],
                 });
-                fill(target, &s, &order.map(|k| q[k]), area.abs(), bounds);
+                fill(
+                    target,
+                    &clockwise(area, s),
+                    &clockwise(area, q),
+                    area.abs(),
+                    bounds,
+                );
             } else if needs_clipping(&v, union, &mut stats) {
                 let colors = triangle_colors(mesh, params, prepared, t, tri, &v);
                 let uv = uvs(mesh);
@@ -542,9 +546,13 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
                     let Some(bounds) = pixel_bounds(s.map(|v| [v.x, v.y]), &target.window) else {
                         return;
                     };
-                    let order = if area < 0 { [0, 2, 1] } else { [0, 1, 2] };
-                    let (s, q) = (order.map(|k| s[k]), order.map(|k| q[k]));
-                    fill(target, &s, &q, area.abs(), bounds);
+                    fill(
+                        target,
+                        &clockwise(area, *s),
+                        &clockwise(area, *q),
+                        area.abs(),
+                        bounds,
+                    );
                 });
             }
         }
@@ -591,17 +599,10 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
                 if union == 0 {
                     edges(&v.map(|v| v.screen()));
                 } else {
-                    let none = ([[0.0; 3]; 3], [[0.0; 2]; 3]);
-                    for_each_clipped(
-                        viewport,
-                        params,
-                        mesh,
-                        tri,
-                        none.0,
-                        none.1,
-                        union,
-                        |s, _| edges(s),
-                    );
+                    let (colors, uvs) = ([[0.0; 3]; 3], [[0.0; 2]; 3]);
+                    for_each_clipped(viewport, params, mesh, tri, colors, uvs, union, |s, _| {
+                        edges(s)
+                    });
                 }
             }
         }
@@ -622,6 +623,17 @@ fn needs_clipping(v: &[&ShadedVertex; 3], union: u8, stats: &mut DrawStats) -> b
     } else {
         stats.clipped += 1;
         true
+    }
+}
+
+/// A triangle's corners (or their attributes) clockwise on screen, as the pixel loop wants them,
+/// given its [`signed_area2`].
+#[inline(always)]
+fn clockwise<T>(area: i64, [a, b, c]: [T; 3]) -> [T; 3] {
+    if area < 0 {
+        [a, c, b]
+    } else {
+        [a, b, c]
     }
 }
 

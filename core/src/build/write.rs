@@ -193,13 +193,10 @@ impl Hierarchy {
         for (k, &p) in order.parents.iter().enumerate() {
             rank[p as usize] = k as u32;
         }
-        let face = |f: u32| match f.checked_sub(base) {
-            _ if f == NONE => NONE,
-            None => f,
-            Some(k) => match rank.get(leaves.saturating_add(k / 2) as usize) {
-                Some(&r) if r != NONE => base + 2 * r + k % 2,
-                _ => NONE,
-            },
+        let face = |f: u32| match self.face_creator(f) {
+            None if f < base => f,
+            Some(p) if rank[p as usize] != NONE => base + 2 * rank[p as usize] + (f - base) % 2,
+            _ => NONE,
         };
         let mut bits = BitWriter::new(&mut out);
         for &p in &order.parents {
