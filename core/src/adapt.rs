@@ -168,6 +168,14 @@ fn pair_error(d: Demand) -> f32 {
     }
 }
 
+/// A vertex's flags after a frame in which it was `visible` or not: `VISIBLE` moves to
+/// `WAS_VISIBLE`.
+#[inline(always)]
+fn seen(flags: u8, visible: bool) -> u8 {
+    let was = if flags & VISIBLE != 0 { WAS_VISIBLE } else { 0 };
+    (flags & !(VISIBLE | WAS_VISIBLE)) | was | visible as u8
+}
+
 /// Sorts pairs by error, then parent (a total order: the result never depends on the order
 /// they were found in).
 fn sort_pairs(pairs: &mut [Pair]) {
@@ -256,40 +264,64 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         self.candidates.clear();
         self.pairs.clear();
         // Most vertices are far from wanting a split: the policy's bound from the cut's digest
-        // of the node (position and largest spheroid radius) proves it without reading the file.
-        // The others, and the parents of sibling pairs, are read in batches: first every record
-        // the batch needs is touched (independent loads the processor overlaps), then decoded.
+        // of the node (position and largest spheroid radius) proves it without reading the file,
+        // and a vertex proven so that judges no pair is done with in the first pass. The others
+        // (vertices the bound cannot decide, first children of active pairs, vertices in a
+        // geomorph) are listed and read in batches: first every record the batch needs is
+        // touched (independent loads the processor overlaps), then decoded.
         const BATCH: usize = 32;
         // Float rounding between the bound and the exact test stays far below this.
         const SLACK: f32 = 1.0 + 1e-5;
         let t = frame.threshold;
         let blends = self.geomorph_frames > 0;
+        // No geomorph runs or can start: no decision reaches a vertex but its own and its
+        // pair's first child's, so a second child is done with as early as a lone vertex.
+        let calm = !blends && self.blends.len() == 0;
+        let mut listed = [0usize; BATCH];
         let mut bounds = [Bounds::default(); BATCH];
         let mut quick = [false; BATCH];
         let mut demands = [Demand::NONE; BATCH];
         let mut parents = [NONE; BATCH];
         let mut records = [Record::default(); BATCH];
         let mut parent_bounds = [Bounds::default(); BATCH];
-        let mut base = 0;
-        while base < self.v.len() {
-            let n = (self.v.len() - base).min(BATCH);
-            for k in 0..n {
-                let digest = &self.v.digest[base + k];
+        let mut next = 0;
+        while next < self.v.len() {
+            // 1. The digests, until the batch holds `BATCH` vertices still to decide.
+            let mut n = 0;
+            while n < BATCH && next < self.v.len() {
+                let i = next;
+                next += 1;
+                let digest = &self.v.digest[i];
                 let center = h.digest_center(digest);
                 let s = h.length(digest.spheroid);
-                quick[k] = policy.error_bound(center, s * s, view) * SLACK <= t;
-                bounds[k].center = center;
-                bounds[k].radius = h.length(digest.radius);
+                let radius = h.length(digest.radius);
+                let wants_none = policy.error_bound(center, s * s, view) * SLACK <= t;
+                let flags = self.v.flags[i];
+                let alone = flags & (BLENDING | COLLAPSING) == 0
+                    && (self.v.mate(i) == NIL || (calm && flags & FIRST_CHILD == 0));
+                if wants_none && alone {
+                    // Seen if its sphere reaches into the frustum (the flag only decides
+                    // whether changes blend, so without geomorphs it is not computed).
+                    let visible = blends && view.sphere_visible(center, radius);
+                    self.v.flags[i] = seen(flags, visible);
+                    continue;
+                }
+                listed[n] = i;
+                quick[n] = wants_none;
+                bounds[n].center = center;
+                bounds[n].radius = radius;
+                n += 1;
             }
-            let nodes = &self.v.node[base..base + n];
+            let listed = &listed[..n];
+            // 2. The records of the vertices the bound could not decide.
             let mut touched = 0u8;
-            for ((r, &node), _) in records
+            for ((r, &i), _) in records
                 .iter_mut()
-                .zip(nodes)
+                .zip(listed)
                 .zip(&quick)
                 .filter(|(_, &q)| !q)
             {
-                *r = h.record(node);
+                *r = h.record(self.v.node[i]);
                 touched ^= h.touch_record(*r);
             }
             core::hint::black_box(touched);
@@ -301,23 +333,21 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             {
                 *b = h.bounds_at(*r);
             }
-            for k in 0..n {
+            for (k, &i) in listed.iter().enumerate() {
                 demands[k] = if quick[k] {
-                    // Wants no split; seen if its sphere reaches into the frustum (the flag only
-                    // decides whether changes blend, so without geomorphs it is not computed).
                     let b = &bounds[k];
                     Demand {
                         visible: blends && view.sphere_visible(b.center, b.radius),
                         error: 0.0,
                     }
                 } else {
-                    self.judged(h, base + k, &bounds[k], view, policy)
+                    self.judged(h, i, &bounds[k], view, policy)
                 };
             }
-            // The parent of a pair matters unless the first child is to be split or both were
-            // found illegal to collapse (see `decide`).
-            for (k, p) in parents[..n].iter_mut().enumerate() {
-                let i = base + k;
+            // 3. The parent of a pair matters unless the first child is to be split or both
+            // were found illegal to collapse (see `decide`).
+            for (k, (p, r)) in parents.iter_mut().zip(&mut records).enumerate().take(n) {
+                let i = listed[k];
                 let m = self.v.mate(i);
                 let splits = demands[k].error > t && h.is_parent(self.v.node[i]);
                 *p = if self.v.flags[i] & FIRST_CHILD != 0
@@ -325,18 +355,21 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                     && !splits
                     && self.v.flags[i] & self.v.flags[m as usize] & BLOCKED == 0
                 {
-                    h.parent(self.v.node[i])
+                    h.parent_record(self.v.node[i])
                 } else {
-                    NONE
-                };
+                    None
+                }
+                .map_or(NONE, |(parent, record)| {
+                    *r = record;
+                    parent
+                });
             }
             let mut touched = 0u8;
-            for (r, &p) in records
-                .iter_mut()
+            for (r, _) in records
+                .iter()
                 .zip(&parents[..n])
                 .filter(|(_, &p)| p != NONE)
             {
-                *r = h.record(p);
                 touched ^= h.touch_record(*r);
             }
             core::hint::black_box(touched);
@@ -345,11 +378,11 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                     *b = h.bounds_at(*r);
                 }
             }
-            for k in 0..n {
+            // 4. The decisions, in slot order.
+            for (k, &i) in listed.iter().enumerate() {
                 let (p, pb) = (parents[k], &parent_bounds[k]);
-                self.decide(h, view, policy, base + k, demands[k], p, pb, frame);
+                self.decide(h, view, policy, i, demands[k], p, pb, frame);
             }
-            base += n;
         }
     }
 
@@ -374,8 +407,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         }
         let node = self.v.node[i];
         let flags = self.v.flags[i];
-        let was = if flags & VISIBLE != 0 { WAS_VISIBLE } else { 0 };
-        self.v.flags[i] = (flags & !(VISIBLE | WAS_VISIBLE)) | was | d.visible as u8;
+        self.v.flags[i] = seen(flags, d.visible);
         let collapsing = flags & COLLAPSING != 0;
         if collapsing && self.v.mate(i) == NIL {
             // The pair was broken up (a forced split took the sibling): blend back.

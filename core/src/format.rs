@@ -934,6 +934,29 @@ impl<'a> HierarchyView<'a> {
         self.pair_parent((i - self.roots) / 2)
     }
 
+    /// Node `i`'s parent and where the parent's record is, or `None` for roots (and ids out of
+    /// range). The parent of sibling pair `k` is the `k`-th parent (`parse` checks it), so this
+    /// counts nothing: it costs one read, where [`HierarchyView::record`] of the parent costs two.
+    #[inline(always)]
+    #[must_use]
+    pub fn parent_record(&self, i: u32) -> Option<(u32, Record)> {
+        if i < self.roots || i >= self.nodes {
+            return None;
+        }
+        let k = (i - self.roots) / 2;
+        let p = self.pair_parent(k);
+        // `parse` proved every stored parent below `nodes`, so no overflow.
+        let offset =
+            self.offsets[1] + p as usize * NODE_SIZE + k as usize * (PARENT_SIZE - NODE_SIZE);
+        Some((
+            p,
+            Record {
+                offset,
+                parent: true,
+            },
+        ))
+    }
+
     /// Node `i`'s sibling and whether `i` is the first child (`(NONE, false)` for roots and
     /// ids out of range): siblings are adjacent, so this reads nothing.
     #[inline]
