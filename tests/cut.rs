@@ -10,7 +10,7 @@ mod common;
 
 use common::fly::{fly, hierarchy_and_ids, hierarchy_bytes, node_triangles, Path};
 use common::{fixture, sorted};
-use vdlod_core::adapt::Budget;
+use vdlod_core::adapt::{Budget, FrameStats};
 use vdlod_core::cut::Cut;
 use vdlod_core::format::HierarchyView;
 use vdlod_core::policy::ScreenError;
@@ -292,4 +292,84 @@ fn open_borders_honour_the_tolerance() {
         worst <= 1.5,
         "the outline strays {worst:.1} px at a 1 px tolerance"
     );
+}
+
+/// A policy that asks every vertex every frame: the same demands as the one it wraps, but no
+/// envelope, so the cut neither decides vertices from their digests nor skips settled ones.
+struct Opaque<P>(P);
+
+impl<P: vdlod_core::policy::Policy> vdlod_core::policy::Policy for Opaque<P> {
+    fn demand(
+        &self,
+        b: &vdlod_core::policy::Bounds,
+        view: &vdlod_core::policy::View,
+    ) -> vdlod_core::policy::Demand {
+        self.0.demand(b, view)
+    }
+}
+
+/// Skipping settled vertices and deciding vertices from their digests change no frame: over the
+/// peer orbit, a drifting path with jumps, zooms, pauses and a changing tolerance, and a phase
+/// with a binding budget and an operation cap, the cut is the one a cut that asks every vertex
+/// every frame makes, and it does skip most vertices on the orbit.
+#[test]
+fn settled_vertices_change_no_frame() {
+    use vdlod_core::policy::{QRefine, View};
+    use vdlod_demo::camera::peer_orbit;
+    for name in ["bunny.obj", "head.obj"] {
+        let mesh = fixture(name);
+        let bytes = hierarchy_bytes(&mesh);
+        let h = HierarchyView::parse(&bytes).unwrap();
+        let b = mesh.bounds();
+        let (c, r) = (b.center().to_array(), b.radius());
+        let orbit = peer_orbit(&b, 200, 640, 480);
+        let mut path = Path::new(11);
+        let mut views: Vec<(View, f32)> = (0..120).map(|i| (orbit.camera(i).view(), 1.0)).collect();
+        let mut held = path.view(c, r);
+        for i in 0..240u32 {
+            // Pauses (the same view again), drift with jumps, and a new tolerance now and then.
+            if i % 40 >= 8 {
+                held = path.view(c, r);
+            }
+            views.push((held, [0.5, 2.0][(i / 60) as usize % 2]));
+        }
+        let mut asked = Cut::<32_767, 65_534, 4096>::boxed();
+        let mut skipping = Cut::<32_767, 65_534, 4096>::boxed();
+        asked.reset(&h).unwrap();
+        skipping.reset(&h).unwrap();
+        let (mut settled, mut vertices) = (0u64, 0u64);
+        for (i, (view, tau)) in views.iter().enumerate() {
+            let budget = if (200..260).contains(&i) {
+                Budget {
+                    max_triangles: 3000,
+                    max_ops: 40,
+                    ..Budget::default()
+                }
+            } else {
+                Budget::default()
+            };
+            let policy = QRefine::new(*tau);
+            let a = asked.adapt(&h, view, &Opaque(policy), &budget);
+            let s = skipping.adapt(&h, view, &policy, &budget);
+            assert_eq!(a.settled, 0);
+            assert_eq!(
+                FrameStats { settled: 0, ..s },
+                a,
+                "{name}, frame {i}: the stats differ"
+            );
+            assert_eq!(
+                node_triangles(&skipping),
+                node_triangles(&asked),
+                "{name}, frame {i}: the cuts differ"
+            );
+            if i < 120 {
+                settled += s.settled as u64;
+                vertices += s.vertices as u64;
+            }
+        }
+        assert!(
+            settled * 3 > vertices,
+            "{name}: only {settled} of {vertices} vertices skipped on the orbit"
+        );
+    }
 }

@@ -3,8 +3,10 @@
 //! Incremental from the previous frame's cut, as in the merge-tree paper (Berkey and Song, §3.5)
 //! and Hoppe's `adapt_refinement` ("View-dependent refinement of progressive meshes", 1997): one
 //! pass over the active vertices asks the [`Policy`] about each (a vertex whose digest proves,
-//! through [`Policy::error_bound`], that it wants no split is decided without reading the file),
-//! then
+//! through the policy's [`crate::policy::Envelope`], that it wants no split is decided without
+//! reading the file; without geomorphs, a vertex or pair whose answer provably cannot have changed
+//! since an anchor frame, the camera having moved less than the margin the anchor measured, is
+//! not asked at all: [`FrameStats::settled`]), then
 //!
 //! 1. **coarsen**: sibling pairs whose parent the policy no longer needs are collapsed where
 //!    Hoppe's condition allows; a collapse lists the pair it makes and the pairs around it whose
@@ -63,10 +65,11 @@
 //! # }
 //! ```
 
+use crate::cut::steady::Mode;
 use crate::cut::NIL;
 use crate::cut::{
-    Cut, Pair, PairFans, Refused, SlotIndex, BLENDING, BLOCKED, COLLAPSING, FIRST_CHILD, VISIBLE,
-    WAS_VISIBLE,
+    Cut, Pair, PairFans, Refused, SlotIndex, BLENDING, BLOCKED, COLLAPSING, FIRST_CHILD, SETTLED,
+    VISIBLE, WAS_VISIBLE,
 };
 use crate::format::{HierarchyView, Record, NONE};
 use crate::policy::{Bounds, Demand, Policy, View};
@@ -114,6 +117,9 @@ pub struct FrameStats {
     pub budget_ecols: u32,
     /// Vertices with a geomorph running.
     pub blending: u32,
+    /// Vertices skipped because their answers could not have changed since an anchor frame
+    /// (see [`Cut::adapt`]; the frame is the same as if they had been asked).
+    pub settled: u32,
     /// The error threshold used (1 unless regulated).
     pub threshold: f32,
     /// Splits were refused by [`Budget::max_triangles`].
@@ -263,8 +269,8 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
     ) {
         self.candidates.clear();
         self.pairs.clear();
-        // Most vertices are far from wanting a split: the policy's bound from the cut's digest
-        // of the node (position and largest spheroid radius) proves it without reading the file,
+        // Most vertices are far from wanting a split: the policy's envelope and the cut's digest
+        // of the node (position and largest spheroid radius) prove it without reading the file,
         // and a vertex proven so that judges no pair is done with in the first pass. The others
         // (vertices the bound cannot decide, first children of active pairs, vertices in a
         // geomorph) are listed and read in batches: first every record the batch needs is
@@ -277,130 +283,168 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         // No geomorph runs or can start: no decision reaches a vertex but its own and its
         // pair's first child's, so a second child is done with as early as a lone vertex.
         let calm = !blends && self.blends.len() == 0;
+        let envelope = if policy.judges_triangles() {
+            None
+        } else {
+            policy.envelope(view)
+        };
+        let upper = envelope.map_or(f32::INFINITY, |e| e.upper);
+        // Settled vertices are skipped while the anchor holds; otherwise an anchor frame marks
+        // them anew (see `crate::cut::steady`).
+        let mode = self
+            .steady
+            .begin(view, envelope, t, calm, h.bounding_sphere());
+        let (skip, anchor) = (mode == Mode::Skip, mode == Mode::Anchor);
+        // Batch lists, built without branches (each item is written, and counted when it
+        // belongs): the vertices still to decide, those of them the bound could not decide
+        // ("slow"), and those that judge a pair (by place in the first list).
         let mut listed = [0usize; BATCH];
+        let mut slow = [0usize; BATCH];
+        let mut pairs = [0usize; BATCH];
+        let mut quiet = [false; BATCH];
         let mut bounds = [Bounds::default(); BATCH];
-        let mut quick = [false; BATCH];
         let mut demands = [Demand::NONE; BATCH];
         let mut parents = [NONE; BATCH];
         let mut records = [Record::default(); BATCH];
         let mut parent_bounds = [Bounds::default(); BATCH];
         let mut next = 0;
         while next < self.v.len() {
-            // 1. The digests, until the batch holds `BATCH` vertices still to decide.
+            // 1. The digests, until the batch holds `BATCH` vertices still to decide. A vertex
+            // the bound decides that has no pair to judge and no geomorph is done with here:
+            // only its visibility flag moves (computed only with geomorphs, the one use of it).
             let mut n = 0;
+            let mut ns = 0;
             while n < BATCH && next < self.v.len() {
                 let i = next;
                 next += 1;
+                let flags = self.v.flags[i];
+                if skip && flags & SETTLED != 0 {
+                    frame.stats.settled += 1;
+                    continue;
+                }
                 let digest = &self.v.digest[i];
                 let center = h.digest_center(digest);
                 let s = h.length(digest.spheroid);
                 let radius = h.length(digest.radius);
-                let wants_none = policy.error_bound(center, s * s, view) * SLACK <= t;
-                let flags = self.v.flags[i];
-                let alone = flags & (BLENDING | COLLAPSING) == 0
-                    && (self.v.mate(i) == NIL || (calm && flags & FIRST_CHILD == 0));
-                if wants_none && alone {
-                    // Seen if its sphere reaches into the frustum (the flag only decides
-                    // whether changes blend, so without geomorphs it is not computed).
-                    let visible = blends && view.sphere_visible(center, radius);
-                    self.v.flags[i] = seen(flags, visible);
-                    continue;
+                let r = [
+                    center[0] - view.eye[0],
+                    center[1] - view.eye[1],
+                    center[2] - view.eye[2],
+                ];
+                let d2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+                let wants_none = s * s * upper * SLACK <= t * d2;
+                let alone = (flags & (BLENDING | COLLAPSING) == 0)
+                    & ((self.v.mate(i) == NIL) | (calm & (flags & FIRST_CHILD == 0)));
+                let done = wants_none & alone;
+                let visible = blends && view.sphere_visible(center, radius);
+                let mut next_flags = if done { seen(flags, visible) } else { flags };
+                if anchor {
+                    quiet[n] = wants_none && self.steady.stays_quiet(s * s * upper, d2, t, SLACK);
+                    next_flags &= !SETTLED;
+                    if done && quiet[n] {
+                        next_flags |= SETTLED;
+                    }
                 }
+                self.v.flags[i] = next_flags;
                 listed[n] = i;
-                quick[n] = wants_none;
+                slow[ns] = n;
                 bounds[n].center = center;
                 bounds[n].radius = radius;
-                n += 1;
+                demands[n] = Demand {
+                    visible,
+                    error: 0.0,
+                };
+                ns += !wants_none as usize;
+                n += !done as usize;
             }
-            let listed = &listed[..n];
-            // 2. The records of the vertices the bound could not decide.
+            let (listed, slow) = (&listed[..n], &slow[..ns]);
+            // 2. The records of the vertices the bound could not decide, and their demands.
             let mut touched = 0u8;
-            for ((r, &i), _) in records
-                .iter_mut()
-                .zip(listed)
-                .zip(&quick)
-                .filter(|(_, &q)| !q)
-            {
-                *r = h.record(self.v.node[i]);
-                touched ^= h.touch_record(*r);
+            for &k in slow {
+                records[k] = h.record(self.v.node[listed[k]]);
+                touched ^= h.touch_record(records[k]);
             }
             core::hint::black_box(touched);
-            for ((b, r), _) in bounds
-                .iter_mut()
-                .zip(&records)
-                .zip(&quick)
-                .filter(|(_, &q)| !q)
-            {
-                *b = h.bounds_at(*r);
-            }
-            for (k, &i) in listed.iter().enumerate() {
-                demands[k] = if quick[k] {
-                    let b = &bounds[k];
-                    Demand {
-                        visible: blends && view.sphere_visible(b.center, b.radius),
-                        error: 0.0,
-                    }
-                } else {
-                    self.judged(h, i, &bounds[k], view, policy)
-                };
+            for &k in slow {
+                bounds[k] = h.bounds_at(records[k]);
+                demands[k] = self.judged(h, listed[k], &bounds[k], view, policy);
             }
             // 3. The parent of a pair matters unless the first child is to be split or both
             // were found illegal to collapse (see `decide`).
-            for (k, (p, r)) in parents.iter_mut().zip(&mut records).enumerate().take(n) {
-                let i = listed[k];
+            let mut np = 0;
+            for (k, &i) in listed.iter().enumerate() {
+                let flags = self.v.flags[i];
                 let m = self.v.mate(i);
+                let mate_flags = self.v.flags.get(m as usize).copied().unwrap_or(0);
                 let splits = demands[k].error > t && h.is_parent(self.v.node[i]);
-                *p = if self.v.flags[i] & FIRST_CHILD != 0
-                    && m != NIL
-                    && !splits
-                    && self.v.flags[i] & self.v.flags[m as usize] & BLOCKED == 0
-                {
-                    h.parent_record(self.v.node[i])
-                } else {
-                    None
+                let judges = (flags & FIRST_CHILD != 0)
+                    & (m != NIL)
+                    & !splits
+                    & (flags & mate_flags & BLOCKED == 0);
+                pairs[np] = k;
+                np += judges as usize;
+                // A first child whose pair is marked illegal settles on its own answer (a
+                // collapse that clears the mark clears this one too).
+                if anchor && quiet[k] && !judges {
+                    self.v.flags[i] |= SETTLED;
                 }
-                .map_or(NONE, |(parent, record)| {
-                    *r = record;
-                    parent
-                });
             }
+            let pairs = &pairs[..np];
             let mut touched = 0u8;
-            for (r, _) in records
-                .iter()
-                .zip(&parents[..n])
-                .filter(|(_, &p)| p != NONE)
-            {
-                touched ^= h.touch_record(*r);
+            for &k in pairs {
+                let (p, r) = h
+                    .parent_record(self.v.node[listed[k]])
+                    .unwrap_or((NONE, Record::default()));
+                parents[k] = p;
+                records[k] = r;
+            }
+            for &k in pairs {
+                touched ^= h.touch_record(records[k]);
             }
             core::hint::black_box(touched);
-            for ((b, r), &p) in parent_bounds.iter_mut().zip(&records).zip(&parents[..n]) {
-                if p != NONE {
-                    *b = h.bounds_at(*r);
+            for &k in pairs {
+                parent_bounds[k] = h.bounds_at(records[k]);
+            }
+            if anchor {
+                for &k in pairs {
+                    if quiet[k] && self.steady.stays_wanted(&parent_bounds[k], view, t, SLACK) {
+                        self.v.flags[listed[k]] |= SETTLED;
+                    }
                 }
             }
-            // 4. The decisions, in slot order.
-            for (k, &i) in listed.iter().enumerate() {
-                let (p, pb) = (parents[k], &parent_bounds[k]);
-                self.decide(h, view, policy, i, demands[k], p, pb, frame);
+            // 4. The decisions, in slot order. Without geomorphs they touch nothing but the
+            // split heap and the pair list, so the pairs can follow the vertices.
+            if calm {
+                for (k, &i) in listed.iter().enumerate() {
+                    self.decide(h, i, demands[k], frame);
+                }
+                for &k in pairs {
+                    self.decide_pair(
+                        h,
+                        view,
+                        policy,
+                        listed[k],
+                        parents[k],
+                        &parent_bounds[k],
+                        frame,
+                    );
+                }
+            } else {
+                let mut pairs = pairs.iter().peekable();
+                for (k, &i) in listed.iter().enumerate() {
+                    self.decide(h, i, demands[k], frame);
+                    if pairs.next_if_eq(&&k).is_some() {
+                        self.decide_pair(h, view, policy, i, parents[k], &parent_bounds[k], frame);
+                    }
+                }
             }
         }
     }
 
-    /// The decisions for slot `i` (see [`Cut::evaluate`]), with its demand and, for a first child
-    /// whose sibling is active, its parent and the parent's bounds.
-    #[allow(clippy::too_many_arguments)]
+    /// Slot `i`'s own decisions (see [`Cut::evaluate`]) with its demand `d`: its blend advances,
+    /// its visibility moves, and it joins the split heap when over the threshold.
     #[inline(always)]
-    fn decide<P: Policy>(
-        &mut self,
-        h: &HierarchyView<'_>,
-        view: &View,
-        policy: &P,
-        i: usize,
-        d: Demand,
-        p: u32,
-        parent_bounds: &Bounds,
-        frame: &mut Frame,
-    ) {
+    fn decide(&mut self, h: &HierarchyView<'_>, i: usize, d: Demand, frame: &mut Frame) {
         let t = frame.threshold;
         if self.v.flags[i] & BLENDING != 0 {
             self.advance(i);
@@ -424,20 +468,27 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             {
                 frame.stats.queue_overflow = true;
             }
-            return;
         }
-        if p == NONE {
-            return;
-        }
+    }
+
+    /// The decision for the pair whose first child is at slot `i` (its sibling is active, it
+    /// does not split, and the pair is not marked illegal): parent `p` with bounds
+    /// `parent_bounds`, still wanted (a collapse under way blends back) or listed for coarsening.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn decide_pair<P: Policy>(
+        &mut self,
+        h: &HierarchyView<'_>,
+        view: &View,
+        policy: &P,
+        i: usize,
+        p: u32,
+        parent_bounds: &Bounds,
+        frame: &mut Frame,
+    ) {
         let j = self.v.mate(i) as usize;
-        if self.v.flags[i] & self.v.flags[j] & BLOCKED != 0 {
-            // Found illegal before, and nothing around has collapsed since; a collapse that
-            // clears the mark lists the pair again (`list_unblocked`).
-            return;
-        }
         let e = pair_error(self.judged_pair(h, (i, j), parent_bounds, view, policy));
-        if e > t {
-            // The parent is wanted: a collapse under way blends back.
+        if e > frame.threshold {
             if (self.v.flags[i] | self.v.flags[j]) & COLLAPSING != 0 {
                 self.start_blend(h, i, false);
                 self.start_blend(h, j, false);

@@ -444,14 +444,14 @@ pub fn oct_encode(n: [f32; 3]) -> (i8, i8) {
 /// Decodes octahedral coordinates in `[-127, 127]` to a unit vector (one square root and one
 /// division: the policies decode an axis per vertex per frame).
 pub fn oct_decode(x: i8, y: i8) -> [f32; 3] {
-    // In units of 1/127: |u| + |v| + |z| = 127 before normalizing.
-    let (mut u, mut v) = (x as f32, y as f32);
-    let z = 127.0 - u.abs() - v.abs();
-    if z < 0.0 {
-        let (ou, ov) = (u, v);
-        u = (127.0 - ov.abs()) * if ou >= 0.0 { 1.0 } else { -1.0 };
-        v = (127.0 - ou.abs()) * if ov >= 0.0 { 1.0 } else { -1.0 };
-    }
+    // In units of 1/127: |u| + |v| + |z| = 127 before normalizing. The lower hemisphere's
+    // fold is computed always and selected, so that it costs no branch.
+    let (x, y) = (x as f32, y as f32);
+    let z = 127.0 - x.abs() - y.abs();
+    let sign = |a: f32| if a >= 0.0 { 1.0 } else { -1.0 };
+    let fold = z < 0.0;
+    let u = if fold { (127.0 - y.abs()) * sign(x) } else { x };
+    let v = if fold { (127.0 - x.abs()) * sign(y) } else { y };
     // Never zero: the components' magnitudes add up to 127.
     let inv = 1.0 / libm::sqrtf(u * u + v * v + z * z);
     [u * inv, v * inv, z * inv]

@@ -87,6 +87,56 @@ impl Demand {
     }
 }
 
+/// How a policy's demand depends on the view, for the cut to skip vertices whose answer is
+/// known: with `r = b.center - eye`, `d2 = |r|^2` and `p2 = d2 - (r . b.axis)^2` (the squared
+/// distance of the eye from the axis), for every [`Bounds`] `b`,
+///
+/// - `demand(b, view)` is culled exactly when `frustum` and `b`'s sphere misses the frustum
+///   ([`View::sphere_visible`]), or `back_face` and `b`'s normal cone faces away ([`BackFace`]);
+/// - otherwise `max(b.b2 d2, b.a2 p2) lower / d2^2 <= demand(b, view).error` and
+///   `demand(b, view).error <= max(b.a2, b.b2) upper / d2`;
+/// - and the error depends on the view only through its eye and these two scales.
+///
+/// (Up to float rounding: a policy's sums may cancel, so a user of the lower bound leaves a
+/// margin of a small share of `max(b.a2, b.b2) d2`.)
+///
+/// A cut proves "wants no split" from `upper` and a node's largest spheroid radius (its digest),
+/// and, while the eye moves less than a margin, "still wants no split" and "the parent is still
+/// wanted" without asking again.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Envelope {
+    /// Scale of the upper bound (0: never wants a split).
+    pub upper: f32,
+    /// Scale of the lower bound (0: proves nothing).
+    pub lower: f32,
+    /// Culls by the frustum.
+    pub frustum: bool,
+    /// Culls by the normal cone.
+    pub back_face: bool,
+}
+
+impl Envelope {
+    /// Culls nothing and wants nothing.
+    pub const ZERO: Envelope = Envelope {
+        upper: 0.0,
+        lower: 0.0,
+        frustum: false,
+        back_face: false,
+    };
+
+    /// Both policies' tests: culled when either culls, the larger error otherwise (the tuple
+    /// policy's rule).
+    #[must_use]
+    pub fn and(self, other: Envelope) -> Envelope {
+        Envelope {
+            upper: self.upper.max(other.upper),
+            lower: self.lower.max(other.lower),
+            frustum: self.frustum || other.frustum,
+            back_face: self.back_face || other.back_face,
+        }
+    }
+}
+
 /// A camera for one frame, reduced to what the policies test against.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct View {
@@ -282,14 +332,12 @@ pub trait Policy {
     /// The policy's demand for a vertex with bounds `b` seen from `view`.
     fn demand(&self, b: &Bounds, view: &View) -> Demand;
 
-    /// An upper bound on `demand(b, view).error` over every `b` centred at `center` whose
-    /// spheroid radii `a` and `b` are at most `sqrt(s2)` (whatever its radius, axis and cone),
-    /// or infinity when the policy cannot bound it (the default). A cut skips decoding a vertex
-    /// whose bound is below the threshold: it cannot want a split.
+    /// How the demand depends on `view` ([`Envelope`]), or `None` when the policy cannot say
+    /// (the default): a cut then asks about every vertex every frame.
     #[inline]
-    fn error_bound(&self, center: [f32; 3], s2: f32, view: &View) -> f32 {
-        let _ = (center, s2, view);
-        f32::INFINITY
+    fn envelope(&self, view: &View) -> Option<Envelope> {
+        let _ = view;
+        None
     }
 
     /// Whether the policy also judges triangles ([`Policy::triangle`]); `false` (the default)
@@ -331,10 +379,8 @@ impl<A: Policy, B: Policy> Policy for (A, B) {
     }
 
     #[inline]
-    fn error_bound(&self, center: [f32; 3], s2: f32, view: &View) -> f32 {
-        self.0
-            .error_bound(center, s2, view)
-            .max(self.1.error_bound(center, s2, view))
+    fn envelope(&self, view: &View) -> Option<Envelope> {
+        Some(self.0.envelope(view)?.and(self.1.envelope(view)?))
     }
 
     #[inline]
@@ -357,8 +403,8 @@ impl<P: Policy + ?Sized> Policy for &P {
     }
 
     #[inline]
-    fn error_bound(&self, center: [f32; 3], s2: f32, view: &View) -> f32 {
-        (**self).error_bound(center, s2, view)
+    fn envelope(&self, view: &View) -> Option<Envelope> {
+        (**self).envelope(view)
     }
 
     #[inline]
@@ -387,8 +433,11 @@ impl Policy for Frustum {
     }
 
     #[inline]
-    fn error_bound(&self, _: [f32; 3], _: f32, _: &View) -> f32 {
-        0.0
+    fn envelope(&self, _: &View) -> Option<Envelope> {
+        Some(Envelope {
+            frustum: true,
+            ..Envelope::ZERO
+        })
     }
 }
 
@@ -409,8 +458,11 @@ impl Policy for BackFace {
     }
 
     #[inline]
-    fn error_bound(&self, _: [f32; 3], _: f32, _: &View) -> f32 {
-        0.0
+    fn envelope(&self, _: &View) -> Option<Envelope> {
+        Some(Envelope {
+            back_face: true,
+            ..Envelope::ZERO
+        })
     }
 }
 
@@ -471,21 +523,23 @@ impl Policy for ScreenError {
         }
     }
 
-    /// `lhs <= max(a^2, b^2) |d|^2` for any axis (wavelet paper eq. 4-5), so the ratio is at most
-    /// `s2 ppu^2 / (tol^2 |d|^2)` with the smaller tolerance.
+    /// `max(b^2 |d|^2, a^2 p^2) <= lhs <= max(a^2, b^2) |d|^2` for any axis (wavelet paper eq.
+    /// 4-5; `p` the eye's distance from the axis), so the ratio lies between
+    /// `max(b^2 |d|^2, a^2 p^2) ppu^2 / (tol^2 |d|^4)` with the larger tolerance and
+    /// `max(a^2, b^2) ppu^2 / (tol^2 |d|^2)` with the smaller.
     #[inline]
-    fn error_bound(&self, center: [f32; 3], s2: f32, view: &View) -> f32 {
-        let r = sub(center, view.eye);
-        let d2 = dot(r, r);
-        let tol = self.silhouette.min(self.interior);
-        let rhs = tol * tol * d2;
-        if s2 <= 0.0 {
-            0.0
-        } else if rhs > 0.0 {
-            s2 * (view.pixels_per_unit * view.pixels_per_unit) / rhs
-        } else {
-            f32::INFINITY
-        }
+    fn envelope(&self, view: &View) -> Option<Envelope> {
+        let ppu2 = view.pixels_per_unit * view.pixels_per_unit;
+        let (lo, hi) = (
+            self.silhouette.min(self.interior),
+            self.silhouette.max(self.interior),
+        );
+        Some(Envelope {
+            upper: ppu2 / (lo * lo),
+            lower: ppu2 / (hi * hi),
+            frustum: false,
+            back_face: false,
+        })
     }
 }
 
@@ -525,10 +579,10 @@ impl Policy for HoppeError {
         }
     }
 
-    /// `lhs <= max(mu^2, delta^2) |d|^2`, as for the spheroid.
+    /// `lhs = max(mu^2 |d|^2, delta^2 p^2)`, within the spheroid's envelope.
     #[inline]
-    fn error_bound(&self, center: [f32; 3], s2: f32, view: &View) -> f32 {
-        self.error.error_bound(center, s2, view)
+    fn envelope(&self, view: &View) -> Option<Envelope> {
+        self.error.envelope(view)
     }
 }
 
@@ -566,8 +620,12 @@ impl Policy for QRefine {
     }
 
     #[inline]
-    fn error_bound(&self, center: [f32; 3], s2: f32, view: &View) -> f32 {
-        self.error.error_bound(center, s2, view)
+    fn envelope(&self, view: &View) -> Option<Envelope> {
+        Some(Envelope {
+            frustum: true,
+            back_face: true,
+            ..self.error.envelope(view)?
+        })
     }
 }
 
@@ -859,26 +917,41 @@ mod tests {
                 b2: if next() < 0.5 { 0.0 } else { a * a * next() },
             };
             assert_eq!(composed.demand(&b, &v), fused.demand(&b, &v), "{b:?}");
-            // The bound the cut skips vertices with holds for both forms.
-            let s2 = b.a2.max(b.b2);
-            for bound in [
-                composed.error_bound(c, s2, &v),
-                fused.error_bound(c, s2, &v),
-            ] {
-                assert!(fused.demand(&b, &v).error <= bound * (1.0 + 1e-5), "{b:?}");
+            // The envelope the cut skips vertices with holds, and is the same for both forms.
+            let env = fused.envelope(&v).unwrap();
+            assert_eq!(composed.envelope(&v), Some(env));
+            let d = fused.demand(&b, &v);
+            let r = sub(c, v.eye);
+            let d2 = dot(r, r);
+            let culled = (env.frustum && !v.sphere_visible(c, b.radius))
+                || (env.back_face && Eye::of(&b, &v).faces_away(&b));
+            assert_eq!(d.visible, !culled, "{b:?}");
+            if !culled {
+                let s2 = b.a2.max(b.b2);
+                let rn = dot(r, b.axis);
+                let floor = ((b.b2 * d2).max(b.a2 * (d2 - rn * rn)) - 1e-5 * s2 * d2) * env.lower
+                    / (d2 * d2);
+                assert!(d.error <= s2 * env.upper / d2 * (1.0 + 1e-5), "{b:?}");
+                assert!(d.error >= floor * (1.0 - 1e-5), "{b:?}");
             }
-            assert_eq!(
-                composed.error_bound(c, s2, &v),
-                fused.error_bound(c, s2, &v)
-            );
         }
-        // Policies that cannot bound their error say so.
-        let c = [0.0; 3];
+        // Policies that cannot describe their error say so.
+        assert_eq!(MergeTree { near: 1.0 }.envelope(&v), None);
         assert_eq!(
-            MergeTree { near: 1.0 }.error_bound(c, 1.0, &v),
-            f32::INFINITY
+            Frustum.envelope(&v),
+            Some(Envelope {
+                frustum: true,
+                ..Envelope::ZERO
+            })
         );
-        assert_eq!(Frustum.error_bound(c, 1.0, &v), 0.0);
+        // Different tolerances: the lower bound uses the larger one.
+        let two = ScreenError {
+            silhouette: 0.5,
+            interior: 2.0,
+        }
+        .envelope(&v)
+        .unwrap();
+        assert_eq!(two.upper, 16.0 * two.lower);
     }
 
     #[test]

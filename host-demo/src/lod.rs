@@ -11,8 +11,8 @@ use vdlod_core::adapt::{Budget, FrameStats};
 use vdlod_core::cut::{Coloring, Cut, SlotIndex};
 use vdlod_core::format::{HierarchyView, NONE};
 use vdlod_core::policy::{
-    Bounds as NodeBounds, Demand, Frustum, Importance, MergeTree, Policy, QRefine, ScreenError,
-    View,
+    Bounds as NodeBounds, Demand, Envelope, Frustum, Importance, MergeTree, Policy, QRefine,
+    ScreenError, View,
 };
 use vdlod_core::wavelet::{SemiRegularView, WaveletCut};
 use vdlod_raster::{Rgba8, Shading, VertexIndex};
@@ -284,11 +284,11 @@ impl Policy for DemoPolicy {
     }
 
     #[inline]
-    fn error_bound(&self, center: [f32; 3], s2: f32, view: &View) -> f32 {
+    fn envelope(&self, view: &View) -> Option<Envelope> {
         match self {
-            DemoPolicy::Screen(p) => p.error_bound(center, s2, view),
-            DemoPolicy::MergeTree(p) => p.error_bound(center, s2, view),
-            DemoPolicy::Importance(p) => p.error_bound(center, s2, view),
+            DemoPolicy::Screen(p) => p.envelope(view),
+            DemoPolicy::MergeTree(p) => p.envelope(view),
+            DemoPolicy::Importance(p) => p.envelope(view),
         }
     }
 

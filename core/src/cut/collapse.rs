@@ -2,7 +2,7 @@
 
 use super::fan::PairFans;
 use super::slot::SlotIndex;
-use super::{corner, next3, prev3, Cut, Refused, BLOCKED, NIL};
+use super::{corner, next3, prev3, Cut, Refused, BLOCKED, NIL, SETTLED};
 use crate::format::{HierarchyView, SplitView, NONE};
 
 /// The slots of a legal collapse: the two children `a` and `b`, and the triangles it removes
@@ -134,7 +134,8 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             for v in self.t.at(f) {
                 if let Some(flags) = self.v.flags.get_mut(v as usize) {
                     if *flags & BLOCKED != 0 {
-                        *flags &= !BLOCKED;
+                        // The pair is judged again: no longer settled either.
+                        *flags &= !(BLOCKED | SETTLED);
                         if v != a && v != b && fans.unblocked.push(self.v.node[v as usize]).is_err()
                         {
                             fans.overflow = true;

@@ -13,8 +13,9 @@
 //! [`Cut::check`] proves it (Hoppe's `ok()`).
 //!
 //! The rooms: [`slot`] (index widths and the queue arena), `store` (vertex and triangle
-//! records), `fan` (walks around a vertex), `judge` (policies that judge triangles), `split`, `collapse`, `blend` (geomorph state and the
-//! vertex output), `check` (the invariants).
+//! records), `fan` (walks around a vertex), `judge` (policies that judge triangles), `split`,
+//! `collapse`, `blend` (geomorph state and the vertex output), `steady` (which vertices a frame
+//! may skip), `check` (the invariants).
 //!
 //! # Memory
 //!
@@ -32,10 +33,11 @@
 //! | triangle slot | `6i + 4 + i` (18 with `u16`) | corners, neighbours, id; one node-map entry |
 //! | queue entry | `4 + 8 + 12 + 28 = 52` | forcing stack, split heap, collapse pairs, blend arena |
 //!
-//! plus 40 bytes of lengths and settings. With the recommended `F = 2 V` and `Q = V / 8` that is
-//! 21 + 36 + 6.5 = 63.5 bytes per vertex slot, **31.75 bytes per triangle of capacity** with
-//! `u16` (48.75 with `u32`). A cut for a 10,000-triangle budget, `Cut<5008, 10000, 626>`, is
-//! 317,760 bytes. The queues only bound how much one frame can do: when one overflows, the rest
+//! plus 164 bytes of lengths, settings and the anchor frame of the settled vertices (`steady`).
+//! With the recommended `F = 2 V` and `Q = V / 8` that is 21 + 36 + 6.5 = 63.5 bytes per vertex
+//! slot, **31.75 bytes per triangle of capacity** with `u16` (48.75 with `u32`), 31.89 for a
+//! 1,000-triangle cut. A cut for a 10,000-triangle budget, `Cut<5000, 10000, 625>`, is 317,664
+//! bytes. The queues only bound how much one frame can do: when one overflows, the rest
 //! waits for the next frame and [`crate::adapt::FrameStats`] says so.
 //!
 //! [`Cut::new`] is `const` and all zeros, so `static CUT: Mutex<RefCell<Cut<..>>>` lands in
@@ -82,6 +84,7 @@ mod fan;
 mod judge;
 pub mod slot;
 mod split;
+pub(crate) mod steady;
 mod store;
 
 pub(crate) use blend::Blend;
@@ -92,12 +95,13 @@ pub(crate) use fan::{Fan, PairFans};
 pub use slot::SlotIndex;
 
 use slot::Arena;
+pub(crate) use steady::Steady;
 use store::{Triangles, Vertices};
 
 // The documented figure, checked when the crate is compiled for any target (CI builds it for
 // x86_64 and a 32-bit Cortex-M): a cut of 10,240 triangle slots with the recommended
-// capacities is 325,160 bytes, at most 32 bytes per triangle of capacity.
-const _: () = assert!(Cut::<5120, 10240, 640>::BYTES == 325_160);
+// capacities is 325,284 bytes, at most 32 bytes per triangle of capacity.
+const _: () = assert!(Cut::<5120, 10240, 640>::BYTES == 325_284);
 const _: () = assert!(Cut::<5120, 10240, 640>::BYTES <= 32 * 10240);
 
 /// A slot that holds nothing (no neighbour across a border edge, no incident triangle).
@@ -116,6 +120,9 @@ pub(crate) const BLENDING: u8 = 8;
 pub(crate) const COLLAPSING: u8 = 16;
 /// Vertex flag: the node is its parent's first child (the one a pair is looked at from).
 pub(crate) const FIRST_CHILD: u8 = 32;
+/// Vertex flag: its answer (and, for a first child, its pair's) cannot change while the camera
+/// stays near the anchor frame's (see `steady`); cleared by anything that changes its family.
+pub(crate) const SETTLED: u8 = 64;
 
 /// Why the cut could not be set up.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -215,6 +222,8 @@ pub struct Cut<const V: usize, const F: usize, const Q: usize, I: SlotIndex = u1
     pub(crate) geomorph_frames: u16,
     /// The regulated error threshold; 0 before [`Cut::reset`] (which makes it 1).
     pub(crate) threshold: f32,
+    /// The anchor frame of the vertices marked `SETTLED`.
+    pub(crate) steady: Steady,
 }
 
 impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> fmt::Debug for Cut<V, F, Q, I> {
@@ -313,6 +322,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             coloring: Coloring::Node,
             geomorph_frames: 0,
             threshold: 0.0,
+            steady: Steady::ZERO,
         }
     }
 
@@ -407,6 +417,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         self.pairs.clear();
         self.blends.clear();
         self.threshold = 1.0;
+        self.steady.clear();
     }
 
     /// Active vertices.

@@ -11,7 +11,7 @@
 //! (across edges `t[k] -> t[k + 1]`) and its id in the hierarchy's numbering.
 
 use super::slot::{load3, store3, SlotIndex};
-use super::NIL;
+use super::{NIL, SETTLED};
 use crate::format::Digest;
 
 /// The vertex records.
@@ -83,10 +83,12 @@ impl<const V: usize, I: SlotIndex> Vertices<V, I> {
         self.mate.get(s).map_or(NIL, |m| m.load())
     }
 
+    /// Links slot `s` to its sibling's slot `m` (or `NIL`); the vertex is no longer settled.
     #[inline(always)]
     pub fn set_mate(&mut self, s: usize, m: u32) {
-        if let Some(x) = self.mate.get_mut(s) {
+        if let (Some(x), Some(f)) = (self.mate.get_mut(s), self.flags.get_mut(s)) {
             *x = I::store(m);
+            *f &= !SETTLED;
         }
     }
 

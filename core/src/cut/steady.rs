@@ -1,0 +1,198 @@
+//! Frame-to-frame coherence: which vertices a frame may skip because their answers cannot have
+//! changed since an anchor frame.
+//!
+//! A camera moves a little each frame, and most of a cut's answers do not change: a vertex far
+//! from wanting a split still wants none, a pair whose parent is well in view, facing the eye
+//! and far over the threshold is still wanted. When the policy describes how its demand depends
+//! on the view ([`Envelope`]), an anchor frame asks every vertex as usual and also measures each
+//! answer's margin: how far the eye (and the frustum's planes, over the model's bounding sphere)
+//! may move before the answer could change. A vertex or pair whose margin covers `STEPS` times
+//! the camera's last step is marked settled (the `SETTLED` flag); later frames skip settled
+//! vertices as long as the eye stays within that reach of the anchor's, the planes within that
+//! sway, and the policy's envelope and the threshold are unchanged. The first frame that leaves
+//! the reach anchors again. Skipping changes no decision: every skipped answer is proven the same
+//! as asking would give (with a relative slack far above float rounding), so frames are the
+//! same with or without it, only faster.
+//!
+//! Only without geomorphs (a blend ties a vertex's answer to its neighbours' order of asking)
+//! and for policies that do not judge triangles. Any operation that changes a vertex's family
+//! (its sibling link, its node, a pair's illegal mark) clears its mark.
+
+use crate::policy::{Bounds, Envelope, View};
+
+/// How many of the last frame's camera steps an anchor's margins must cover: the anchor holds
+/// for about this many frames of steady motion.
+const STEPS: f32 = 4.0;
+/// Relative slack on every margin, far above float rounding.
+const SLACK: f32 = 1e-4;
+
+#[inline]
+fn sub(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+#[inline]
+fn dot(a: [f32; 3], b: [f32; 3]) -> f32 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// A frustum's planes as `(n, d)` (left, right, bottom, top, near).
+type Planes = [[f32; 4]; 5];
+
+fn planes(view: &View) -> Planes {
+    core::array::from_fn(|i| view.plane(i).unwrap_or([0.0; 4]))
+}
+
+/// How far any point within `radius` of `center` moves relative to any plane between `a` and
+/// `b`: `max_i |n_a - n_b| radius + |(n_a - n_b) . center + d_a - d_b|`.
+fn sway(a: &Planes, b: &Planes, (center, radius): ([f32; 3], f32)) -> f32 {
+    let mut most = 0.0f32;
+    for (p, q) in a.iter().zip(b) {
+        let dn = [p[0] - q[0], p[1] - q[1], p[2] - q[2]];
+        let shift = libm::sqrtf(dot(dn, dn)) * radius + libm::fabsf(dot(dn, center) + p[3] - q[3]);
+        most = most.max(shift);
+    }
+    most
+}
+
+/// What a frame does with the settled vertices.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Mode {
+    /// Asks every vertex; the `SETTLED` flags mean nothing.
+    Off,
+    /// Asks every vertex and marks the settled ones.
+    Anchor,
+    /// Skips the settled vertices.
+    Skip,
+}
+
+/// The anchor frame and the margins its settled vertices have (see the module documentation).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Steady {
+    /// Whether an anchor was set since the cut was reset.
+    set: bool,
+    /// Whether the vertices' `SETTLED` flags were set against the anchor.
+    valid: bool,
+    /// Frames since the anchor.
+    frames: u32,
+    eye: [f32; 3],
+    planes: Planes,
+    envelope: Envelope,
+    threshold: f32,
+    /// How far the eye may move from the anchor's.
+    reach: f32,
+    /// How far the planes may move within the model's bounding sphere.
+    sway: f32,
+}
+
+impl Steady {
+    /// No anchor (all zeros).
+    pub const ZERO: Steady = Steady {
+        set: false,
+        valid: false,
+        frames: 0,
+        eye: [0.0; 3],
+        planes: [[0.0; 4]; 5],
+        envelope: Envelope::ZERO,
+        threshold: 0.0,
+        reach: 0.0,
+        sway: 0.0,
+    };
+
+    /// Starts a frame seen from `view` with threshold `t`: skips the settled vertices when the
+    /// anchor holds (same `envelope` and threshold, eye within the reach, planes within the
+    /// sway over the bounding sphere `model`), else anchors here when it can (`envelope` known
+    /// and `calm`: no geomorph), else asks everything.
+    pub fn begin(
+        &mut self,
+        view: &View,
+        envelope: Option<Envelope>,
+        t: f32,
+        calm: bool,
+        model: ([f32; 3], f32),
+    ) -> Mode {
+        self.frames = self.frames.saturating_add(1);
+        let Some(envelope) = envelope.filter(|_| calm) else {
+            self.valid = false;
+            return Mode::Off;
+        };
+        let now = planes(view);
+        let moved = sub(view.eye, self.eye);
+        let moved = libm::sqrtf(dot(moved, moved));
+        let swayed = sway(&self.planes, &now, model);
+        if self.valid
+            && envelope == self.envelope
+            && t == self.threshold
+            && moved <= self.reach
+            && (!envelope.frustum || swayed <= self.sway)
+        {
+            return Mode::Skip;
+        }
+        // The margins cover `STEPS` times the mean step since the last anchor.
+        let steps = STEPS / self.frames as f32;
+        let (reach, sway_) = if self.set {
+            (moved * steps, swayed * steps)
+        } else {
+            (0.0, 0.0)
+        };
+        *self = Steady {
+            set: true,
+            valid: reach.is_finite() && sway_.is_finite(),
+            frames: 0,
+            eye: view.eye,
+            planes: now,
+            envelope,
+            threshold: t,
+            reach,
+            sway: sway_,
+        };
+        Mode::Anchor
+    }
+
+    /// Forgets everything (a new hierarchy).
+    pub fn clear(&mut self) {
+        *self = Steady::ZERO;
+    }
+
+    /// Float slop on a distance `d` from the eye.
+    fn slop(&self, d: f32) -> f32 {
+        SLACK * (d + self.reach)
+    }
+
+    /// Whether a vertex whose bound is `s2 upper / d2` (at `d2` from the anchor's eye) stays at
+    /// most `t / slack` within the reach: `slack` is the cut's own margin on its bound.
+    pub fn stays_quiet(&self, s2_upper: f32, d2: f32, t: f32, slack: f32) -> bool {
+        let d = libm::sqrtf(d2);
+        let near = d - self.reach - self.slop(d);
+        near > 0.0 && s2_upper * slack * (1.0 + SLACK) <= t * near * near
+    }
+
+    /// Whether a parent with bounds `b` stays wanted within the reach and sway: seen (with
+    /// margin from every culling plane), facing the eye (with margin), and its error's lower
+    /// bound over `t * slack` at the farthest the eye can get.
+    pub fn stays_wanted(&self, b: &Bounds, view: &View, t: f32, slack: f32) -> bool {
+        let e = &self.envelope;
+        let r = sub(b.center, view.eye);
+        let d = libm::sqrtf(dot(r, r));
+        let slop = self.slop(d);
+        let seen = !e.frustum
+            || self.planes.iter().all(|p| {
+                p[0] * b.center[0] + p[1] * b.center[1] + p[2] * b.center[2] + p[3] + b.radius
+                    >= self.sway * (1.0 + SLACK) + slop + SLACK * libm::fabsf(p[3])
+            });
+        let rn = dot(r, b.axis);
+        // Not facing away (`s <= 0` or `s^2 <= d2 cone_sin^2`, `s = rn - radius`) wherever the
+        // eye gets: `s` grows by at most the reach, `d` shrinks by at most the reach.
+        let s = rn - b.radius + self.reach + slop;
+        let facing = !e.back_face || s <= ((d - self.reach - slop) * b.cone_sin).max(0.0);
+        // The error's lower bound where the eye is farthest from the centre and nearest the
+        // axis: `max(b2 d2, a2 p2) lower / d2^2`.
+        let far = d + self.reach + slop;
+        let p = libm::sqrtf((d * d - rn * rn).max(0.0)) - self.reach - slop;
+        // Less what rounding can take from the policy's own sum (which cancels when the eye is
+        // near the axis): far below this share of its largest term.
+        let floor = (b.b2 * far * far).max(b.a2 * p.max(0.0) * p.max(0.0))
+            - SLACK * b.a2.max(b.b2) * far * far;
+        seen && facing && floor * e.lower > t * slack * (1.0 + SLACK) * far * far * far * far
+    }
+}
