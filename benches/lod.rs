@@ -22,8 +22,14 @@
 //!    interleaved (QRefine, importance, QRefine): median microseconds, mean triangles, and the
 //!    time per triangle as a ratio.
 //!
-//! Run: `../shared/peers/run.sh` once (builds the peers), then `cargo bench --bench lod`
-//! (`-- adaptation`, `-- quality`, `-- full` or `-- policies` for one section).
+//! 6. **Hoppe's SrMesh** (`srmesh_orbit` from `../shared/peers/hoppe/run.sh`, when built), the
+//!    same orbit and policy: ours before and after SrMesh's runs over a finer tolerance grid,
+//!    and the speed-up at equal triangle counts (SrMesh's time interpolated log-log at ours),
+//!    steady frames and the first frame.
+//!
+//! Run: `../shared/peers/run.sh` and `../shared/peers/hoppe/run.sh` once (they build the peers),
+//! then `cargo bench --bench lod` (`-- adaptation`, `-- quality`, `-- full`, `-- policies` or
+//! `-- srmesh` for one section).
 
 use std::path::PathBuf;
 use std::process::Command;
@@ -203,6 +209,149 @@ fn adaptation(h: &HierarchyView<'_>, mesh: &IndexedMesh) {
             .collect::<Vec<_>>()
             .join(", ")
     );
+}
+
+/// One tolerance of Hoppe's SrMesh: tolerance, median us, mean triangles, operations per frame,
+/// first-frame us and triangles.
+#[derive(Clone, Copy, Debug)]
+struct SrPeer {
+    tol: f64,
+    us: f64,
+    tris: f64,
+    ops: f64,
+    first_us: f64,
+    first_tris: f64,
+}
+
+/// SrMesh's tolerances: a finer grid than ours, reaching below 0.25 px, so that each of our
+/// triangle counts falls between two of its own.
+const SR_TOLERANCES: [f32; 11] = [
+    0.125, 0.177, 0.25, 0.354, 0.5, 0.707, 1.0, 1.414, 2.0, 2.828, 4.0,
+];
+
+/// The `srmesh_adapt` lines of `srmesh_orbit` (`../shared/peers/hoppe/`, when built:
+/// `VDLOD_SRMESH` names its work folder, default `$TMPDIR/hoppe-srmesh`), one fresh process per
+/// tolerance.
+fn run_srmesh() -> Vec<SrPeer> {
+    let dir = std::env::var_os("VDLOD_SRMESH")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| std::env::temp_dir().join("hoppe-srmesh"));
+    let (bin, srm, off) = (
+        dir.join("build/bin/srmesh_orbit"),
+        dir.join("bunny.srm"),
+        dir.join("bunny00.off"),
+    );
+    if !bin.exists() || !srm.exists() || !off.exists() {
+        println!(
+            "(Hoppe's SrMesh not built in {}: run ../shared/peers/hoppe/run.sh for the SrMesh section)",
+            dir.display()
+        );
+        return Vec::new();
+    }
+    let mut peers = Vec::new();
+    for t in SR_TOLERANCES {
+        let Ok(out) = Command::new(&bin)
+            .arg(&srm)
+            .arg(&off)
+            .args(["--tau", &t.to_string(), "--revs", "2"])
+            .output()
+        else {
+            continue;
+        };
+        for l in String::from_utf8_lossy(&out.stdout).lines() {
+            if !l.starts_with("srmesh_adapt") {
+                continue;
+            }
+            let get = |k: &str| {
+                l.split_whitespace()
+                    .find_map(|kv| kv.strip_prefix(k)?.strip_prefix('='))
+                    .and_then(|v| v.parse::<f64>().ok())
+            };
+            if let (Some(tol), Some(us), Some(tris), Some(v), Some(e), Some(fu), Some(ft)) = (
+                get("tol_px"),
+                get("median_us"),
+                get("tris_mean"),
+                get("vsplits_per_frame"),
+                get("ecols_per_frame"),
+                get("first_us"),
+                get("first_faces"),
+            ) {
+                peers.push(SrPeer {
+                    tol,
+                    us,
+                    tris,
+                    ops: v + e,
+                    first_us: fu,
+                    first_tris: ft,
+                });
+            }
+        }
+    }
+    peers
+}
+
+/// `y` at `x` on the log-log polyline through `points` (sorted by `x`), or `None` outside it.
+fn log_log(points: &[(f64, f64)], x: f64) -> Option<f64> {
+    points.windows(2).find_map(|w| {
+        let ((x0, y0), (x1, y1)) = (w[0], w[1]);
+        (x0.min(x1) <= x && x <= x0.max(x1) && x0 != x1).then(|| {
+            let f = (x.ln() - x0.ln()) / (x1.ln() - x0.ln());
+            (y0.ln() + f * (y1.ln() - y0.ln())).exp()
+        })
+    })
+}
+
+/// Our cut beside Hoppe's SrMesh in the same run: per tolerance ours, then SrMesh's whole grid,
+/// then ours again; SrMesh's time at our triangle count interpolated log-log between its two
+/// nearest tolerances (steady frames and the first frame, refined from the base mesh).
+fn srmesh(h: &HierarchyView<'_>, mesh: &IndexedMesh) {
+    println!("\n## 6. Beside Hoppe's SrMesh, bunny, peer orbit (640x480, 60 deg, 200 frames)\n");
+    let before: Vec<Adapt> = TOLERANCES
+        .iter()
+        .map(|&t| adapt_orbit(h, mesh, t, 2))
+        .collect();
+    let peer = run_srmesh();
+    if peer.is_empty() {
+        return;
+    }
+    let after: Vec<Adapt> = TOLERANCES
+        .iter()
+        .map(|&t| adapt_orbit(h, mesh, t, 2))
+        .collect();
+    let mut steady: Vec<(f64, f64)> = peer.iter().map(|p| (p.tris, p.us)).collect();
+    steady.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut first: Vec<(f64, f64)> = peer.iter().map(|p| (p.first_tris, p.first_us)).collect();
+    first.sort_by(|a, b| a.0.total_cmp(&b.0));
+    println!(
+        "SrMesh over its own tolerances: {}\n",
+        peer.iter()
+            .map(|p| format!(
+                "{} px {:.0} us, {:.0} tris, {:.1} ops",
+                p.tol, p.us, p.tris, p.ops
+            ))
+            .collect::<Vec<_>>()
+            .join("; ")
+    );
+    println!("| tol px | our median us | our tris | ops/frame | SrMesh us at our tris | speed-up | our first frame | SrMesh first frame at our tris | speed-up |");
+    println!("|---|---|---|---|---|---|---|---|---|");
+    for (k, &t) in TOLERANCES.iter().enumerate() {
+        let (a, b) = (&before[k], &after[k]);
+        let us = median(a.us.iter().chain(&b.us).copied().collect());
+        let tris = mean(&[a.tris.clone(), b.tris.clone()].concat());
+        let ops = mean(&[a.ops.clone(), b.ops.clone()].concat());
+        let first_us = a.first_us.min(b.first_us);
+        let cell = |v: Option<f64>, ours: f64| {
+            v.map_or(("-".to_string(), "-".to_string()), |v| {
+                (format!("{v:.0}"), format!("{:.2}x", v / ours))
+            })
+        };
+        let (sr, up) = cell(log_log(&steady, tris), us);
+        let (sr_first, up_first) = cell(log_log(&first, a.first_tris as f64), first_us);
+        println!(
+            "| {t} | {us:.1} | {tris:.0} | {ops:.1} | {sr} | {up} | {first_us:.0} us, {} tris | {sr_first} | {up_first} |",
+            a.first_tris
+        );
+    }
 }
 
 fn policies(h: &HierarchyView<'_>, mesh: &IndexedMesh) {
@@ -413,6 +562,9 @@ fn main() {
         }
         if wanted("policies") {
             policies(&h, &mesh);
+        }
+        if wanted("srmesh") {
+            srmesh(&h, &mesh);
         }
     }
 }
