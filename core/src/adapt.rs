@@ -203,6 +203,12 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         self.geomorph_frames = frames;
     }
 
+    /// Whether frames skip the vertices whose answers cannot have changed since an anchor frame
+    /// (on by default). The frames are the same either way; only their time differs.
+    pub fn set_settling(&mut self, on: bool) {
+        self.steady.set_on(on);
+    }
+
     /// The regulated error threshold (1 after [`Cut::reset`] unless
     /// [`Budget::target_triangles`] moved it).
     #[must_use]
@@ -293,7 +299,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         // them anew (see `crate::cut::steady`).
         let mode = self
             .steady
-            .begin(view, envelope, t, calm, h.bounding_sphere());
+            .begin(view, envelope, t, blends, h.bounding_sphere());
         let (skip, anchor) = (mode == Mode::Skip, mode == Mode::Anchor);
         // Batch lists, built without branches (each item is written, and counted when it
         // belongs): the vertices still to decide, those of them the bound could not decide
@@ -339,7 +345,14 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 let visible = blends && view.sphere_visible(center, radius);
                 let mut next_flags = if done { seen(flags, visible) } else { flags };
                 if anchor {
-                    quiet[n] = wants_none && self.steady.stays_quiet(s * s * upper, d2, t, SLACK);
+                    // Wants no split wherever the eye gets; with geomorphs also seen (or not)
+                    // wherever the frustum gets, as in the frame before, since that flag
+                    // decides whether a change blends.
+                    quiet[n] = wants_none
+                        && self.steady.stays_quiet(s * s * upper, d2, t, SLACK)
+                        && (!blends
+                            || (self.steady.stays_visible(center, radius, d2) == Some(visible)
+                                && (flags & VISIBLE != 0) == visible));
                     next_flags &= !SETTLED;
                     if done && quiet[n] {
                         next_flags |= SETTLED;
@@ -385,7 +398,13 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 np += judges as usize;
                 // A first child whose pair is marked illegal settles on its own answer (a
                 // collapse that clears the mark clears this one too).
-                if anchor && quiet[k] && !judges {
+                if anchor
+                    && quiet[k]
+                    && !judges
+                    && (flags & FIRST_CHILD != 0)
+                    && (m != NIL)
+                    && flags & (BLENDING | COLLAPSING) == 0
+                {
                     self.v.flags[i] |= SETTLED;
                 }
             }

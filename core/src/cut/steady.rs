@@ -14,8 +14,9 @@
 //! as asking would give (with a relative slack far above float rounding), so frames are the
 //! same with or without it, only faster.
 //!
-//! Only without geomorphs (a blend ties a vertex's answer to its neighbours' order of asking)
-//! and for policies that do not judge triangles. Any operation that changes a vertex's family
+//! With geomorphs a vertex settles only when it is in no blend and whether it is seen (which
+//! decides whether a change around it blends) provably stays what it was in the frame before.
+//! Only for policies that do not judge triangles. Any operation that changes a vertex's family
 //! (its sibling link, its node, a pair's illegal mark) clears its mark.
 
 use crate::policy::{Bounds, Envelope, View};
@@ -71,10 +72,14 @@ pub(crate) enum Mode {
 pub(crate) struct Steady {
     /// Whether an anchor was set since the cut was reset.
     set: bool,
+    /// Never skip (see `Cut::set_settling`).
+    off: bool,
     /// Whether the vertices' `SETTLED` flags were set against the anchor.
     valid: bool,
     /// Frames since the anchor.
     frames: u32,
+    /// Whether geomorphs were on at the anchor (settling then also proved visibility).
+    blends: bool,
     eye: [f32; 3],
     planes: Planes,
     envelope: Envelope,
@@ -89,8 +94,10 @@ impl Steady {
     /// No anchor (all zeros).
     pub const ZERO: Steady = Steady {
         set: false,
+        off: false,
         valid: false,
         frames: 0,
+        blends: false,
         eye: [0.0; 3],
         planes: [[0.0; 4]; 5],
         envelope: Envelope::ZERO,
@@ -100,19 +107,19 @@ impl Steady {
     };
 
     /// Starts a frame seen from `view` with threshold `t`: skips the settled vertices when the
-    /// anchor holds (same `envelope` and threshold, eye within the reach, planes within the
-    /// sway over the bounding sphere `model`), else anchors here when it can (`envelope` known
-    /// and `calm`: no geomorph), else asks everything.
+    /// anchor holds (same `envelope`, threshold and geomorphs on or off, eye within the reach,
+    /// planes within the sway over the bounding sphere `model`), else anchors here when it can
+    /// (`envelope` known), else asks everything.
     pub fn begin(
         &mut self,
         view: &View,
         envelope: Option<Envelope>,
         t: f32,
-        calm: bool,
+        blends: bool,
         model: ([f32; 3], f32),
     ) -> Mode {
         self.frames = self.frames.saturating_add(1);
-        let Some(envelope) = envelope.filter(|_| calm) else {
+        let Some(envelope) = envelope.filter(|_| !self.off) else {
             self.valid = false;
             return Mode::Off;
         };
@@ -123,6 +130,7 @@ impl Steady {
         if self.valid
             && envelope == self.envelope
             && t == self.threshold
+            && blends == self.blends
             && moved <= self.reach
             && (!envelope.frustum || swayed <= self.sway)
         {
@@ -137,8 +145,10 @@ impl Steady {
         };
         *self = Steady {
             set: true,
+            off: false,
             valid: reach.is_finite() && sway_.is_finite(),
             frames: 0,
+            blends,
             eye: view.eye,
             planes: now,
             envelope,
@@ -149,9 +159,18 @@ impl Steady {
         Mode::Anchor
     }
 
-    /// Forgets everything (a new hierarchy).
+    /// Forgets everything but whether it is on (a new hierarchy).
     pub fn clear(&mut self) {
-        *self = Steady::ZERO;
+        *self = Steady {
+            off: self.off,
+            ..Steady::ZERO
+        };
+    }
+
+    /// Turns skipping on or off (it starts on).
+    pub fn set_on(&mut self, on: bool) {
+        self.off = !on;
+        self.valid = false;
     }
 
     /// Float slop on a distance `d` from the eye.
@@ -165,6 +184,26 @@ impl Steady {
         let d = libm::sqrtf(d2);
         let near = d - self.reach - self.slop(d);
         near > 0.0 && s2_upper * slack * (1.0 + SLACK) <= t * near * near
+    }
+
+    /// Whether a sphere at `center` (`d2` from the anchor's eye) of `radius` provably stays in
+    /// the frustum (`Some(true)`) or out of it (`Some(false)`) within the sway.
+    pub fn stays_visible(&self, center: [f32; 3], radius: f32, d2: f32) -> Option<bool> {
+        let margin = self.sway * (1.0 + SLACK) + self.slop(libm::sqrtf(d2));
+        let (mut inside, mut outside) = (true, false);
+        for p in &self.planes {
+            let dist = p[0] * center[0] + p[1] * center[1] + p[2] * center[2] + p[3] + radius;
+            let slop = margin + SLACK * libm::fabsf(p[3]);
+            inside &= dist >= slop;
+            outside |= dist < -slop;
+        }
+        if inside {
+            Some(true)
+        } else if outside {
+            Some(false)
+        } else {
+            None
+        }
     }
 
     /// Whether a parent with bounds `b` stays wanted within the reach and sway: seen (with
