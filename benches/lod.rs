@@ -27,9 +27,11 @@
 //!    and the speed-up at equal triangle counts (SrMesh's time interpolated log-log at ours),
 //!    steady frames and the first frame.
 //!
+//! 7. **Settled vertices** skipped or asked (`Cut::set_settling`), without and with geomorphs.
+//!
 //! Run: `../shared/peers/run.sh` and `../shared/peers/hoppe/run.sh` once (they build the peers),
 //! then `cargo bench --bench lod` (`-- adaptation`, `-- quality`, `-- full`, `-- policies` or
-//! `-- srmesh` for one section).
+//! `-- srmesh`, `-- settling` for one section).
 
 use std::path::PathBuf;
 use std::process::Command;
@@ -75,6 +77,8 @@ struct Adapt {
     us: Vec<f64>,
     tris: Vec<f64>,
     ops: Vec<f64>,
+    /// Share of the active vertices skipped as settled.
+    settled: Vec<f64>,
 }
 
 fn adapt_orbit(
@@ -92,9 +96,23 @@ fn adapt_orbit_with(
     policy: &impl Policy,
     revolutions: u32,
 ) -> Adapt {
+    adapt_orbit_set(h, mesh, policy, revolutions, 0, true)
+}
+
+/// [`adapt_orbit_with`] with geomorphs over `geomorph` frames and settled vertices skipped or not.
+fn adapt_orbit_set(
+    h: &HierarchyView<'_>,
+    mesh: &IndexedMesh,
+    policy: &impl Policy,
+    revolutions: u32,
+    geomorph: u16,
+    settling: bool,
+) -> Adapt {
     let orbit = peer_orbit(&mesh.bounds(), FRAMES, W, H);
     let mut cut = BunnyCut::boxed();
     cut.reset(h).expect("base mesh fits");
+    cut.set_geomorph_frames(geomorph);
+    cut.set_settling(settling);
     let mut out = Adapt::default();
     for i in 0..FRAMES * revolutions {
         let view = orbit.camera(i).view();
@@ -108,6 +126,8 @@ fn adapt_orbit_with(
             out.us.push(us);
             out.tris.push(s.triangles as f64);
             out.ops.push((s.vsplits + s.ecols) as f64);
+            out.settled
+                .push(s.settled as f64 / s.vertices.max(1) as f64);
         }
     }
     out
@@ -354,6 +374,34 @@ fn srmesh(h: &HierarchyView<'_>, mesh: &IndexedMesh) {
     }
 }
 
+/// Settled vertices skipped or not ([`Cut::set_settling`]), without and with 4-frame geomorphs:
+/// the same cuts, interleaved (on, off, on, off), medians of both runs of each.
+fn settling(h: &HierarchyView<'_>, mesh: &IndexedMesh) {
+    println!("\n## 7. Settled vertices skipped or asked, bunny, peer orbit (640x480, 60 deg, 200 frames)\n");
+    println!("| tol px | geomorphs | skipped: median us | asked: median us | ratio | share of vertices skipped |");
+    println!("|---|---|---|---|---|---|");
+    for geomorph in [0u16, 4] {
+        for &t in &TOLERANCES {
+            let policy = QRefine::new(t);
+            let mut on = Vec::new();
+            let mut off = Vec::new();
+            let mut share = Vec::new();
+            for _ in 0..2 {
+                let a = adapt_orbit_set(h, mesh, &policy, 1, geomorph, true);
+                share.extend(a.settled.iter().copied());
+                on.extend(a.us);
+                off.extend(adapt_orbit_set(h, mesh, &policy, 1, geomorph, false).us);
+            }
+            let (on, off) = (median(on), median(off));
+            println!(
+                "| {t} | {geomorph} frames | {on:.1} | {off:.1} | {:.2}x | {:.0}% |",
+                on / off,
+                100.0 * mean(&share)
+            );
+        }
+    }
+}
+
 fn policies(h: &HierarchyView<'_>, mesh: &IndexedMesh) {
     println!("\n## 5. Policies, bunny, peer orbit (640x480, 60 deg, 200 frames)\n");
     let screen = QRefine::new(0.3);
@@ -565,6 +613,9 @@ fn main() {
         }
         if wanted("srmesh") {
             srmesh(&h, &mesh);
+        }
+        if wanted("settling") {
+            settling(&h, &mesh);
         }
     }
 }
