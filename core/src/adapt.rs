@@ -253,7 +253,23 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         // A cut that shrank gets a smaller node map (faster lookups).
         self.respan_map(self.v.len());
         let triangles = self.t.len() as u32;
-        self.threshold = budget.regulate(self.threshold, triangles);
+        // Regulated on the triangles the cut will have once its running collapses arrive (about
+        // one fewer per collapsing vertex), and raised at most once per geomorph: coarsening
+        // lands a level per blend, so raising every frame while it lands ran far past the target.
+        let collapsing = self
+            .blends
+            .as_slice()
+            .iter()
+            .filter(|b| b.collapsing)
+            .count() as u32;
+        let next = budget.regulate(self.threshold, triangles.saturating_sub(collapsing));
+        self.raise_wait = self.raise_wait.saturating_sub(1);
+        if next <= self.threshold || self.raise_wait == 0 {
+            if next > self.threshold {
+                self.raise_wait = self.geomorph_frames.min(u8::MAX as u16) as u8;
+            }
+            self.threshold = next;
+        }
         let mut stats = frame.stats;
         stats.triangles = triangles;
         stats.vertices = self.v.len() as u32;
@@ -301,6 +317,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             .steady
             .begin(view, envelope, t, blends, h.bounding_sphere());
         let (skip, anchor) = (mode == Mode::Skip, mode == Mode::Anchor);
+        let quiet_terms = self.steady.quiet(upper, t, SLACK, h.bounding_sphere());
         // Batch lists, built without branches (each item is written, and counted when it
         // belongs): the vertices still to decide, those of them the bound could not decide
         // ("slow"), and those that judge a pair (by place in the first list).
@@ -349,9 +366,10 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                     // wherever the frustum gets, as in the frame before, since that flag
                     // decides whether a change blends.
                     quiet[n] = wants_none
-                        && self.steady.stays_quiet(s * s * upper, d2, t, SLACK)
+                        && self.steady.stays_quiet(&quiet_terms, s, d2)
                         && (!blends
-                            || (self.steady.stays_visible(center, radius, d2) == Some(visible)
+                            || (self.steady.stays_visible(&quiet_terms, center, radius)
+                                == Some(visible)
                                 && (flags & VISIBLE != 0) == visible));
                     next_flags &= !SETTLED;
                     if done && quiet[n] {
@@ -457,6 +475,13 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                     }
                 }
             }
+        }
+        if anchor {
+            let settled = self.v.flags[..self.v.len()]
+                .iter()
+                .filter(|&&f| f & SETTLED != 0)
+                .count();
+            self.steady.anchored(settled, self.v.len());
         }
     }
 

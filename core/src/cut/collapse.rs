@@ -132,15 +132,21 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         fans.overflow = false;
         for &f in fan_a.iter().chain(fan_b.iter()) {
             for v in self.t.at(f) {
-                if let Some(flags) = self.v.flags.get_mut(v as usize) {
-                    if *flags & BLOCKED != 0 {
-                        // The pair is judged again: no longer settled either.
-                        *flags &= !(BLOCKED | SETTLED);
-                        if v != a && v != b && fans.unblocked.push(self.v.node[v as usize]).is_err()
-                        {
-                            fans.overflow = true;
-                        }
-                    }
+                let Some(flags) = self.v.flags.get_mut(v as usize) else {
+                    continue;
+                };
+                if *flags & BLOCKED == 0 {
+                    continue;
+                }
+                // The pair is judged again (by its first child, which may be the sibling): no
+                // longer settled either.
+                *flags &= !(BLOCKED | SETTLED);
+                let m = self.v.mate(v as usize) as usize;
+                if let Some(mate) = self.v.flags.get_mut(m) {
+                    *mate &= !SETTLED;
+                }
+                if v != a && v != b && fans.unblocked.push(self.v.node[v as usize]).is_err() {
+                    fans.overflow = true;
                 }
             }
         }

@@ -220,6 +220,8 @@ pub struct Cut<const V: usize, const F: usize, const Q: usize, I: SlotIndex = u1
     pub(crate) blends: Arena<Blend, Q>,
     pub(crate) coloring: Coloring,
     pub(crate) geomorph_frames: u16,
+    /// Frames before regulation may raise the threshold again (see [`Cut::adapt`]).
+    pub(crate) raise_wait: u8,
     /// The regulated error threshold; 0 before [`Cut::reset`] (which makes it 1).
     pub(crate) threshold: f32,
     /// The anchor frame of the vertices marked `SETTLED`.
@@ -321,6 +323,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             blends: Arena::new(Blend::ZERO),
             coloring: Coloring::Node,
             geomorph_frames: 0,
+            raise_wait: 0,
             threshold: 0.0,
             steady: Steady::ZERO,
         }

@@ -56,6 +56,15 @@ fn sway(a: &Planes, b: &Planes, (center, radius): ([f32; 3], f32)) -> f32 {
     most
 }
 
+/// A frame's terms for [`Steady::stays_quiet`]: a vertex whose spheroid radius is at most `s`
+/// wants no split while it is at least `s scale` from the eye, and the eye stays within
+/// `margin` (the reach and float slop) of the anchor's.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Quiet {
+    scale: f32,
+    margin: f32,
+}
+
 /// What a frame does with the settled vertices.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum Mode {
@@ -77,7 +86,10 @@ pub(crate) struct Steady {
     /// Whether the vertices' `SETTLED` flags were set against the anchor.
     valid: bool,
     /// Frames since the anchor.
-    frames: u32,
+    frames: u16,
+    /// Frames left without anchoring: the last anchor settled too few vertices to pay for
+    /// itself (the camera moves too far per frame).
+    idle: u16,
     /// Whether geomorphs were on at the anchor (settling then also proved visibility).
     blends: bool,
     eye: [f32; 3],
@@ -97,6 +109,7 @@ impl Steady {
         off: false,
         valid: false,
         frames: 0,
+        idle: 0,
         blends: false,
         eye: [0.0; 3],
         planes: [[0.0; 4]; 5],
@@ -123,6 +136,11 @@ impl Steady {
             self.valid = false;
             return Mode::Off;
         };
+        if self.idle > 0 {
+            self.idle -= 1;
+            self.valid = false;
+            return Mode::Off;
+        }
         let now = planes(view);
         let moved = sub(view.eye, self.eye);
         let moved = libm::sqrtf(dot(moved, moved));
@@ -148,6 +166,7 @@ impl Steady {
             off: false,
             valid: reach.is_finite() && sway_.is_finite(),
             frames: 0,
+            idle: 0,
             blends,
             eye: view.eye,
             planes: now,
@@ -157,6 +176,15 @@ impl Steady {
             sway: sway_,
         };
         Mode::Anchor
+    }
+
+    /// After an anchor frame that settled `settled` of `vertices`: when that is under one in
+    /// eight, the next `2 STEPS` frames do not anchor (an anchor costs more than a plain frame,
+    /// and a camera that moves that far per frame leaves little to skip).
+    pub fn anchored(&mut self, settled: usize, vertices: usize) {
+        if settled * 8 < vertices {
+            self.idle = 2 * STEPS as u16;
+        }
     }
 
     /// Forgets everything but whether it is on (a new hierarchy).
@@ -178,18 +206,30 @@ impl Steady {
         SLACK * (d + self.reach)
     }
 
-    /// Whether a vertex whose bound is `s2 upper / d2` (at `d2` from the anchor's eye) stays at
-    /// most `t / slack` within the reach: `slack` is the cut's own margin on its bound.
-    pub fn stays_quiet(&self, s2_upper: f32, d2: f32, t: f32, slack: f32) -> bool {
-        let d = libm::sqrtf(d2);
-        let near = d - self.reach - self.slop(d);
-        near > 0.0 && s2_upper * slack * (1.0 + SLACK) <= t * near * near
+    /// Whether a vertex of spheroid radius `s`, at `d2` from the anchor's eye, keeps its bound
+    /// `s^2 upper / d^2` at most `t / slack` within the reach (`slack` the cut's own margin on
+    /// its bound): whether `d >= s sqrt(upper slack / t) + reach`, with float slop.
+    pub fn stays_quiet(&self, quiet: &Quiet, s: f32, d2: f32) -> bool {
+        let least = s * quiet.scale + quiet.margin;
+        d2 >= least * least
     }
 
-    /// Whether a sphere at `center` (`d2` from the anchor's eye) of `radius` provably stays in
-    /// the frustum (`Some(true)`) or out of it (`Some(false)`) within the sway.
-    pub fn stays_visible(&self, center: [f32; 3], radius: f32, d2: f32) -> Option<bool> {
-        let margin = self.sway * (1.0 + SLACK) + self.slop(libm::sqrtf(d2));
+    /// What [`Steady::stays_quiet`] needs of a frame with envelope scale `upper`, threshold `t`
+    /// and the cut's bound slack `slack`, with every node centre within the sphere `model`: one
+    /// square root per frame instead of one per vertex.
+    pub fn quiet(&self, upper: f32, t: f32, slack: f32, model: ([f32; 3], f32)) -> Quiet {
+        let to = sub(model.0, self.eye);
+        let farthest = libm::sqrtf(dot(to, to)) + model.1;
+        Quiet {
+            scale: libm::sqrtf(upper * slack * (1.0 + SLACK) / t),
+            margin: self.reach + self.slop(farthest),
+        }
+    }
+
+    /// Whether a sphere at `center` of `radius` provably stays in the frustum (`Some(true)`)
+    /// or out of it (`Some(false)`) within the sway.
+    pub fn stays_visible(&self, quiet: &Quiet, center: [f32; 3], radius: f32) -> Option<bool> {
+        let margin = self.sway * (1.0 + SLACK) + quiet.margin;
         let (mut inside, mut outside) = (true, false);
         for p in &self.planes {
             let dist = p[0] * center[0] + p[1] * center[1] + p[2] * center[2] + p[3] + radius;
