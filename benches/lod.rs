@@ -133,6 +133,23 @@ fn adapt_orbit_set(
     out
 }
 
+/// Two revolutions of the peer orbit at each of [`TOLERANCES`].
+fn every_tolerance(h: &HierarchyView<'_>, mesh: &IndexedMesh) -> Vec<Adapt> {
+    TOLERANCES
+        .iter()
+        .map(|&t| adapt_orbit(h, mesh, t, 2))
+        .collect()
+}
+
+/// The median microseconds, mean triangles and mean operations of two runs together.
+fn both(a: &Adapt, b: &Adapt) -> (f64, f64, f64) {
+    (
+        median(a.us.iter().chain(&b.us).copied().collect()),
+        mean(&[a.tris.clone(), b.tris.clone()].concat()),
+        mean(&[a.ops.clone(), b.ops.clone()].concat()),
+    )
+}
+
 /// One tolerance of OpenMesh's VDPM: tolerance, median us, mean triangles, operations per frame.
 type Peer = (f32, f64, f64, f64);
 
@@ -180,24 +197,16 @@ fn run_vdpm() -> Vec<Peer> {
 
 fn adaptation(h: &HierarchyView<'_>, mesh: &IndexedMesh) {
     println!("\n## 1. Adaptation per frame, bunny, peer orbit (640x480, 60 deg, 200 frames)\n");
-    let before: Vec<Adapt> = TOLERANCES
-        .iter()
-        .map(|&t| adapt_orbit(h, mesh, t, 2))
-        .collect();
+    let before = every_tolerance(h, mesh);
     let peer = run_vdpm();
-    let after: Vec<Adapt> = TOLERANCES
-        .iter()
-        .map(|&t| adapt_orbit(h, mesh, t, 2))
-        .collect();
+    let after = every_tolerance(h, mesh);
     println!(
         "| tol px | first frame | median us | mean tris | ns/active vertex | ops/frame | VDPM median us | VDPM tris | VDPM ops/frame | speed-up, same tol | VDPM at nearest tris | speed-up, nearest tris |"
     );
     println!("|---|---|---|---|---|---|---|---|---|---|---|---|");
     for (k, &t) in TOLERANCES.iter().enumerate() {
         let (a, b) = (&before[k], &after[k]);
-        let us = median(a.us.iter().chain(&b.us).copied().collect());
-        let tris = mean(&[a.tris.clone(), b.tris.clone()].concat());
-        let ops = mean(&[a.ops.clone(), b.ops.clone()].concat());
+        let (us, tris, ops) = both(a, b);
         let per_vertex = us * 1e3 / (tris / 2.0);
         let same = peer.iter().find(|p| (p.0 - t).abs() < 1e-3);
         let nearest = peer
@@ -326,18 +335,12 @@ fn log_log(points: &[(f64, f64)], x: f64) -> Option<f64> {
 /// nearest tolerances (steady frames and the first frame, refined from the base mesh).
 fn srmesh(h: &HierarchyView<'_>, mesh: &IndexedMesh) {
     println!("\n## 6. Beside Hoppe's SrMesh, bunny, peer orbit (640x480, 60 deg, 200 frames)\n");
-    let before: Vec<Adapt> = TOLERANCES
-        .iter()
-        .map(|&t| adapt_orbit(h, mesh, t, 2))
-        .collect();
+    let before = every_tolerance(h, mesh);
     let peer = run_srmesh();
     if peer.is_empty() {
         return;
     }
-    let after: Vec<Adapt> = TOLERANCES
-        .iter()
-        .map(|&t| adapt_orbit(h, mesh, t, 2))
-        .collect();
+    let after = every_tolerance(h, mesh);
     let mut steady: Vec<(f64, f64)> = peer.iter().map(|p| (p.tris, p.us)).collect();
     steady.sort_by(|a, b| a.0.total_cmp(&b.0));
     let mut first: Vec<(f64, f64)> = peer.iter().map(|p| (p.first_tris, p.first_us)).collect();
@@ -356,9 +359,7 @@ fn srmesh(h: &HierarchyView<'_>, mesh: &IndexedMesh) {
     println!("|---|---|---|---|---|---|---|---|---|");
     for (k, &t) in TOLERANCES.iter().enumerate() {
         let (a, b) = (&before[k], &after[k]);
-        let us = median(a.us.iter().chain(&b.us).copied().collect());
-        let tris = mean(&[a.tris.clone(), b.tris.clone()].concat());
-        let ops = mean(&[a.ops.clone(), b.ops.clone()].concat());
+        let (us, tris, ops) = both(a, b);
         let first_us = a.first_us.min(b.first_us);
         let cell = |v: Option<f64>, ours: f64| {
             v.map_or(("-".to_string(), "-".to_string()), |v| {
