@@ -7,10 +7,13 @@
 //! on the view ([`Envelope`]), an anchor frame asks every vertex as usual and also measures each
 //! answer's margin: how far the eye (and the frustum's planes, over the model's bounding sphere)
 //! may move before the answer could change. A vertex or pair whose margin covers `STEPS` times
-//! the camera's last step is marked settled (the `SETTLED` flag); later frames skip settled
+//! the camera's mean step since the previous anchor is marked settled (the `SETTLED` flag);
+//! later frames skip settled
 //! vertices as long as the eye stays within that reach of the anchor's, the planes within that
 //! sway, and the policy's envelope and the threshold are unchanged. The first frame that leaves
-//! the reach anchors again. Skipping changes no decision: every skipped answer is proven the same
+//! the reach anchors again; after an anchor that settled under an eighth of the vertices (a
+//! camera that moves far each frame) the next `2 STEPS` frames do not anchor, since an anchor
+//! costs more than a plain frame. Skipping changes no decision: every skipped answer is proven the same
 //! as asking would give (with a relative slack far above float rounding), so frames are the
 //! same with or without it, only faster.
 //!
@@ -21,8 +24,8 @@
 
 use crate::policy::{Bounds, Envelope, View};
 
-/// How many of the last frame's camera steps an anchor's margins must cover: the anchor holds
-/// for about this many frames of steady motion.
+/// How many of the camera's mean steps since the previous anchor an anchor's margins must
+/// cover: the anchor holds for about this many frames of steady motion.
 const STEPS: f32 = 4.0;
 /// Relative slack on every margin, far above float rounding.
 const SLACK: f32 = 1e-4;
