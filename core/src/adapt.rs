@@ -72,7 +72,7 @@ use crate::cut::{
     VISIBLE, WAS_VISIBLE,
 };
 use crate::format::{HierarchyView, Record, NONE};
-use crate::policy::{Bounds, Demand, Policy, View};
+use crate::policy::{dot, sub, Bounds, Demand, Policy, View};
 
 /// Limits on one frame's cut.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -313,11 +313,11 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         let upper = envelope.map_or(f32::INFINITY, |e| e.upper);
         // Settled vertices are skipped while the anchor holds; otherwise an anchor frame marks
         // them anew (see `crate::cut::steady`).
-        let mode = self
-            .steady
-            .begin(view, envelope, t, blends, h.bounding_sphere());
-        let (skip, anchor) = (mode == Mode::Skip, mode == Mode::Anchor);
-        let quiet_terms = self.steady.quiet(upper, t, SLACK, h.bounding_sphere());
+        let model = h.bounding_sphere();
+        let mode = self.steady.begin(view, envelope, t, blends, model);
+        let skip = mode == Mode::Skip;
+        // On an anchor frame, the margins its settled vertices must have.
+        let anchor = (mode == Mode::Anchor).then(|| self.steady.margins(upper, t, SLACK, model));
         // Batch lists, built without branches (each item is written, and counted when it
         // belongs): the vertices still to decide, those of them the bound could not decide
         // ("slow"), and those that judge a pair (by place in the first list).
@@ -349,27 +349,22 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 let center = h.digest_center(digest);
                 let s = h.length(digest.spheroid);
                 let radius = h.length(digest.radius);
-                let r = [
-                    center[0] - view.eye[0],
-                    center[1] - view.eye[1],
-                    center[2] - view.eye[2],
-                ];
-                let d2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+                let r = sub(center, view.eye);
+                let d2 = dot(r, r);
                 let wants_none = s * s * upper * SLACK <= t * d2;
                 let alone = (flags & (BLENDING | COLLAPSING) == 0)
                     & ((self.v.mate(i) == NIL) | (calm & (flags & FIRST_CHILD == 0)));
                 let done = wants_none & alone;
                 let visible = blends && view.sphere_visible(center, radius);
                 let mut next_flags = if done { seen(flags, visible) } else { flags };
-                if anchor {
+                if let Some(m) = &anchor {
                     // Wants no split wherever the eye gets; with geomorphs also seen (or not)
                     // wherever the frustum gets, as in the frame before, since that flag
                     // decides whether a change blends.
                     quiet[n] = wants_none
-                        && self.steady.stays_quiet(&quiet_terms, s, d2)
+                        && self.steady.stays_quiet(m, s, d2)
                         && (!blends
-                            || (self.steady.stays_visible(&quiet_terms, center, radius)
-                                == Some(visible)
+                            || (self.steady.stays_visible(m, center, radius) == Some(visible)
                                 && (flags & VISIBLE != 0) == visible));
                     next_flags &= !SETTLED;
                     if done && quiet[n] {
@@ -415,8 +410,8 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 pairs[np] = k;
                 np += judges as usize;
                 // A first child whose pair is marked illegal settles on its own answer (a
-                // collapse that clears the mark clears this one too).
-                if anchor
+                // collapse that clears the mark on either child clears this one too).
+                if anchor.is_some()
                     && quiet[k]
                     && !judges
                     && (flags & FIRST_CHILD != 0)
@@ -442,9 +437,9 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             for &k in pairs {
                 parent_bounds[k] = h.bounds_at(records[k]);
             }
-            if anchor {
+            if let Some(m) = &anchor {
                 for &k in pairs {
-                    if quiet[k] && self.steady.stays_wanted(&parent_bounds[k], view, t, SLACK) {
+                    if quiet[k] && self.steady.stays_wanted(m, &parent_bounds[k], t, SLACK) {
                         self.v.flags[listed[k]] |= SETTLED;
                     }
                 }
@@ -476,7 +471,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 }
             }
         }
-        if anchor {
+        if anchor.is_some() {
             let settled = self.v.flags[..self.v.len()]
                 .iter()
                 .filter(|&&f| f & SETTLED != 0)

@@ -945,13 +945,11 @@ impl<'a> HierarchyView<'a> {
         }
         let k = (i - self.roots) / 2;
         let p = self.pair_parent(k);
-        // `parse` proved every stored parent below `nodes`, so no overflow.
-        let offset =
-            self.offsets[1] + p as usize * NODE_SIZE + k as usize * (PARENT_SIZE - NODE_SIZE);
+        // `parse` proved every stored parent below `nodes`.
         Some((
             p,
             Record {
-                offset,
+                offset: self.record_offset(p, k),
                 parent: true,
             },
         ))
@@ -1007,10 +1005,17 @@ impl<'a> HierarchyView<'a> {
                 parent: false,
             };
         }
-        // In range: `parse` proved the section inside the file, so no overflow.
-        let offset =
-            self.offsets[1] + i as usize * NODE_SIZE + rank as usize * (PARENT_SIZE - NODE_SIZE);
-        Record { offset, parent }
+        Record {
+            offset: self.record_offset(i, rank),
+            parent,
+        }
+    }
+
+    /// Where the record of node `i` (in range), with `rank` parents before it, starts: `parse`
+    /// proved the section inside the file, so this does not overflow.
+    #[inline(always)]
+    fn record_offset(&self, i: u32, rank: u32) -> usize {
+        self.offsets[1] + i as usize * NODE_SIZE + rank as usize * (PARENT_SIZE - NODE_SIZE)
     }
 
     /// The first byte of node `i`'s record (0 out of range): reading it brings the record into

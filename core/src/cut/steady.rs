@@ -20,25 +20,15 @@
 //! With geomorphs a vertex settles only when it is in no blend and whether it is seen (which
 //! decides whether a change around it blends) provably stays what it was in the frame before.
 //! Only for policies that do not judge triangles. Any operation that changes a vertex's family
-//! (its sibling link, its node, a pair's illegal mark) clears its mark.
+//! (its sibling link, its node, its pair's illegal mark on either child) clears its mark.
 
-use crate::policy::{Bounds, Envelope, View};
+use crate::policy::{dot, sub, Bounds, Envelope, View};
 
 /// How many of the camera's mean steps since the previous anchor an anchor's margins must
 /// cover: the anchor holds for about this many frames of steady motion.
 const STEPS: f32 = 4.0;
 /// Relative slack on every margin, far above float rounding.
 const SLACK: f32 = 1e-4;
-
-#[inline]
-fn sub(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-#[inline]
-fn dot(a: [f32; 3], b: [f32; 3]) -> f32 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
 
 /// A frustum's planes as `(n, d)` (left, right, bottom, top, near).
 type Planes = [[f32; 4]; 5];
@@ -59,13 +49,13 @@ fn sway(a: &Planes, b: &Planes, (center, radius): ([f32; 3], f32)) -> f32 {
     most
 }
 
-/// A frame's terms for [`Steady::stays_quiet`]: a vertex whose spheroid radius is at most `s`
-/// wants no split while it is at least `s scale` from the eye, and the eye stays within
-/// `margin` (the reach and float slop) of the anchor's.
+/// An anchor frame's terms for the `stays_*` tests, computed once per anchor: a vertex whose
+/// spheroid radius is at most `s` wants no split while it is at least `s scale` from the eye;
+/// `slop` covers float rounding on any distance from the eye to a node centre.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct Quiet {
+pub(crate) struct Margins {
     scale: f32,
-    margin: f32,
+    slop: f32,
 }
 
 /// What a frame does with the settled vertices.
@@ -204,35 +194,30 @@ impl Steady {
         self.valid = false;
     }
 
-    /// Float slop on a distance `d` from the eye.
-    fn slop(&self, d: f32) -> f32 {
-        SLACK * (d + self.reach)
+    /// The terms of this anchor frame, with envelope scale `upper`, threshold `t` and the cut's
+    /// bound slack `slack`, every node centre within the sphere `model`: the square roots once
+    /// per anchor instead of once per vertex.
+    pub fn margins(&self, upper: f32, t: f32, slack: f32, model: ([f32; 3], f32)) -> Margins {
+        let to = sub(model.0, self.eye);
+        let farthest = libm::sqrtf(dot(to, to)) + model.1;
+        Margins {
+            scale: libm::sqrtf(upper * slack * (1.0 + SLACK) / t),
+            slop: SLACK * (farthest + self.reach),
+        }
     }
 
     /// Whether a vertex of spheroid radius `s`, at `d2` from the anchor's eye, keeps its bound
     /// `s^2 upper / d^2` at most `t / slack` within the reach (`slack` the cut's own margin on
     /// its bound): whether `d >= s sqrt(upper slack / t) + reach`, with float slop.
-    pub fn stays_quiet(&self, quiet: &Quiet, s: f32, d2: f32) -> bool {
-        let least = s * quiet.scale + quiet.margin;
+    pub fn stays_quiet(&self, m: &Margins, s: f32, d2: f32) -> bool {
+        let least = s * m.scale + self.reach + m.slop;
         d2 >= least * least
-    }
-
-    /// What [`Steady::stays_quiet`] needs of a frame with envelope scale `upper`, threshold `t`
-    /// and the cut's bound slack `slack`, with every node centre within the sphere `model`: one
-    /// square root per frame instead of one per vertex.
-    pub fn quiet(&self, upper: f32, t: f32, slack: f32, model: ([f32; 3], f32)) -> Quiet {
-        let to = sub(model.0, self.eye);
-        let farthest = libm::sqrtf(dot(to, to)) + model.1;
-        Quiet {
-            scale: libm::sqrtf(upper * slack * (1.0 + SLACK) / t),
-            margin: self.reach + self.slop(farthest),
-        }
     }
 
     /// Whether a sphere at `center` of `radius` provably stays in the frustum (`Some(true)`)
     /// or out of it (`Some(false)`) within the sway.
-    pub fn stays_visible(&self, quiet: &Quiet, center: [f32; 3], radius: f32) -> Option<bool> {
-        let margin = self.sway * (1.0 + SLACK) + quiet.margin;
+    pub fn stays_visible(&self, m: &Margins, center: [f32; 3], radius: f32) -> Option<bool> {
+        let margin = self.sway * (1.0 + SLACK) + m.slop;
         let (mut inside, mut outside) = (true, false);
         for p in &self.planes {
             let dist = p[0] * center[0] + p[1] * center[1] + p[2] * center[2] + p[3] + radius;
@@ -252,29 +237,24 @@ impl Steady {
     /// Whether a parent with bounds `b` stays wanted within the reach and sway: seen (with
     /// margin from every culling plane), facing the eye (with margin), and its error's lower
     /// bound over `t * slack` at the farthest the eye can get.
-    pub fn stays_wanted(&self, b: &Bounds, view: &View, t: f32, slack: f32) -> bool {
+    pub fn stays_wanted(&self, m: &Margins, b: &Bounds, t: f32, slack: f32) -> bool {
         let e = &self.envelope;
-        let r = sub(b.center, view.eye);
+        let seen = !e.frustum || self.stays_visible(m, b.center, b.radius) == Some(true);
+        let r = sub(b.center, self.eye);
         let d = libm::sqrtf(dot(r, r));
-        let slop = self.slop(d);
-        let seen = !e.frustum
-            || self.planes.iter().all(|p| {
-                p[0] * b.center[0] + p[1] * b.center[1] + p[2] * b.center[2] + p[3] + b.radius
-                    >= self.sway * (1.0 + SLACK) + slop + SLACK * libm::fabsf(p[3])
-            });
         let rn = dot(r, b.axis);
+        let shift = self.reach + m.slop;
         // Not facing away (`s <= 0` or `s^2 <= d2 cone_sin^2`, `s = rn - radius`) wherever the
         // eye gets: `s` grows by at most the reach, `d` shrinks by at most the reach.
-        let s = rn - b.radius + self.reach + slop;
-        let facing = !e.back_face || s <= ((d - self.reach - slop) * b.cone_sin).max(0.0);
+        let s = rn - b.radius + shift;
+        let facing = !e.back_face || s <= ((d - shift) * b.cone_sin).max(0.0);
         // The error's lower bound where the eye is farthest from the centre and nearest the
         // axis: `max(b2 d2, a2 p2) lower / d2^2`.
-        let far = d + self.reach + slop;
-        let p = libm::sqrtf((d * d - rn * rn).max(0.0)) - self.reach - slop;
+        let far = d + shift;
+        let p = (libm::sqrtf((d * d - rn * rn).max(0.0)) - shift).max(0.0);
         // Less what rounding can take from the policy's own sum (which cancels when the eye is
         // near the axis): far below this share of its largest term.
-        let floor = (b.b2 * far * far).max(b.a2 * p.max(0.0) * p.max(0.0))
-            - SLACK * b.a2.max(b.b2) * far * far;
+        let floor = (b.b2 * far * far).max(b.a2 * p * p) - SLACK * b.a2.max(b.b2) * far * far;
         seen && facing && floor * e.lower > t * slack * (1.0 + SLACK) * far * far * far * far
     }
 }
