@@ -19,4 +19,6 @@ pub mod cut;
 pub mod format;
 mod nodemap;
 pub mod policy;
+#[cfg(feature = "build")]
+pub mod remesh;
 pub mod wavelet;

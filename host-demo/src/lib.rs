@@ -13,6 +13,7 @@ pub mod input;
 pub mod label;
 pub mod lod;
 pub mod mesh;
+pub mod remesh;
 pub mod render;
 pub mod repair;
 pub mod terrain;

@@ -139,6 +139,10 @@ enum Command {
     /// Subdivide a mesh into a semi-regular one for the wavelet engine: its triangles (or, with
     /// --base, a simplification of it to about that many faces) become the base mesh.
     Subdivide(SubdivideArgs),
+    /// Remesh any mesh into a semi-regular one for the wavelet engine: a simplification of it
+    /// to about --base faces, subdivided --levels times, every vertex on the input surface
+    /// through a bijective map of the base onto it; prints its distances to the input.
+    Remesh(RemeshArgs),
     /// Run one of the papers' experiments: pictures and CSV into OUT/NAME/, one `key=value`
     /// summary line per engine or setting.
     Reproduce(ReproduceArgs),
@@ -192,6 +196,26 @@ struct SubdivideArgs {
     /// Simplify the mesh to about this many faces first (0: use it as it is).
     #[arg(long, default_value_t = 0)]
     base: u32,
+    /// Output file (.vdw).
+    #[arg(long, short)]
+    out: PathBuf,
+    /// Also write the finest level as an OBJ file.
+    #[arg(long)]
+    obj: Option<PathBuf>,
+}
+
+#[derive(clap::Args)]
+struct RemeshArgs {
+    /// Mesh file (OBJ, OFF, PLY or STL).
+    mesh: PathBuf,
+    #[command(flatten)]
+    input: InputArgs,
+    /// Faces of the base mesh to aim for.
+    #[arg(long, default_value_t = 300)]
+    base: u32,
+    /// Subdivision levels.
+    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=8))]
+    levels: u32,
     /// Output file (.vdw).
     #[arg(long, short)]
     out: PathBuf,
@@ -936,6 +960,21 @@ fn subdivide(args: SubdivideArgs) -> Result<(), String> {
     write_semi_regular(&semi, &source, &args.out, args.obj.as_deref())
 }
 
+fn remesh_command(args: RemeshArgs) -> Result<(), String> {
+    let (source, mesh) = load(Some(&args.mesh), args.input)?;
+    let options = vdlod_core::remesh::RemeshOptions {
+        base_faces: args.base,
+        levels: args.levels,
+    };
+    let done = vdlod_demo::remesh::remesh_with_progress(&mesh, &options, true)
+        .map_err(|e| format!("{source}: {e}"))?;
+    say!(
+        "{source}: {}",
+        vdlod_demo::remesh::summary(&done, args.levels)
+    );
+    write_semi_regular(&done.remesh.mesh, &source, &args.out, args.obj.as_deref())
+}
+
 fn reproduce(args: ReproduceArgs) -> Result<(), String> {
     let (name, lines) = match args.name {
         Experiment::Fig11 => ("fig11", wavelet::fig11(&args.out.join("fig11"))?),
@@ -992,6 +1031,7 @@ fn main() -> ExitCode {
         Some(Command::Info { file }) => info(file),
         Some(Command::Sphere(args)) => sphere(args),
         Some(Command::Subdivide(args)) => subdivide(args),
+        Some(Command::Remesh(args)) => remesh_command(args),
         Some(Command::Reproduce(args)) => reproduce(args),
         None => orbit_command(OrbitArgs::default()),
     };

@@ -12,6 +12,7 @@ use alloc::vec::Vec;
 use core::cmp::Reverse;
 
 use super::closest::Surface;
+use super::flatten::{flatten, PlanarCollapse};
 use super::quadric::{place, Quadric};
 use super::vec3::{add, cross, dot, from_f32, len, normalize, scale, sub, Vec3d};
 use super::{BuildOptions, Cost, InputMesh, NONE};
@@ -57,6 +58,26 @@ pub(crate) struct Engine<'o> {
     pub collapses: Vec<Collapse>,
     /// The input surface, for [`Cost::Color`]'s `Gerr`.
     surface: Option<Surface>,
+    /// When set, every collapse's planar maps (for the remesher); an edge whose region has no
+    /// valid pair of maps is not collapsed.
+    pub planar: Option<Vec<PlanarCollapse>>,
+    /// Triangles the collapses may not make worse than this shape (`4 sqrt(3) area / sum of
+    /// squared edges`, 1 for equilateral), unless the region already had one as bad: 0 for the
+    /// hierarchy builder, where shape does not matter; the remesher's base faces need it.
+    pub min_shape: f64,
+}
+
+/// `4 sqrt(3) area / (sum of squared edge lengths)`: 1 for an equilateral triangle, 0 for a
+/// degenerate one.
+pub(crate) fn shape(t: [Vec3d; 3]) -> f64 {
+    let [a, b, c] = t;
+    let edges = [sub(b, a), sub(c, b), sub(a, c)];
+    let squares: f64 = edges.iter().map(|&e| dot(e, e)).sum();
+    if squares > 0.0 {
+        2.0 * libm::sqrt(3.0) * len(cross(edges[0], sub(c, a))) / squares
+    } else {
+        0.0
+    }
 }
 
 fn face_normal(p: &[Vec3d], f: [u32; 3]) -> Vec3d {
@@ -123,6 +144,8 @@ impl<'o> Engine<'o> {
             collapses: Vec::new(),
             surface: (opts.cost == Cost::Color)
                 .then(|| Surface::new(mesh.positions, mesh.triangles)),
+            planar: None,
+            min_shape: 0.0,
         };
         e.alive_count = e.alive.iter().filter(|&&a| a).count();
         // Boundary quadrics keep open borders in place.
@@ -303,7 +326,9 @@ impl<'o> Engine<'o> {
                 return Ok(false);
             }
         }
-        // No flipped or collapsed triangle.
+        // No flipped or collapsed triangle, and none worse shaped than `min_shape` allows.
+        let mut worst_before = f64::INFINITY;
+        let mut worst_after = f64::INFINITY;
         for &s in &[a, b] {
             for &f in &self.vfaces[s as usize] {
                 let t = self.faces[f as usize];
@@ -318,9 +343,13 @@ impl<'o> Engine<'o> {
                 if !kept {
                     return Ok(false);
                 }
+                if self.min_shape > 0.0 {
+                    worst_before = worst_before.min(shape(t.map(|i| self.pos[i as usize])));
+                    worst_after = worst_after.min(shape(moved));
+                }
             }
         }
-        Ok(true)
+        Ok(self.min_shape <= 0.0 || worst_after >= self.min_shape.min(worst_before))
     }
 
     /// Collapses the cheapest legal edge; `false` when none is left.
@@ -344,7 +373,8 @@ impl<'o> Engine<'o> {
                 continue;
             }
             let (v, _) = self.evaluate(a, b);
-            match self.legal(a, b, v) {
+            let legal = self.legal(a, b, v).map(|ok| ok && self.map_planar(a, b, v));
+            match legal {
                 Ok(true) => {
                     self.collapse(a, b, v);
                     return true;
@@ -355,6 +385,33 @@ impl<'o> Engine<'o> {
                 }
                 Err(()) => self.deferred.push((a, b)),
             }
+        }
+    }
+
+    /// With [`Engine::planar`] set, records the planar maps of collapsing `a-b` into `v`;
+    /// `false` when there are none (the edge is then illegal).
+    fn map_planar(&mut self, a: u32, b: u32, v: Vec3d) -> bool {
+        if self.planar.is_none() {
+            return true;
+        }
+        let mut ids: Vec<u32> = self.vfaces[a as usize]
+            .iter()
+            .chain(&self.vfaces[b as usize])
+            .copied()
+            .collect();
+        ids.sort_unstable();
+        ids.dedup();
+        let before = ids.iter().map(|&f| (f, self.faces[f as usize])).collect();
+        let pos = |x: u32| self.pos[x as usize];
+        let parent = self.pos.len() as u32;
+        match flatten(before, [a, b], parent, v, &pos) {
+            Some(map) => {
+                if let Some(list) = self.planar.as_mut() {
+                    list.push(map);
+                }
+                true
+            }
+            None => false,
         }
     }
 

@@ -39,11 +39,12 @@
 //! ```
 
 mod attributes;
-mod closest;
-mod collapse;
+pub(crate) mod closest;
+pub(crate) mod collapse;
+pub(crate) mod flatten;
 mod input;
 mod quadric;
-mod vec3;
+pub(crate) mod vec3;
 mod write;
 
 use alloc::vec::Vec;

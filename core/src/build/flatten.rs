@@ -1,0 +1,474 @@
+//! Planar maps of collapse regions, for the remesher's parameterization.
+//!
+//! Liu, Kim, Chen, Jacobson, Sharp and Aigerman ("Neural subdivision", 2020) parameterize a mesh
+//! over its own simplification by mapping, at every edge collapse, the collapsed edge's region
+//! (the triangles around either end) into the plane twice: before the collapse and after it,
+//! with the same boundary polygon. A point in a triangle of one map is then a point in a
+//! triangle of the other, and a chain of such maps carries any point of the coarse mesh down to
+//! the input surface, one collapse at a time (Lee, Sweldens, Schröder, Cowsar and Dobkin's MAPS,
+//! 1998, does the same per removed vertex with a conformal map of its star).
+//!
+//! [`flatten`] builds both maps. Where the region is nearly flat it projects it onto its mean
+//! plane (no distortion beyond the projection's); when that folds a triangle, it falls back to a
+//! map that cannot fold: the boundary on a convex polygon (a circle, spaced by the 3D lengths of
+//! its edges; a straight side for the border edge of an open mesh) and the inner vertices at
+//! Floater's mean-value combinations of their neighbours ("Mean value coordinates", 2003), which
+//! Tutte's theorem makes an embedding. Both maps are checked triangle by triangle before they are
+//! used; a region that admits no valid pair (never seen on manifold input, but possible on
+//! degenerate triangles) is reported as `None`, and the builder does not collapse that edge.
+
+use alloc::vec::Vec;
+
+use super::vec3::{cross, dot, len, normalize, sub, Vec3d};
+
+/// A point of a planar map.
+pub type Uv = [f64; 2];
+
+/// One collapse's two planar maps, sharing the boundary: every vertex of the region before the
+/// collapse (the children and the ring) and the parent after it, each at one point.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlanarCollapse {
+    /// The vertex the collapse made.
+    pub parent: u32,
+    /// The merged vertices.
+    pub children: [u32; 2],
+    /// The region before the collapse: (face id, corners), counter-clockwise.
+    pub before: Vec<(u32, [u32; 3])>,
+    /// Each vertex of the region (the parent included) with its point, sorted by vertex.
+    pub uv: Vec<(u32, Uv)>,
+}
+
+impl PlanarCollapse {
+    /// The point of vertex `v`, if it is in the region.
+    pub fn uv_of(&self, v: u32) -> Option<Uv> {
+        let k = self.uv.binary_search_by_key(&v, |&(x, _)| x).ok()?;
+        Some(self.uv[k].1)
+    }
+
+    /// The region after the collapse: the faces that were not on the collapsed edge, with the
+    /// children renamed to the parent.
+    pub fn after(&self) -> impl Iterator<Item = (u32, [u32; 3])> + '_ {
+        let [a, b] = self.children;
+        self.before
+            .iter()
+            .filter(move |(_, t)| !(t.contains(&a) && t.contains(&b)))
+            .map(move |&(f, t)| (f, t.map(|x| if x == a || x == b { self.parent } else { x })))
+    }
+}
+
+/// Twice the signed area of the planar triangle `a b c`.
+pub fn area2(a: Uv, b: Uv, c: Uv) -> f64 {
+    (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+}
+
+/// Barycentric weights of `q` in the planar triangle `t` (`None` when it is degenerate).
+pub fn barycentric(t: [Uv; 3], q: Uv) -> Option<[f64; 3]> {
+    let d = area2(t[0], t[1], t[2]);
+    if d.abs() <= 0.0 || !d.is_finite() {
+        return None;
+    }
+    let w1 = area2(t[0], q, t[2]) / d;
+    let w2 = area2(t[0], t[1], q) / d;
+    Some([1.0 - w1 - w2, w1, w2])
+}
+
+/// The region's boundary as one counter-clockwise loop, or `None` when it is not a disk.
+fn boundary_loop(faces: &[[u32; 3]]) -> Option<Vec<u32>> {
+    let edges: Vec<(u32, u32)> = faces
+        .iter()
+        .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
+        .collect();
+    let outer: Vec<(u32, u32)> = edges
+        .iter()
+        .copied()
+        .filter(|&(x, y)| !edges.contains(&(y, x)))
+        .collect();
+    let first = outer.first()?;
+    let mut ring = Vec::with_capacity(outer.len());
+    let mut at = first.0;
+    for _ in 0..outer.len() {
+        ring.push(at);
+        let from = at;
+        let mut next = outer.iter().filter(|&&(x, _)| x == from);
+        at = next.next()?.1;
+        if next.next().is_some() {
+            return None; // the boundary touches itself
+        }
+    }
+    (at == first.0 && ring.len() >= 3).then_some(ring)
+}
+
+/// Whether every triangle of both maps is counter-clockwise with a useful area, and the
+/// boundary polygon is simple (with all triangles positive, a disk's map is then an embedding).
+fn valid(collapse: &PlanarCollapse, ring: &[u32]) -> bool {
+    let Some(pts) = ring
+        .iter()
+        .map(|&v| collapse.uv_of(v))
+        .collect::<Option<Vec<Uv>>>()
+    else {
+        return false;
+    };
+    let mut lo = [f64::INFINITY; 2];
+    let mut hi = [f64::NEG_INFINITY; 2];
+    for p in &pts {
+        for k in 0..2 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    let size = (hi[0] - lo[0]).max(hi[1] - lo[1]);
+    if !(size > 0.0 && size.is_finite()) {
+        return false;
+    }
+    let least = 1e-9 * size * size;
+    let positive = |(_, t): (u32, [u32; 3])| match t.map(|v| collapse.uv_of(v)) {
+        [Some(a), Some(b), Some(c)] => area2(a, b, c) > least,
+        _ => false,
+    };
+    let faces_ok = collapse.before.iter().copied().all(positive) && collapse.after().all(positive);
+    // Same boundary, positive triangles and the same area: both maps tile the same polygon.
+    let area = |t: [u32; 3]| match t.map(|v| collapse.uv_of(v)) {
+        [Some(a), Some(b), Some(c)] => area2(a, b, c),
+        _ => f64::NAN,
+    };
+    let before: f64 = collapse.before.iter().map(|&(_, t)| area(t)).sum();
+    let after: f64 = collapse.after().map(|(_, t)| area(t)).sum();
+    faces_ok && (before - after).abs() <= 1e-9 * before.abs() && simple(&pts)
+}
+
+/// Whether the closed polygon `p` has no two non-adjacent edges that touch.
+fn simple(p: &[Uv]) -> bool {
+    let n = p.len();
+    // Whether `q`, on the line through `a b`, lies within the segment.
+    let within =
+        |a: Uv, b: Uv, q: Uv| (0..2).all(|k| q[k] >= a[k].min(b[k]) && q[k] <= a[k].max(b[k]));
+    for i in 0..n {
+        let (a, b) = (p[i], p[(i + 1) % n]);
+        for j in i + 2..n {
+            if (j + 1) % n == i {
+                continue;
+            }
+            let (c, d) = (p[j], p[(j + 1) % n]);
+            let (d1, d2) = (area2(a, b, c), area2(a, b, d));
+            let (d3, d4) = (area2(c, d, a), area2(c, d, b));
+            let proper = d1 * d2 < 0.0 && d3 * d4 < 0.0;
+            let touching = (d1 == 0.0 && within(a, b, c))
+                || (d2 == 0.0 && within(a, b, d))
+                || (d3 == 0.0 && within(c, d, a))
+                || (d4 == 0.0 && within(c, d, b));
+            if proper || touching {
+                return false;
+            }
+        }
+    }
+    true
+}
+
+/// `tan(theta / 2)` of the angle between `u` and `w`.
+fn half_tan(u: Vec3d, w: Vec3d) -> f64 {
+    let s = len(cross(u, w));
+    let c = len(u) * len(w) + dot(u, w);
+    if c > 0.0 {
+        s / c
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// Floater's mean-value weights of vertex `v` (at `at`) over its neighbours in `faces`.
+fn mean_value(
+    v: u32,
+    at: Vec3d,
+    faces: &[[u32; 3]],
+    pos: &dyn Fn(u32) -> Vec3d,
+) -> Vec<(u32, f64)> {
+    let mut w: Vec<(u32, f64)> = Vec::new();
+    for t in faces {
+        let Some(k) = t.iter().position(|&x| x == v) else {
+            continue;
+        };
+        let (j, l) = (t[(k + 1) % 3], t[(k + 2) % 3]);
+        let (dj, dl) = (sub(pos(j), at), sub(pos(l), at));
+        let h = half_tan(dj, dl);
+        for (x, d) in [(j, dj), (l, dl)] {
+            let add = h / len(d);
+            match w.iter_mut().find(|(y, _)| *y == x) {
+                Some(e) => e.1 += add,
+                None => w.push((x, add)),
+            }
+        }
+    }
+    w
+}
+
+/// Both maps of the collapse of `a-b` into `parent` (at `at`): `before` is every face around
+/// `a` or `b` as (face id, corners), `pos` the 3D position of any other vertex. `None` when the
+/// region is not a disk or no valid pair of maps was found.
+pub fn flatten(
+    before: Vec<(u32, [u32; 3])>,
+    [a, b]: [u32; 2],
+    parent: u32,
+    at: Vec3d,
+    pos: &dyn Fn(u32) -> Vec3d,
+) -> Option<PlanarCollapse> {
+    let faces: Vec<[u32; 3]> = before.iter().map(|&(_, t)| t).collect();
+    let ring = boundary_loop(&faces)?;
+    let on_ring = |v: u32| ring.iter().position(|&x| x == v);
+    let inner_ok = faces
+        .iter()
+        .flatten()
+        .all(|&v| v == a || v == b || on_ring(v).is_some());
+    if !inner_ok {
+        return None;
+    }
+    let mut collapse = PlanarCollapse {
+        parent,
+        children: [a, b],
+        before,
+        uv: Vec::new(),
+    };
+    // The projection cannot keep the polygon when both ends are on it (the parent would have
+    // to lie on a straight line through them): that case always takes the convex map.
+    let border_edge = on_ring(a).is_some() && on_ring(b).is_some();
+    let maps = [
+        (!border_edge)
+            .then(|| projected(&faces, &ring, [a, b], at, pos))
+            .flatten(),
+        convex(&faces, &ring, [a, b], at, pos),
+    ];
+    for uv in maps.into_iter().flatten() {
+        // The parent was pushed as u32::MAX; it is the newest vertex, so under its own id the
+        // list stays sorted.
+        collapse.uv = uv
+            .into_iter()
+            .map(|(v, p)| (if v == u32::MAX { parent } else { v }, p))
+            .collect();
+        collapse.uv.sort_by_key(|&(v, _)| v);
+        if valid(&collapse, &ring) {
+            return Some(collapse);
+        }
+    }
+    None
+}
+
+/// Every point sorted by vertex, with the parent's.
+fn finish(mut uv: Vec<(u32, Uv)>) -> Vec<(u32, Uv)> {
+    uv.sort_by_key(|&(v, _)| v);
+    uv.dedup_by_key(|&mut (v, _)| v);
+    uv
+}
+
+/// The parent's point where the boundary fixes it: on a border, where the collapse keeps the
+/// polygon the same.
+fn parent_on_border(
+    ring: &[u32],
+    [a, b]: [u32; 2],
+    uv: &dyn Fn(u32) -> Option<Uv>,
+    at: Vec3d,
+    pos: &dyn Fn(u32) -> Vec3d,
+) -> Option<Option<Uv>> {
+    let (ia, ib) = (ring.contains(&a), ring.contains(&b));
+    Some(match (ia, ib) {
+        (false, false) => None,
+        (true, false) => Some(uv(a)?),
+        (false, true) => Some(uv(b)?),
+        (true, true) => {
+            // Both on the border: the parent on the segment between them, where it lies along
+            // the edge in 3D.
+            let (pa, pb) = (uv(a)?, uv(b)?);
+            let (da, db) = (len(sub(at, pos(a))), len(sub(at, pos(b))));
+            let t = if da + db > 0.0 { da / (da + db) } else { 0.5 };
+            let t = t.clamp(0.05, 0.95);
+            Some([pa[0] + t * (pb[0] - pa[0]), pa[1] + t * (pb[1] - pa[1])])
+        }
+    })
+}
+
+/// The region projected onto its mean plane, the parent at its own position's projection (or,
+/// on a border, where the boundary fixes it).
+fn projected(
+    faces: &[[u32; 3]],
+    ring: &[u32],
+    [a, b]: [u32; 2],
+    at: Vec3d,
+    pos: &dyn Fn(u32) -> Vec3d,
+) -> Option<Vec<(u32, Uv)>> {
+    let mut n = [0.0; 3];
+    for t in faces {
+        let [p, q, r] = t.map(pos);
+        let c = cross(sub(q, p), sub(r, p));
+        n = [n[0] + c[0], n[1] + c[1], n[2] + c[2]];
+    }
+    let n = normalize(n)?;
+    let helper = if n[0].abs() < 0.6 {
+        [1.0, 0.0, 0.0]
+    } else {
+        [0.0, 1.0, 0.0]
+    };
+    let u = normalize(cross(helper, n))?;
+    let w = cross(n, u);
+    let origin = pos(a);
+    let project = |p: Vec3d| {
+        let d = sub(p, origin);
+        [dot(d, u), dot(d, w)]
+    };
+    let mut uv: Vec<(u32, Uv)> = faces
+        .iter()
+        .flatten()
+        .map(|&v| (v, project(pos(v))))
+        .collect();
+    uv = finish(uv);
+    let lookup = |v: u32| {
+        uv.binary_search_by_key(&v, |&(x, _)| x)
+            .ok()
+            .map(|k| uv[k].1)
+    };
+    let p = match parent_on_border(ring, [a, b], &lookup, at, pos)? {
+        Some(p) => p,
+        None => project(at),
+    };
+    uv.push((u32::MAX, p));
+    Some(uv)
+}
+
+/// The map that cannot fold: the boundary on a convex polygon, inner vertices at mean-value
+/// combinations of their neighbours.
+fn convex(
+    faces: &[[u32; 3]],
+    ring: &[u32],
+    [a, b]: [u32; 2],
+    at: Vec3d,
+    pos: &dyn Fn(u32) -> Vec3d,
+) -> Option<Vec<(u32, Uv)>> {
+    let m = ring.len();
+    let length = |i: usize| len(sub(pos(ring[(i + 1) % m]), pos(ring[i])));
+    let mut uv: Vec<(u32, Uv)> = Vec::with_capacity(m + 3);
+    match (
+        ring.iter().position(|&x| x == a),
+        ring.iter().position(|&x| x == b),
+    ) {
+        (Some(ia), Some(ib)) => {
+            // The collapsed edge is on the border: it and the border edges either side of it on
+            // a straight side, the rest of the boundary on a half circle over it.
+            let k = if (ia + 1) % m == ib { ia } else { ib };
+            if m < 5 {
+                return None;
+            }
+            let start = (k + m - 1) % m; // the straight side is ring[start..start + 4]
+            let side: [f64; 3] = [0, 1, 2].map(|i| length((start + i) % m));
+            let total: f64 = side.iter().sum();
+            let mut s = 0.0;
+            for i in 0..4 {
+                uv.push((ring[(start + i) % m], [-1.0 + 2.0 * s / total, 0.0]));
+                if i < 3 {
+                    s += side[i];
+                }
+            }
+            // The arc runs from the side's far end (angle 0) round to its near end (angle pi).
+            let arc: Vec<usize> = (3..m).map(|i| (start + i) % m).collect();
+            let lengths: Vec<f64> = arc.iter().map(|&i| length(i)).collect();
+            let total: f64 = lengths.iter().sum();
+            let mut s = 0.0;
+            for j in 1..arc.len() {
+                s += lengths[j - 1];
+                let t = core::f64::consts::PI * s / total;
+                uv.push((ring[arc[j]], [libm::cos(t), libm::sin(t)]));
+            }
+        }
+        _ => {
+            let lengths: Vec<f64> = (0..m).map(length).collect();
+            let total: f64 = lengths.iter().sum();
+            let mut s = 0.0;
+            for (i, &l) in lengths.iter().enumerate() {
+                let t = 2.0 * core::f64::consts::PI * s / total;
+                uv.push((ring[i], [libm::cos(t), libm::sin(t)]));
+                s += l;
+            }
+        }
+    }
+    if !uv.iter().all(|(_, p)| p[0].is_finite() && p[1].is_finite()) {
+        return None;
+    }
+    // Inner vertices: a and b where they are not on the boundary, solved together.
+    let inner: Vec<u32> = [a, b].into_iter().filter(|v| !ring.contains(v)).collect();
+    let boundary = finish(uv.clone());
+    let known = |v: u32| {
+        boundary
+            .binary_search_by_key(&v, |&(x, _)| x)
+            .ok()
+            .map(|k| boundary[k].1)
+    };
+    // Row of each inner vertex: its weights' sum, the weight of the other inner vertex, and the
+    // weighted sum of its boundary neighbours.
+    let mut rows = Vec::with_capacity(2);
+    for &v in &inner {
+        let w = mean_value(v, pos(v), faces, pos);
+        let total: f64 = w.iter().map(|(_, x)| x).sum();
+        let mut other = 0.0;
+        let mut sum = [0.0; 2];
+        for &(x, wx) in &w {
+            if inner.contains(&x) {
+                other += wx;
+            } else {
+                let p = known(x)?;
+                sum = [sum[0] + wx * p[0], sum[1] + wx * p[1]];
+            }
+        }
+        if !(total > 0.0 && total.is_finite() && other.is_finite()) {
+            return None;
+        }
+        rows.push((total, other, sum));
+    }
+    match rows.as_slice() {
+        [] => {}
+        [(t, _, s)] => uv.push((inner[0], scale2(*s, 1.0 / t))),
+        [(t0, o0, s0), (t1, o1, s1)] => {
+            // t0 x0 - o0 x1 = s0, t1 x1 - o1 x0 = s1.
+            let det = t0 * t1 - o0 * o1;
+            if det.is_nan() || det <= 0.0 {
+                return None;
+            }
+            let x0 = [0, 1].map(|k| (s0[k] * t1 + o0 * s1[k]) / det);
+            let x1 = [0, 1].map(|k| (s1[k] * t0 + o1 * s0[k]) / det);
+            uv.push((inner[0], x0));
+            uv.push((inner[1], x1));
+        }
+        _ => return None,
+    }
+    let all = finish(uv.clone());
+    let lookup = |v: u32| {
+        all.binary_search_by_key(&v, |&(x, _)| x)
+            .ok()
+            .map(|k| all[k].1)
+    };
+    let p = match parent_on_border(ring, [a, b], &lookup, at, pos)? {
+        Some(p) => p,
+        None => {
+            // Inside the strictly convex polygon at its mean-value combination of the ring.
+            let after: Vec<[u32; 3]> = faces
+                .iter()
+                .filter(|t| !(t.contains(&a) && t.contains(&b)))
+                .map(|t| t.map(|x| if x == a || x == b { u32::MAX } else { x }))
+                .collect();
+            let fake = |v: u32| if v == u32::MAX { at } else { pos(v) };
+            let w = mean_value(u32::MAX, at, &after, &fake);
+            let total: f64 = w.iter().map(|(_, x)| x).sum();
+            let mut sum = [0.0; 2];
+            for &(x, wx) in &w {
+                let p = lookup(x)?;
+                sum = [sum[0] + wx * p[0], sum[1] + wx * p[1]];
+            }
+            if !(total > 0.0 && total.is_finite()) {
+                return None;
+            }
+            scale2(sum, 1.0 / total)
+        }
+    };
+    let mut uv = all;
+    uv.push((u32::MAX, p));
+    Some(uv)
+}
+
+fn scale2(p: Uv, s: f64) -> Uv {
+    [p[0] * s, p[1] * s]
+}

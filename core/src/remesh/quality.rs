@@ -1,0 +1,121 @@
+//! How close a remesh is to its input, and how well shaped.
+//!
+//! Distances are measured both ways with the builder's closest-point grid: from the remesh to
+//! the input at every finest triangle's centroid and edge midpoints (its vertices lie on the
+//! input by construction), and from the input to the remesh at every input vertex and triangle
+//! centroid. The two-sided Hausdorff distance is the largest of them all, the RMS distance the
+//! root of their mean square, both as fractions of the input's bounding-box diagonal.
+
+use super::Remesh;
+use crate::build::closest::Surface;
+use crate::build::vec3::{cross, dot, from_f32, len, normalize, sub, Vec3d};
+use crate::build::InputMesh;
+
+/// A remesh measured against its input.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Quality {
+    /// Two-sided Hausdorff distance over the samples, as a fraction of the bounding-box diagonal.
+    pub hausdorff: f64,
+    /// Root-mean-square distance over the samples, as a fraction of the diagonal.
+    pub rms: f64,
+    /// Finest triangles facing against the input there (their normal's dot product with the
+    /// input's normal at their corners is negative): 0 for a remesh without fold-overs.
+    pub flipped: u32,
+    /// Finest triangles by shape, `4 sqrt(3) area / (sum of squared edge lengths)` (1 for an
+    /// equilateral triangle, 0 for a sliver) in ten bins of 0.1.
+    pub shapes: [u32; 10],
+    /// Distances sampled.
+    pub samples: u64,
+}
+
+impl Remesh {
+    /// Measures this remesh against `input`, the mesh it was made from.
+    #[must_use]
+    pub fn quality(&self, input: &InputMesh<'_>) -> Quality {
+        let finest = self.mesh.finest_triangles();
+        let positions = &self.mesh.positions;
+        let to_input = Surface::new(input.positions, input.triangles);
+        let to_remesh = Surface::new(positions, &finest);
+        let diagonal = diagonal(input.positions).max(f64::MIN_POSITIVE);
+        let mut largest = 0.0f64;
+        let mut squares = 0.0f64;
+        let mut samples = 0u64;
+        let mut add = |d: f64| {
+            largest = largest.max(d);
+            squares += d * d;
+            samples += 1;
+        };
+        let mut flipped = 0;
+        let mut shapes = [0u32; 10];
+        let input_normal = |v: u32| -> Vec3d {
+            let (f, _) = self.on_input[v as usize];
+            let t = input.triangles[f as usize].map(|i| from_f32(input.positions[i as usize]));
+            normalize(cross(sub(t[1], t[0]), sub(t[2], t[0]))).unwrap_or([0.0; 3])
+        };
+        for t in &finest {
+            let [a, b, c] = t.map(|v| from_f32(positions[v as usize]));
+            for p in [
+                centroid(&[a, b, c]),
+                centroid(&[a, b]),
+                centroid(&[b, c]),
+                centroid(&[c, a]),
+            ] {
+                add(to_input.distance(p));
+            }
+            let n = cross(sub(b, a), sub(c, a));
+            let seen = t.iter().fold([0.0; 3], |s, &v| {
+                let m = input_normal(v);
+                [s[0] + m[0], s[1] + m[1], s[2] + m[2]]
+            });
+            if dot(n, seen) < 0.0 {
+                flipped += 1;
+            }
+            let edges = [sub(b, a), sub(c, b), sub(a, c)];
+            let squares: f64 = edges.iter().map(|&e| dot(e, e)).sum();
+            let shape = if squares > 0.0 {
+                2.0 * libm::sqrt(3.0) * len(n) / squares
+            } else {
+                0.0
+            };
+            shapes[((shape * 10.0) as usize).min(9)] += 1;
+        }
+        for p in input.positions {
+            add(to_remesh.distance(from_f32(*p)));
+        }
+        for t in input.triangles {
+            let c = t.map(|v| from_f32(input.positions[v as usize]));
+            add(to_remesh.distance(centroid(&c)));
+        }
+        Quality {
+            hausdorff: largest / diagonal,
+            rms: libm::sqrt(squares / samples.max(1) as f64) / diagonal,
+            flipped,
+            shapes,
+            samples,
+        }
+    }
+}
+
+fn centroid(points: &[Vec3d]) -> Vec3d {
+    let n = points.len() as f64;
+    let s = points
+        .iter()
+        .fold([0.0; 3], |s, p| [s[0] + p[0], s[1] + p[1], s[2] + p[2]]);
+    [s[0] / n, s[1] / n, s[2] / n]
+}
+
+/// The bounding box's diagonal.
+pub(crate) fn diagonal(positions: &[[f32; 3]]) -> f64 {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in positions {
+        for k in 0..3 {
+            lo[k] = lo[k].min(f64::from(p[k]));
+            hi[k] = hi[k].max(f64::from(p[k]));
+        }
+    }
+    if positions.is_empty() {
+        return 0.0;
+    }
+    len(sub(hi, lo))
+}
