@@ -71,7 +71,7 @@ pub fn summary(r: &Remeshed, levels: u32) -> String {
     format!(
         "base_faces={} levels={} faces={} collapses={} hausdorff_pct={:.3} rms_pct={:.4} \
          flipped={} worst_weight={:.1e} shape_below_0.3_pct={:.2} shape_below_0.5_pct={:.2} \
-         seconds={:.2}",
+         seconds={:.2} farthest={:?}",
         r.remesh.base_faces,
         levels,
         triangles,
@@ -82,6 +82,7 @@ pub fn summary(r: &Remeshed, levels: u32) -> String {
         r.remesh.worst_weight,
         100.0 * below(3),
         100.0 * below(5),
-        r.seconds
+        r.seconds,
+        q.farthest
     )
 }

@@ -17,6 +17,7 @@
 //! used; a region that admits no valid pair (never seen on manifold input, but possible on
 //! degenerate triangles) is reported as `None`, and the builder does not collapse that edge.
 
+use alloc::vec;
 use alloc::vec::Vec;
 
 use super::vec3::{cross, dot, len, normalize, sub, Vec3d};
@@ -232,6 +233,9 @@ pub fn flatten(
     let border_edge = on_ring(a).is_some() && on_ring(b).is_some();
     let maps = [
         (!border_edge)
+            .then(|| conformal(&faces, &ring, [a, b], at, pos))
+            .flatten(),
+        (!border_edge)
             .then(|| projected(&faces, &ring, [a, b], at, pos))
             .flatten(),
         convex(&faces, &ring, [a, b], at, pos),
@@ -282,6 +286,164 @@ fn parent_on_border(
             Some([pa[0] + t * (pb[0] - pa[0]), pa[1] + t * (pb[1] - pa[1])])
         }
     })
+}
+
+/// The least-squares conformal map (Lévy, Petitjean, Ray and Maillot, "Least squares conformal
+/// maps for automatic texture atlas generation", 2002) of the region with `a` and `b` pinned,
+/// and the parent where the same energy over the triangles after the collapse puts it (or, on a
+/// border, where the boundary fixes it). Isometric where the region is developable, so a region
+/// wrapped round a thin part (a leg, an ear) is unrolled rather than squashed.
+fn conformal(
+    faces: &[[u32; 3]],
+    ring: &[u32],
+    [a, b]: [u32; 2],
+    at: Vec3d,
+    pos: &dyn Fn(u32) -> Vec3d,
+) -> Option<Vec<(u32, Uv)>> {
+    let ab = len(sub(pos(b), pos(a)));
+    let pinned = [(a, [0.0, 0.0]), (b, [ab, 0.0])];
+    let mut free: Vec<u32> = faces.iter().flatten().copied().collect();
+    free.sort_unstable();
+    free.dedup();
+    free.retain(|&v| v != a && v != b);
+    let mut uv = least_squares_conformal(faces, pos, &pinned, &free)?;
+    uv.extend_from_slice(&pinned);
+    uv = finish(uv);
+    let lookup = |v: u32| {
+        uv.binary_search_by_key(&v, |&(x, _)| x)
+            .ok()
+            .map(|k| uv[k].1)
+    };
+    let p = match parent_on_border(ring, [a, b], &lookup, at, pos)? {
+        Some(p) => p,
+        None => {
+            let after: Vec<[u32; 3]> = faces
+                .iter()
+                .filter(|t| !(t.contains(&a) && t.contains(&b)))
+                .map(|t| t.map(|x| if x == a || x == b { u32::MAX } else { x }))
+                .collect();
+            let with_parent = |v: u32| if v == u32::MAX { at } else { pos(v) };
+            let fixed: Vec<(u32, Uv)> = ring
+                .iter()
+                .map(|&v| Some((v, lookup(v)?)))
+                .collect::<Option<_>>()?;
+            least_squares_conformal(&after, &with_parent, &fixed, &[u32::MAX])?
+                .first()?
+                .1
+        }
+    };
+    uv.push((u32::MAX, p));
+    Some(uv)
+}
+
+/// The points of the `free` vertices minimising the conformal energy of `faces` (each
+/// triangle's residual `sum_k W_k U_k`, `W_k` its edge opposite corner `k` in its own plane,
+/// weighted by one over its area) with the `fixed` vertices where they are given.
+fn least_squares_conformal(
+    faces: &[[u32; 3]],
+    pos: &dyn Fn(u32) -> Vec3d,
+    fixed: &[(u32, Uv)],
+    free: &[u32],
+) -> Option<Vec<(u32, Uv)>> {
+    let n = 2 * free.len();
+    if n == 0 {
+        return Some(Vec::new());
+    }
+    // Normal equations of the rows, accumulated: (A^T A) x = A^T r.
+    let mut m = vec![0.0f64; n * n];
+    let mut rhs = vec![0.0f64; n];
+    for t in faces {
+        let [p0, p1, p2] = t.map(pos);
+        let (e1, e2) = (sub(p1, p0), sub(p2, p0));
+        let l1 = len(e1);
+        let normal = cross(e1, e2);
+        let area = 0.5 * len(normal);
+        if !(l1 > 0.0 && area > 0.0 && area.is_finite()) {
+            return None;
+        }
+        let x = [e1[0] / l1, e1[1] / l1, e1[2] / l1];
+        let y = normalize(cross(normal, x))?;
+        let z = [[0.0, 0.0], [l1, 0.0], [dot(e2, x), dot(e2, y)]];
+        let weight = 1.0 / libm::sqrt(area);
+        // W_k = z_{k+2} - z_{k+1}; the residual's real and imaginary rows.
+        let w: [Uv; 3] = core::array::from_fn(|k| {
+            let (p, q) = (z[(k + 2) % 3], z[(k + 1) % 3]);
+            [(p[0] - q[0]) * weight, (p[1] - q[1]) * weight]
+        });
+        for row in 0..2 {
+            // Coefficients of (u_k, v_k): real row (wr, -wi), imaginary row (wi, wr).
+            let coef = |k: usize| -> [f64; 2] {
+                if row == 0 {
+                    [w[k][0], -w[k][1]]
+                } else {
+                    [w[k][1], w[k][0]]
+                }
+            };
+            let mut cols: [(Option<usize>, [f64; 2]); 3] = [(None, [0.0; 2]); 3];
+            let mut known = 0.0;
+            for k in 0..3 {
+                let c = coef(k);
+                match free.iter().position(|&v| v == t[k]) {
+                    Some(i) => cols[k] = (Some(i), c),
+                    None => {
+                        let (_, p) = fixed.iter().find(|(v, _)| *v == t[k])?;
+                        known += c[0] * p[0] + c[1] * p[1];
+                    }
+                }
+            }
+            for &(i, ci) in &cols {
+                let Some(i) = i else { continue };
+                for (di, &cv) in ci.iter().enumerate() {
+                    let r = 2 * i + di;
+                    rhs[r] -= cv * known;
+                    for &(j, cj) in &cols {
+                        let Some(j) = j else { continue };
+                        for (dj, &cw) in cj.iter().enumerate() {
+                            m[r * n + 2 * j + dj] += cv * cw;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    let x = solve(&mut m, &mut rhs, n)?;
+    Some(
+        free.iter()
+            .enumerate()
+            .map(|(i, &v)| (v, [x[2 * i], x[2 * i + 1]]))
+            .collect(),
+    )
+}
+
+/// Solves the `n` by `n` system `m x = r` by Gaussian elimination with partial pivoting.
+fn solve(m: &mut [f64], r: &mut [f64], n: usize) -> Option<Vec<f64>> {
+    for c in 0..n {
+        let pivot = (c..n).max_by(|&i, &j| m[i * n + c].abs().total_cmp(&m[j * n + c].abs()))?;
+        if !(m[pivot * n + c].abs() > 1e-300) {
+            return None;
+        }
+        if pivot != c {
+            for k in 0..n {
+                m.swap(c * n + k, pivot * n + k);
+            }
+            r.swap(c, pivot);
+        }
+        for i in c + 1..n {
+            let f = m[i * n + c] / m[c * n + c];
+            if f != 0.0 {
+                for k in c..n {
+                    m[i * n + k] -= f * m[c * n + k];
+                }
+                r[i] -= f * r[c];
+            }
+        }
+    }
+    let mut x = vec![0.0; n];
+    for c in (0..n).rev() {
+        let s: f64 = (c + 1..n).map(|k| m[c * n + k] * x[k]).sum();
+        x[c] = (r[c] - s) / m[c * n + c];
+    }
+    x.iter().all(|v| v.is_finite()).then_some(x)
 }
 
 /// The region projected onto its mean plane, the parent at its own position's projection (or,

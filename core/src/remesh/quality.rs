@@ -26,6 +26,9 @@ pub struct Quality {
     pub shapes: [u32; 10],
     /// Distances sampled.
     pub samples: u64,
+    /// Where the largest distance was found: a point of the input (`true`: the remesh misses
+    /// the input there) or of the remesh (`false`: it leaves the input there).
+    pub farthest: ([f32; 3], bool),
 }
 
 impl Remesh {
@@ -40,7 +43,11 @@ impl Remesh {
         let mut largest = 0.0f64;
         let mut squares = 0.0f64;
         let mut samples = 0u64;
-        let mut add = |d: f64| {
+        let mut farthest = ([0.0f32; 3], false);
+        let mut add = |d: f64, at: Vec3d, on_input: bool| {
+            if d > largest {
+                farthest = (at.map(|x| x as f32), on_input);
+            }
             largest = largest.max(d);
             squares += d * d;
             samples += 1;
@@ -60,7 +67,7 @@ impl Remesh {
                 centroid(&[b, c]),
                 centroid(&[c, a]),
             ] {
-                add(to_input.distance(p));
+                add(to_input.distance(p), p, false);
             }
             let n = cross(sub(b, a), sub(c, a));
             let seen = t.iter().fold([0.0; 3], |s, &v| {
@@ -80,11 +87,11 @@ impl Remesh {
             shapes[((shape * 10.0) as usize).min(9)] += 1;
         }
         for p in input.positions {
-            add(to_remesh.distance(from_f32(*p)));
+            add(to_remesh.distance(from_f32(*p)), from_f32(*p), true);
         }
         for t in input.triangles {
             let c = t.map(|v| from_f32(input.positions[v as usize]));
-            add(to_remesh.distance(centroid(&c)));
+            add(to_remesh.distance(centroid(&c)), centroid(&c), true);
         }
         Quality {
             hausdorff: largest / diagonal,
@@ -92,6 +99,7 @@ impl Remesh {
             flipped,
             shapes,
             samples,
+            farthest,
         }
     }
 }
