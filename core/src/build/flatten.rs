@@ -419,7 +419,8 @@ fn least_squares_conformal(
 fn solve(m: &mut [f64], r: &mut [f64], n: usize) -> Option<Vec<f64>> {
     for c in 0..n {
         let pivot = (c..n).max_by(|&i, &j| m[i * n + c].abs().total_cmp(&m[j * n + c].abs()))?;
-        if !(m[pivot * n + c].abs() > 1e-300) {
+        let size = m[pivot * n + c].abs();
+        if size.is_nan() || size <= 1e-300 {
             return None;
         }
         if pivot != c {
