@@ -19,6 +19,9 @@ missing=()
 command -v qemu-aarch64 >/dev/null || missing+=(qemu-user)
 command -v aarch64-linux-gnu-gcc >/dev/null || missing+=(gcc-aarch64-linux-gnu)
 command -v aarch64-linux-gnu-g++ >/dev/null || missing+=(g++-aarch64-linux-gnu)
+# The C library to link against: a recommendation of the cross compiler, so a compiler installed
+# without recommendations (or by another script) can be there without it.
+[ -e /usr/aarch64-linux-gnu/lib/Scrt1.o ] || missing+=(libc6-dev-arm64-cross)
 if [ "${#missing[@]}" -gt 0 ]; then
     echo "installing ${missing[*]}"
     sudo_if_needed apt-get update
