@@ -24,8 +24,8 @@ fn fixtures_remesh_onto_themselves() {
     for (name, hausdorff_pct) in [
         ("head.obj", 1.0),
         ("fandisk.obj", 1.0),
-        ("elk.obj", 2.0),
-        ("cow.obj", 5.0),
+        ("elk.obj", 1.5),
+        ("cow.obj", 1.5),
     ] {
         let mesh = fixture(name);
         let options = RemeshOptions {
@@ -42,7 +42,12 @@ fn fixtures_remesh_onto_themselves() {
         assert!(q.rms < 0.001, "{name}: {q:?}");
         assert!(q.hausdorff * 100.0 < hausdorff_pct, "{name}: {q:?}");
         // Flipped triangles are not zero yet (the README says where); they stay rare.
-        assert!(q.flipped * 50 < finest.len() as u32, "{name}: {q:?}");
+        assert!(q.flipped * 500 < finest.len() as u32, "{name}: {q:?}");
+        // The relaxation leaves few slivers.
+        assert!(
+            q.shapes[..3].iter().sum::<u32>() * 10 < finest.len() as u32,
+            "{name}: {q:?}"
+        );
         // The file parses and says what it holds.
         let bytes = out.mesh.to_bytes().unwrap();
         let s = SemiRegularView::parse(&bytes).unwrap();

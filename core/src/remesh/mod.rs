@@ -16,11 +16,18 @@
 //!    triangle, the point goes through that collapse's two planar maps into a triangle of the
 //!    finer mesh. After the first collapse it lies in an input triangle, and its position is
 //!    there, on the input surface.
+//! 4. The composition of piecewise-linear bijections is one, so the points are the images of a
+//!    bijective map from the base domain onto the input; but a chain of a few dozen nearly
+//!    conformal maps compounds its small errors into slivers here and there, and conformal maps
+//!    shrink spikes, so a horn's tip gets no point. A relaxation on the input surface evens the
+//!    triangles out and untangles the few that face the wrong way, then the input vertices
+//!    still farther than 0.3% of the diagonal from the remesh (the tips) each pull the nearest
+//!    remesh vertex onto themselves (`relax`).
 //!
-//! The composition of piecewise-linear bijections is one, so the semi-regular mesh's vertices
-//! are the images of a bijective map from the base domain onto the input (colours follow the
-//! same map), and the result keeps the input's genus and borders. [`Remesh::quality`] measures
-//! what came out: two-sided distances, flipped triangles, triangle shapes.
+//! Every vertex stays on the input surface, the result keeps the input's genus and borders,
+//! and colours follow each vertex's place on the input ([`Remesh::on_input`]).
+//! [`Remesh::quality`] measures what came out: two-sided distances, flipped triangles, triangle
+//! shapes.
 //!
 //! ```
 //! use vdlod_core::build::InputMesh;
@@ -46,6 +53,7 @@
 //! ```
 
 mod quality;
+mod relax;
 
 use alloc::vec;
 use alloc::vec::Vec;
@@ -169,11 +177,11 @@ pub struct Remesh {
     /// Edge collapses the simplification made.
     pub collapses: u32,
     /// Where each vertex of the semi-regular mesh lies on the input: an input triangle and
-    /// barycentric weights over its corners (the parameterization, for colours and textures).
+    /// barycentric weights over its corners (for colours and textures).
     pub on_input: Vec<(u32, [f64; 3])>,
-    /// The most negative barycentric weight met when a point was carried into a finer triangle:
-    /// 0 (up to rounding, about `-1e-12`) when every planar map was a bijection; a fold shows up
-    /// as a clearly negative value.
+    /// The most negative barycentric weight met when a point was carried into a finer triangle
+    /// (before the relaxation): 0 (up to rounding, about `-1e-12`) when every planar map was a
+    /// bijection; a fold shows up as a clearly negative value.
     pub worst_weight: f64,
 }
 
@@ -250,7 +258,7 @@ pub fn remesh(
         })?;
     let planar = engine.planar.take().unwrap_or_default();
     let worst_weight = unwind(&mut points, &planar, input_faces, progress);
-    let on_input: Vec<(u32, [f64; 3])> = points.iter().map(|p| (p.face, p.w)).collect();
+    let mut on_input: Vec<(u32, [f64; 3])> = points.iter().map(|p| (p.face, p.w)).collect();
     mesh.positions = on_input
         .iter()
         .map(|&(f, w)| {
@@ -258,6 +266,7 @@ pub fn remesh(
             core::array::from_fn(|k| (0..3).map(|i| w[i] * f64::from(t[i][k])).sum::<f64>() as f32)
         })
         .collect();
+    relaxed(input, &mut mesh, &mut on_input, base_positions.len());
     mesh.colors = input.colors.map(|colors| {
         on_input
             .iter()
@@ -277,6 +286,57 @@ pub fn remesh(
         on_input,
         worst_weight,
     })
+}
+
+/// Rounds of tangential relaxation after the map.
+const RELAX_ROUNDS: u32 = 24;
+
+/// Input vertices farther than this fraction of the diagonal from the relaxed remesh get a
+/// remesh vertex snapped onto them.
+const SNAP_REACH: f64 = 0.003;
+
+/// Passes of snapping (each followed by a few rounds of relaxation).
+const SNAP_PASSES: u32 = 3;
+
+/// Relaxes the finest level on the input (see `relax`), keeping the base vertices and the
+/// border where they are.
+fn relaxed(
+    input: &InputMesh<'_>,
+    mesh: &mut SemiRegular,
+    on_input: &mut [(u32, [f64; 3])],
+    base_vertices: usize,
+) {
+    let triangles = mesh.finest_triangles();
+    let n = mesh.positions.len();
+    let mut fixed = vec![false; n];
+    fixed[..base_vertices].iter_mut().for_each(|f| *f = true);
+    // Border vertices: on an edge only one triangle has.
+    let mut edges: Vec<(u32, u32)> = triangles
+        .iter()
+        .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
+        .collect();
+    edges.sort_unstable();
+    for &(a, b) in &edges {
+        if edges.binary_search(&(b, a)).is_err() {
+            fixed[a as usize] = true;
+            fixed[b as usize] = true;
+        }
+    }
+    let around = relax::Around::new(input.positions.len(), input.triangles);
+    let mut relax = relax::Relax {
+        input,
+        around: &around,
+        triangles: &triangles,
+        fixed,
+    };
+    relax.run(RELAX_ROUNDS, &mut mesh.positions, on_input);
+    let reach = SNAP_REACH * quality::diagonal(input.positions);
+    for _ in 0..SNAP_PASSES {
+        if relax.snap(reach, &mut mesh.positions, on_input) == 0 {
+            break;
+        }
+        relax.run(RELAX_ROUNDS / 4, &mut mesh.positions, on_input);
+    }
 }
 
 /// Collapses edges until at most `base_faces` faces are left or none is legal; returns the faces

@@ -1,0 +1,289 @@
+//! Tangential relaxation of the remesh on the input surface.
+//!
+//! The map the collapses build is a bijection, but a chain of a few dozen planar maps is only
+//! nearly conformal, and the small errors compound: here and there it stretches the lattice into
+//! slivers, and a sliver across a bend of the input can face the wrong way. Each round moves
+//! every free vertex part of the way towards the centroid of its neighbours, within its tangent
+//! plane, and puts it back on the input at the closest point of the triangles around where it
+//! was (a local walk, so a point never jumps across a thin part to the far side). A move is kept
+//! when it leaves fewer triangles around the vertex facing against the input, or as few and none
+//! worse shaped than the worst it had; base vertices and border vertices stay.
+
+use alloc::vec;
+use alloc::vec::Vec;
+
+use crate::build::closest::Surface;
+use crate::build::collapse::shape;
+use crate::build::vec3::{add, cross, dot, from_f32, normalize, scale, sub, Vec3d};
+use crate::build::InputMesh;
+
+/// The input's triangles around each vertex, as flat arrays.
+pub(super) struct Around {
+    starts: Vec<u32>,
+    faces: Vec<u32>,
+}
+
+impl Around {
+    pub(super) fn new(vertices: usize, triangles: &[[u32; 3]]) -> Around {
+        let mut starts = vec![0u32; vertices + 1];
+        for t in triangles {
+            for &v in t {
+                starts[v as usize + 1] += 1;
+            }
+        }
+        for v in 0..vertices {
+            starts[v + 1] += starts[v];
+        }
+        let mut fill = starts.clone();
+        let mut faces = vec![0u32; starts[vertices] as usize];
+        for (f, t) in triangles.iter().enumerate() {
+            for &v in t {
+                faces[fill[v as usize] as usize] = f as u32;
+                fill[v as usize] += 1;
+            }
+        }
+        Around { starts, faces }
+    }
+
+    fn of(&self, v: u32) -> &[u32] {
+        &self.faces[self.starts[v as usize] as usize..self.starts[v as usize + 1] as usize]
+    }
+}
+
+/// The closest point of triangle `t` to `p`: its barycentric weights and squared distance.
+fn closest(p: Vec3d, t: [Vec3d; 3]) -> ([f64; 3], f64) {
+    // Ericson, "Real-time collision detection" (2004), 5.1.5: by the Voronoi regions.
+    let [a, b, c] = t;
+    let (ab, ac, ap) = (sub(b, a), sub(c, a), sub(p, a));
+    let (d1, d2) = (dot(ab, ap), dot(ac, ap));
+    let weights = if d1 <= 0.0 && d2 <= 0.0 {
+        [1.0, 0.0, 0.0]
+    } else {
+        let bp = sub(p, b);
+        let (d3, d4) = (dot(ab, bp), dot(ac, bp));
+        let cp = sub(p, c);
+        let (d5, d6) = (dot(ab, cp), dot(ac, cp));
+        let vc = d1 * d4 - d3 * d2;
+        let vb = d5 * d2 - d1 * d6;
+        let va = d3 * d6 - d5 * d4;
+        if d3 >= 0.0 && d4 <= d3 {
+            [0.0, 1.0, 0.0]
+        } else if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+            let v = d1 / (d1 - d3);
+            [1.0 - v, v, 0.0]
+        } else if d6 >= 0.0 && d5 <= d6 {
+            [0.0, 0.0, 1.0]
+        } else if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+            let w = d2 / (d2 - d6);
+            [1.0 - w, 0.0, w]
+        } else if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+            let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+            [0.0, 1.0 - w, w]
+        } else {
+            let s = va + vb + vc;
+            if s > 0.0 && s.is_finite() {
+                [va / s, vb / s, vc / s]
+            } else {
+                [1.0 / 3.0; 3]
+            }
+        }
+    };
+    let q = point(t, weights);
+    let d = sub(p, q);
+    (weights, dot(d, d))
+}
+
+fn point(t: [Vec3d; 3], w: [f64; 3]) -> Vec3d {
+    add(add(scale(t[0], w[0]), scale(t[1], w[1])), scale(t[2], w[2]))
+}
+
+/// What the relaxation works on.
+pub(super) struct Relax<'a> {
+    pub input: &'a InputMesh<'a>,
+    pub around: &'a Around,
+    /// The remesh's finest triangles.
+    pub triangles: &'a [[u32; 3]],
+    /// Vertices that never move (snapped vertices join them).
+    pub fixed: Vec<bool>,
+}
+
+impl Relax<'_> {
+    fn corners(&self, f: u32) -> [Vec3d; 3] {
+        self.input.triangles[f as usize].map(|v| from_f32(self.input.positions[v as usize]))
+    }
+
+    fn normal(&self, f: u32) -> Vec3d {
+        let t = self.corners(f);
+        normalize(cross(sub(t[1], t[0]), sub(t[2], t[0]))).unwrap_or([0.0; 3])
+    }
+
+    /// The closest point to `p` on the input triangles around `face`, walking on while a
+    /// neighbouring triangle is closer (at most a few steps).
+    fn project(&self, p: Vec3d, face: u32) -> (u32, [f64; 3]) {
+        let mut best = (face, closest(p, self.corners(face)));
+        for _ in 0..4 {
+            let start = best.0;
+            for &v in &self.input.triangles[start as usize] {
+                for &f in self.around.of(v) {
+                    let c = closest(p, self.corners(f));
+                    if c.1 < best.1 .1 {
+                        best = (f, c);
+                    }
+                }
+            }
+            if best.0 == start {
+                break;
+            }
+        }
+        (best.0, best.1 .0)
+    }
+
+    /// Moves the nearest free remesh vertex onto each input vertex farther than `reach` from
+    /// the remesh (a spike's tip the map left unsampled), farthest first, where that turns no
+    /// triangle against the input; a vertex moved there stays. Returns how many moved.
+    pub(super) fn snap(
+        &mut self,
+        reach: f64,
+        positions: &mut [[f32; 3]],
+        on_input: &mut [(u32, [f64; 3])],
+    ) -> u32 {
+        let surface = Surface::new(positions, self.triangles);
+        let mut far: Vec<(f64, u32)> = self
+            .input
+            .positions
+            .iter()
+            .enumerate()
+            .map(|(x, p)| (surface.distance(from_f32(*p)), x as u32))
+            .filter(|&(d, _)| d > reach)
+            .collect();
+        far.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+        let around_remesh = Around::new(positions.len(), self.triangles);
+        let mut moved = 0;
+        for (_, x) in far {
+            let Some(&face) = self.around.of(x).first() else {
+                continue;
+            };
+            let slot = self.input.triangles[face as usize]
+                .iter()
+                .position(|&c| c == x)
+                .unwrap_or(0);
+            let mut w = [0.0; 3];
+            w[slot] = 1.0;
+            let target = from_f32(self.input.positions[x as usize]);
+            let nearest = (0..positions.len())
+                .filter(|&v| !self.fixed[v])
+                .map(|v| {
+                    let d = sub(from_f32(positions[v]), target);
+                    (dot(d, d), v)
+                })
+                .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            let Some((_, v)) = nearest else {
+                continue;
+            };
+            let tris = around_remesh.of(v as u32);
+            let (before, _) = self.facing(tris, v as u32, None, positions, on_input);
+            let (after, _) = self.facing(tris, v as u32, Some((target, face)), positions, on_input);
+            if after <= before {
+                positions[v] = target.map(|c| c as f32);
+                on_input[v] = (face, w);
+                self.fixed[v] = true;
+                moved += 1;
+            }
+        }
+        moved
+    }
+
+    /// How many of the triangles `tris` around `v` face against the input, and the worst
+    /// shape among them, with `v` where it is or at `moved` (a point and its input triangle).
+    fn facing(
+        &self,
+        tris: &[u32],
+        v: u32,
+        moved: Option<(Vec3d, u32)>,
+        positions: &[[f32; 3]],
+        on_input: &[(u32, [f64; 3])],
+    ) -> (u32, f64) {
+        let mut against = 0u32;
+        let mut least = f64::INFINITY;
+        for &t in tris {
+            let tri = self.triangles[t as usize];
+            let c = tri.map(|x| match moved {
+                Some((at, _)) if x == v => at,
+                _ => from_f32(positions[x as usize]),
+            });
+            let n = cross(sub(c[1], c[0]), sub(c[2], c[0]));
+            let seen = tri.iter().fold([0.0; 3], |s, &x| {
+                let f = match moved {
+                    Some((_, face)) if x == v => face,
+                    _ => on_input[x as usize].0,
+                };
+                add(s, self.normal(f))
+            });
+            against += u32::from(dot(n, seen) <= 0.0);
+            least = least.min(shape(c));
+        }
+        (against, least)
+    }
+
+    /// `rounds` rounds over every free vertex; `on_input` and `positions` are updated together.
+    pub(super) fn run(
+        &self,
+        rounds: u32,
+        positions: &mut [[f32; 3]],
+        on_input: &mut [(u32, [f64; 3])],
+    ) {
+        let n = positions.len();
+        // Triangles around each remesh vertex, flat.
+        let around_remesh = Around::new(n, self.triangles);
+        for _ in 0..rounds {
+            for v in 0..n as u32 {
+                if self.fixed[v as usize] {
+                    continue;
+                }
+                let tris = around_remesh.of(v);
+                let here = from_f32(positions[v as usize]);
+                let mut centroid = [0.0; 3];
+                let mut normal = [0.0; 3];
+                let mut count = 0.0;
+                let mut worst = f64::INFINITY;
+                for &t in tris {
+                    let c = self.triangles[t as usize].map(|x| from_f32(positions[x as usize]));
+                    normal = add(normal, cross(sub(c[1], c[0]), sub(c[2], c[0])));
+                    worst = worst.min(shape(c));
+                    for (k, &x) in self.triangles[t as usize].iter().enumerate() {
+                        if x != v {
+                            centroid = add(centroid, c[k]);
+                            count += 1.0;
+                        }
+                    }
+                }
+                let Some(normal) = normalize(normal) else {
+                    continue;
+                };
+                if count == 0.0 {
+                    continue;
+                }
+                let towards = sub(scale(centroid, 1.0 / count), here);
+                let tangent = sub(towards, scale(normal, dot(towards, normal)));
+                // Kept when fewer triangles around face against the input than before, or as
+                // few and none is worse shaped than the worst was.
+                let (before, _) = self.facing(tris, v, None, positions, on_input);
+                // Half way to the centroid; a vertex of a triangle facing the wrong way also
+                // tries all the way, to untangle it.
+                let steps: &[f64] = if before > 0 { &[0.5, 1.0] } else { &[0.5] };
+                for &step in steps {
+                    let target = add(here, scale(tangent, step));
+                    let (face, w) = self.project(target, on_input[v as usize].0);
+                    let moved = point(self.corners(face), w);
+                    let (after, least) =
+                        self.facing(tris, v, Some((moved, face)), positions, on_input);
+                    if after < before || (after == before && least >= worst.min(0.5)) {
+                        positions[v as usize] = moved.map(|x| x as f32);
+                        on_input[v as usize] = (face, w);
+                        break;
+                    }
+                }
+            }
+        }
+    }
+}
