@@ -21,8 +21,8 @@
 //!    conformal maps compounds its small errors into slivers here and there, and conformal maps
 //!    shrink spikes, so a horn's tip gets no point. A relaxation on the input surface evens the
 //!    triangles out and untangles the few that face the wrong way, then the input vertices
-//!    still farther than 0.3% of the diagonal from the remesh (the tips) each pull the nearest
-//!    remesh vertex onto themselves (`relax`).
+//!    still farther from the remesh than 0.3% of the diagonal and than its mean edge (the tips)
+//!    each pull the nearest remesh vertex onto themselves (`relax`).
 //!
 //! Every vertex stays on the input surface, the result keeps the input's genus and borders,
 //! and colours follow each vertex's place on the input ([`Remesh::on_input`]).
@@ -61,6 +61,7 @@ use core::fmt;
 
 use crate::build::collapse::Engine;
 use crate::build::flatten::{area2, barycentric, PlanarCollapse, Uv};
+use crate::build::vec3::{dot, from_f32, sub};
 use crate::build::{validate, BuildError, BuildOptions, InputMesh, NONE};
 use crate::wavelet::format::MAX_LEVELS;
 use crate::wavelet::{SemiRegular, SemiRegularBuildError};
@@ -291,8 +292,8 @@ pub fn remesh(
 /// Rounds of tangential relaxation after the map.
 const RELAX_ROUNDS: u32 = 24;
 
-/// Input vertices farther than this fraction of the diagonal from the relaxed remesh get a
-/// remesh vertex snapped onto them.
+/// Input vertices farther than this fraction of the diagonal (or the remesh's mean edge, if
+/// longer) from the relaxed remesh get a remesh vertex snapped onto them.
 const SNAP_REACH: f64 = 0.003;
 
 /// Passes of snapping (each followed by a few rounds of relaxation).
@@ -330,7 +331,20 @@ fn relaxed(
         fixed,
     };
     relax.run(RELAX_ROUNDS, &mut mesh.positions, on_input);
-    let reach = SNAP_REACH * quality::diagonal(input.positions);
+    // Past the chord error a remesh this fine has anyway: its mean edge.
+    let edges: f64 = triangles
+        .iter()
+        .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
+        .map(|(a, b)| {
+            let d = sub(
+                from_f32(mesh.positions[a as usize]),
+                from_f32(mesh.positions[b as usize]),
+            );
+            libm::sqrt(dot(d, d))
+        })
+        .sum::<f64>()
+        / (3 * triangles.len()).max(1) as f64;
+    let reach = (SNAP_REACH * quality::diagonal(input.positions)).max(edges);
     for _ in 0..SNAP_PASSES {
         if relax.snap(reach, &mut mesh.positions, on_input) == 0 {
             break;

@@ -17,6 +17,9 @@ use crate::build::collapse::shape;
 use crate::build::vec3::{add, cross, dot, from_f32, normalize, scale, sub, Vec3d};
 use crate::build::InputMesh;
 
+/// How many of the nearest free vertices a far input vertex tries to pull.
+const SNAP_TRIES: usize = 8;
+
 /// The input's triangles around each vertex, as flat arrays.
 pub(super) struct Around {
     starts: Vec<u32>,
@@ -148,6 +151,7 @@ impl Relax<'_> {
         on_input: &mut [(u32, [f64; 3])],
     ) -> u32 {
         let surface = Surface::new(positions, self.triangles);
+        let on = Surface::new(self.input.positions, self.input.triangles);
         let mut far: Vec<(f64, u32)> = self
             .input
             .positions
@@ -159,7 +163,7 @@ impl Relax<'_> {
         far.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
         let around_remesh = Around::new(positions.len(), self.triangles);
         let mut moved = 0;
-        for (_, x) in far {
+        for (distance, x) in far {
             let Some(&face) = self.around.of(x).first() else {
                 continue;
             };
@@ -170,24 +174,51 @@ impl Relax<'_> {
             let mut w = [0.0; 3];
             w[slot] = 1.0;
             let target = from_f32(self.input.positions[x as usize]);
-            let nearest = (0..positions.len())
+            // The nearest free vertices, nearest first: the first whose move turns no triangle
+            // against the input goes.
+            let mut nearest: Vec<(f64, usize)> = (0..positions.len())
                 .filter(|&v| !self.fixed[v])
                 .map(|v| {
                     let d = sub(from_f32(positions[v]), target);
                     (dot(d, d), v)
                 })
-                .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-            let Some((_, v)) = nearest else {
+                .collect();
+            let tried = nearest.len().min(SNAP_TRIES);
+            if tried == 0 {
                 continue;
-            };
-            let tris = around_remesh.of(v as u32);
-            let (before, _) = self.facing(tris, v as u32, None, positions, on_input);
-            let (after, _) = self.facing(tris, v as u32, Some((target, face)), positions, on_input);
-            if after <= before {
-                positions[v] = target.map(|c| c as f32);
-                on_input[v] = (face, w);
-                self.fixed[v] = true;
-                moved += 1;
+            }
+            nearest
+                .select_nth_unstable_by(tried - 1, |a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            nearest.truncate(tried);
+            nearest.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            for (_, v) in nearest {
+                let tris = around_remesh.of(v as u32);
+                let (before, _) = self.facing(tris, v as u32, None, positions, on_input);
+                let (after, _) =
+                    self.facing(tris, v as u32, Some((target, face)), positions, on_input);
+                // Nor may it open a gap wider than the one it closes: the moved triangles'
+                // centroids and edge midpoints stay nearer the input than the vertex was.
+                let gap = tris.iter().fold(0.0f64, |g, &t| {
+                    let c = self.triangles[t as usize].map(|x| {
+                        if x as usize == v {
+                            target
+                        } else {
+                            from_f32(positions[x as usize])
+                        }
+                    });
+                    let mid = |a: Vec3d, b: Vec3d| scale(add(a, b), 0.5);
+                    let centre = scale(add(add(c[0], c[1]), c[2]), 1.0 / 3.0);
+                    [centre, mid(c[0], c[1]), mid(c[1], c[2]), mid(c[2], c[0])]
+                        .iter()
+                        .fold(g, |g, &p| g.max(on.distance(p)))
+                });
+                if after <= before && gap < distance {
+                    positions[v] = target.map(|c| c as f32);
+                    on_input[v] = (face, w);
+                    self.fixed[v] = true;
+                    moved += 1;
+                    break;
+                }
             }
         }
         moved
