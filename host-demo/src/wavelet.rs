@@ -826,13 +826,32 @@ fn forest_at(
     Ok((fly(&mut engine, full, cameras)?, hbytes.len()))
 }
 
+/// The wavelet engine's mesh of `s` adapted from the base mesh for `camera` by `policy`, drawn
+/// in `style`.
+fn wavelet_frame<P: Policy>(
+    s: &SemiRegularView<'_>,
+    camera: &Camera,
+    policy: &P,
+    style: &Style,
+) -> Result<Frame, String> {
+    let mut cut = DemoWaveletCut::boxed();
+    cut.reset(s).map_err(|e| e.to_string())?;
+    cut.adapt(s, &camera.view(), policy, &Budget::default());
+    let mut frame = Frame::new(camera.width, camera.height).map_err(|e| e.to_string())?;
+    frame
+        .draw_styled(&WaveletMesh::new(&cut, s, false), camera, style)
+        .map_err(|e| e.to_string())?;
+    Ok(frame)
+}
+
 /// The wavelet paper's fish experiment (its Fig. 13 and §4) on our meshes: the bunny and the
 /// cow remeshed over a base of about 200 faces with four levels (the fish: 199 base faces,
 /// 50,944 at four levels); the remesh's distances to the input; from the session's first
 /// camera, the adaptive mesh at a 2 px silhouette / 10 px interior tolerance against three
 /// uniform levels (paper: 3,943 against 12,736 faces); and over the whole session both engines
 /// at equal triangle counts, PSNR against the *input* (the vertex forest built from the input
-/// itself). Writes `NAME.csv` per mesh into `out`.
+/// itself). Writes `NAME.csv` and `NAME_coarse.png`, `NAME_adapted.png` and `NAME_fine.png`
+/// (wireframe, from that first camera) per mesh into `out`.
 pub fn fish(out: &Path) -> Result<Vec<String>, String> {
     use crate::mesh::{BUNNY_NAME, BUNNY_OBJ};
     use vdlod_core::remesh::RemeshOptions;
@@ -861,6 +880,24 @@ pub fn fish(out: &Path) -> Result<Vec<String>, String> {
             },
         };
         let first = fly_wavelets(&s, &input, &cameras[..1], &coarse)?;
+        // The pictures: the base mesh, the adapted mesh and the finest level from that camera.
+        let wire = Style {
+            wireframe: Some([20, 20, 20]),
+            ..Style::default()
+        };
+        for (picture, frame) in [
+            (
+                "coarse",
+                wavelet_frame(&s, &cameras[0], &ScreenError::new(1e9), &wire)?,
+            ),
+            ("adapted", wavelet_frame(&s, &cameras[0], &coarse, &wire)?),
+            (
+                "fine",
+                wavelet_frame(&s, &cameras[0], &ScreenError::new(1e-6), &wire)?,
+            ),
+        ] {
+            save(out, &format!("{name}_{picture}.png"), &frame_png(&frame)?)?;
+        }
         lines.push(format!(
             "experiment=fish mesh={name} stage=fig13 adaptive_2_10px_faces={} uniform3_faces={} \
              full_faces={} psnr_db={:.2} paper_adaptive_faces=3943 paper_uniform3_faces=12736",
