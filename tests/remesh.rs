@@ -35,7 +35,7 @@ fn fixtures_remesh_onto_themselves() {
         assert!(q.rms < 0.001, "{name}: {q:?}");
         assert!(q.hausdorff < 0.01, "{name}: {q:?}");
         // Flipped triangles are not zero yet (the README says where); they stay rare.
-        assert!(q.flipped * 500 < finest.len() as u32, "{name}: {q:?}");
+        assert!(q.flipped * 4000 < finest.len() as u32, "{name}: {q:?}");
         // The relaxation leaves few slivers.
         assert!(
             q.shapes[..3].iter().sum::<u32>() * 10 < finest.len() as u32,

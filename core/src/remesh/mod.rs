@@ -267,7 +267,7 @@ pub fn remesh(
             core::array::from_fn(|k| (0..3).map(|i| w[i] * f64::from(t[i][k])).sum::<f64>() as f32)
         })
         .collect();
-    relaxed(input, &mut mesh, &mut on_input, base_positions.len());
+    relaxed(input, &mut mesh, &mut on_input);
     mesh.colors = input.colors.map(|colors| {
         on_input
             .iter()
@@ -296,21 +296,17 @@ const RELAX_ROUNDS: u32 = 24;
 /// longer) from the relaxed remesh get a remesh vertex snapped onto them.
 const SNAP_REACH: f64 = 0.003;
 
+/// Rounds over the vertices of triangles still facing the wrong way, at the end.
+const UNTANGLE_ROUNDS: u32 = 64;
+
 /// Passes of snapping (each followed by a few rounds of relaxation).
 const SNAP_PASSES: u32 = 3;
 
-/// Relaxes the finest level on the input (see `relax`), keeping the base vertices and the
-/// border where they are.
-fn relaxed(
-    input: &InputMesh<'_>,
-    mesh: &mut SemiRegular,
-    on_input: &mut [(u32, [f64; 3])],
-    base_vertices: usize,
-) {
+/// Relaxes the finest level on the input (see `relax`), keeping the border where it is.
+fn relaxed(input: &InputMesh<'_>, mesh: &mut SemiRegular, on_input: &mut [(u32, [f64; 3])]) {
     let triangles = mesh.finest_triangles();
     let n = mesh.positions.len();
     let mut fixed = vec![false; n];
-    fixed[..base_vertices].iter_mut().for_each(|f| *f = true);
     // Border vertices: on an edge only one triangle has.
     let mut edges: Vec<(u32, u32)> = triangles
         .iter()
@@ -329,8 +325,9 @@ fn relaxed(
         around: &around,
         triangles: &triangles,
         fixed,
+        snapped: vec![false; n],
     };
-    relax.run(RELAX_ROUNDS, &mut mesh.positions, on_input);
+    relax.run(RELAX_ROUNDS, false, &mut mesh.positions, on_input);
     // Past the chord error a remesh this fine has anyway: its mean edge.
     let edges: f64 = triangles
         .iter()
@@ -349,8 +346,9 @@ fn relaxed(
         if relax.snap(reach, &mut mesh.positions, on_input) == 0 {
             break;
         }
-        relax.run(RELAX_ROUNDS / 4, &mut mesh.positions, on_input);
+        relax.run(RELAX_ROUNDS / 4, false, &mut mesh.positions, on_input);
     }
+    relax.run(UNTANGLE_ROUNDS, true, &mut mesh.positions, on_input);
 }
 
 /// Collapses edges until at most `base_faces` faces are left or none is legal; returns the faces

@@ -7,7 +7,8 @@
 //! plane, and puts it back on the input at the closest point of the triangles around where it
 //! was (a local walk, so a point never jumps across a thin part to the far side). A move is kept
 //! when it leaves fewer triangles around the vertex facing against the input, or as few and none
-//! worse shaped than the worst it had; base vertices and border vertices stay.
+//! worse shaped than the worst it had; border vertices stay, and vertices snapped onto a tip
+//! move only to untangle.
 
 use alloc::vec;
 use alloc::vec::Vec;
@@ -106,8 +107,10 @@ pub(super) struct Relax<'a> {
     pub around: &'a Around,
     /// The remesh's finest triangles.
     pub triangles: &'a [[u32; 3]],
-    /// Vertices that never move (snapped vertices join them).
+    /// Vertices that never move: the border's.
     pub fixed: Vec<bool>,
+    /// Vertices snapped onto a tip: they move only to untangle a triangle facing the wrong way.
+    pub snapped: Vec<bool>,
 }
 
 impl Relax<'_> {
@@ -177,7 +180,7 @@ impl Relax<'_> {
             // The nearest free vertices, nearest first: the first whose move turns no triangle
             // against the input goes.
             let mut nearest: Vec<(f64, usize)> = (0..positions.len())
-                .filter(|&v| !self.fixed[v])
+                .filter(|&v| !self.fixed[v] && !self.snapped[v])
                 .map(|v| {
                     let d = sub(from_f32(positions[v]), target);
                     (dot(d, d), v)
@@ -215,7 +218,7 @@ impl Relax<'_> {
                 if after <= before && gap < distance {
                     positions[v] = target.map(|c| c as f32);
                     on_input[v] = (face, w);
-                    self.fixed[v] = true;
+                    self.snapped[v] = true;
                     moved += 1;
                     break;
                 }
@@ -256,10 +259,12 @@ impl Relax<'_> {
         (against, least)
     }
 
-    /// `rounds` rounds over every free vertex; `on_input` and `positions` are updated together.
+    /// `rounds` rounds over every free vertex (or, with `tangled`, over the vertices of
+    /// triangles facing the wrong way only); `on_input` and `positions` are updated together.
     pub(super) fn run(
         &self,
         rounds: u32,
+        tangled: bool,
         positions: &mut [[f32; 3]],
         on_input: &mut [(u32, [f64; 3])],
     ) {
@@ -272,6 +277,10 @@ impl Relax<'_> {
                     continue;
                 }
                 let tris = around_remesh.of(v);
+                let (before, _) = self.facing(tris, v, None, positions, on_input);
+                if (self.snapped[v as usize] || tangled) && before == 0 {
+                    continue;
+                }
                 let here = from_f32(positions[v as usize]);
                 let mut centroid = [0.0; 3];
                 let mut normal = [0.0; 3];
@@ -298,7 +307,6 @@ impl Relax<'_> {
                 let tangent = sub(towards, scale(normal, dot(towards, normal)));
                 // Kept when fewer triangles around face against the input than before, or as
                 // few and none is worse shaped than the worst was.
-                let (before, _) = self.facing(tris, v, None, positions, on_input);
                 // Half way to the centroid; a vertex of a triangle facing the wrong way also
                 // tries all the way, to untangle it.
                 let steps: &[f64] = if before > 0 { &[0.5, 1.0] } else { &[0.5] };
@@ -308,7 +316,10 @@ impl Relax<'_> {
                     let moved = point(self.corners(face), w);
                     let (after, least) =
                         self.facing(tris, v, Some((moved, face)), positions, on_input);
-                    if after < before || (after == before && least >= worst.min(0.5)) {
+                    // A vertex of a tangle may also move without untangling it yet: the moves
+                    // of its neighbours may.
+                    let drift = before > 0 && after <= before;
+                    if drift || after < before || (after == before && least >= worst.min(0.5)) {
                         positions[v as usize] = moved.map(|x| x as f32);
                         on_input[v as usize] = (face, w);
                         break;
