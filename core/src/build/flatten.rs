@@ -42,8 +42,7 @@ pub struct PlanarCollapse {
 impl PlanarCollapse {
     /// The point of vertex `v`, if it is in the region.
     pub fn uv_of(&self, v: u32) -> Option<Uv> {
-        let k = self.uv.binary_search_by_key(&v, |&(x, _)| x).ok()?;
-        Some(self.uv[k].1)
+        lookup(&self.uv, v)
     }
 
     /// The region after the collapse: the faces that were not on the collapsed edge, with the
@@ -255,6 +254,21 @@ pub fn flatten(
     None
 }
 
+/// The point of `v` in `uv` (sorted by vertex).
+fn lookup(uv: &[(u32, Uv)], v: u32) -> Option<Uv> {
+    let k = uv.binary_search_by_key(&v, |&(x, _)| x).ok()?;
+    Some(uv[k].1)
+}
+
+/// The region's faces after the collapse of `a-b`, the parent named `u32::MAX`.
+fn after_faces(faces: &[[u32; 3]], [a, b]: [u32; 2]) -> Vec<[u32; 3]> {
+    faces
+        .iter()
+        .filter(|t| !(t.contains(&a) && t.contains(&b)))
+        .map(|t| t.map(|x| if x == a || x == b { u32::MAX } else { x }))
+        .collect()
+}
+
 /// Every point sorted by vertex, with the parent's.
 fn finish(mut uv: Vec<(u32, Uv)>) -> Vec<(u32, Uv)> {
     uv.sort_by_key(|&(v, _)| v);
@@ -309,23 +323,15 @@ fn conformal(
     let mut uv = least_squares_conformal(faces, pos, &pinned, &free)?;
     uv.extend_from_slice(&pinned);
     uv = finish(uv);
-    let lookup = |v: u32| {
-        uv.binary_search_by_key(&v, |&(x, _)| x)
-            .ok()
-            .map(|k| uv[k].1)
-    };
-    let p = match parent_on_border(ring, [a, b], &lookup, at, pos)? {
+    let find = |v: u32| lookup(&uv, v);
+    let p = match parent_on_border(ring, [a, b], &find, at, pos)? {
         Some(p) => p,
         None => {
-            let after: Vec<[u32; 3]> = faces
-                .iter()
-                .filter(|t| !(t.contains(&a) && t.contains(&b)))
-                .map(|t| t.map(|x| if x == a || x == b { u32::MAX } else { x }))
-                .collect();
+            let after = after_faces(faces, [a, b]);
             let with_parent = |v: u32| if v == u32::MAX { at } else { pos(v) };
             let fixed: Vec<(u32, Uv)> = ring
                 .iter()
-                .map(|&v| Some((v, lookup(v)?)))
+                .map(|&v| Some((v, find(v)?)))
                 .collect::<Option<_>>()?;
             least_squares_conformal(&after, &with_parent, &fixed, &[u32::MAX])?
                 .first()?
@@ -481,12 +487,7 @@ fn projected(
         .map(|&v| (v, project(pos(v))))
         .collect();
     uv = finish(uv);
-    let lookup = |v: u32| {
-        uv.binary_search_by_key(&v, |&(x, _)| x)
-            .ok()
-            .map(|k| uv[k].1)
-    };
-    let p = match parent_on_border(ring, [a, b], &lookup, at, pos)? {
+    let p = match parent_on_border(ring, [a, b], &|v| lookup(&uv, v), at, pos)? {
         Some(p) => p,
         None => project(at),
     };
@@ -555,12 +556,7 @@ fn convex(
     // Inner vertices: a and b where they are not on the boundary, solved together.
     let inner: Vec<u32> = [a, b].into_iter().filter(|v| !ring.contains(v)).collect();
     let boundary = finish(uv.clone());
-    let known = |v: u32| {
-        boundary
-            .binary_search_by_key(&v, |&(x, _)| x)
-            .ok()
-            .map(|k| boundary[k].1)
-    };
+    let known = |v: u32| lookup(&boundary, v);
     // Row of each inner vertex: its weights' sum, the weight of the other inner vertex, and the
     // weighted sum of its boundary neighbours.
     let mut rows = Vec::with_capacity(2);
@@ -599,26 +595,18 @@ fn convex(
         _ => return None,
     }
     let all = finish(uv.clone());
-    let lookup = |v: u32| {
-        all.binary_search_by_key(&v, |&(x, _)| x)
-            .ok()
-            .map(|k| all[k].1)
-    };
-    let p = match parent_on_border(ring, [a, b], &lookup, at, pos)? {
+    let find = |v: u32| lookup(&all, v);
+    let p = match parent_on_border(ring, [a, b], &find, at, pos)? {
         Some(p) => p,
         None => {
             // Inside the strictly convex polygon at its mean-value combination of the ring.
-            let after: Vec<[u32; 3]> = faces
-                .iter()
-                .filter(|t| !(t.contains(&a) && t.contains(&b)))
-                .map(|t| t.map(|x| if x == a || x == b { u32::MAX } else { x }))
-                .collect();
+            let after = after_faces(faces, [a, b]);
             let fake = |v: u32| if v == u32::MAX { at } else { pos(v) };
             let w = mean_value(u32::MAX, at, &after, &fake);
             let total: f64 = w.iter().map(|(_, x)| x).sum();
             let mut sum = [0.0; 2];
             for &(x, wx) in &w {
-                let p = lookup(x)?;
+                let p = find(x)?;
                 sum = [sum[0] + wx * p[0], sum[1] + wx * p[1]];
             }
             if !(total > 0.0 && total.is_finite()) {
