@@ -297,7 +297,7 @@ const RELAX_ROUNDS: u32 = 24;
 const SNAP_REACH: f64 = 0.003;
 
 /// Rounds over the vertices of triangles still facing the wrong way, at the end.
-const UNTANGLE_ROUNDS: u32 = 64;
+const UNTANGLE_ROUNDS: u32 = 32;
 
 /// Passes of snapping (each followed by a few rounds of relaxation).
 const SNAP_PASSES: u32 = 3;
@@ -320,12 +320,14 @@ fn relaxed(input: &InputMesh<'_>, mesh: &mut SemiRegular, on_input: &mut [(u32, 
         }
     }
     let around = relax::Around::new(input.positions.len(), input.triangles);
+    let surface = crate::build::closest::Surface::new(input.positions, input.triangles);
     let mut relax = relax::Relax {
         input,
         around: &around,
         triangles: &triangles,
         fixed,
         snapped: vec![false; n],
+        surface: &surface,
     };
     relax.run(RELAX_ROUNDS, false, &mut mesh.positions, on_input);
     // Past the chord error a remesh this fine has anyway: its mean edge.

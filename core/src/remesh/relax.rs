@@ -111,6 +111,8 @@ pub(super) struct Relax<'a> {
     pub fixed: Vec<bool>,
     /// Vertices snapped onto a tip: they move only to untangle a triangle facing the wrong way.
     pub snapped: Vec<bool>,
+    /// The input, for distances.
+    pub surface: &'a Surface,
 }
 
 impl Relax<'_> {
@@ -154,7 +156,6 @@ impl Relax<'_> {
         on_input: &mut [(u32, [f64; 3])],
     ) -> u32 {
         let surface = Surface::new(positions, self.triangles);
-        let on = Surface::new(self.input.positions, self.input.triangles);
         let mut far: Vec<(f64, u32)> = self
             .input
             .positions
@@ -201,20 +202,7 @@ impl Relax<'_> {
                     self.facing(tris, v as u32, Some((target, face)), positions, on_input);
                 // Nor may it open a gap wider than the one it closes: the moved triangles'
                 // centroids and edge midpoints stay nearer the input than the vertex was.
-                let gap = tris.iter().fold(0.0f64, |g, &t| {
-                    let c = self.triangles[t as usize].map(|x| {
-                        if x as usize == v {
-                            target
-                        } else {
-                            from_f32(positions[x as usize])
-                        }
-                    });
-                    let mid = |a: Vec3d, b: Vec3d| scale(add(a, b), 0.5);
-                    let centre = scale(add(add(c[0], c[1]), c[2]), 1.0 / 3.0);
-                    [centre, mid(c[0], c[1]), mid(c[1], c[2]), mid(c[2], c[0])]
-                        .iter()
-                        .fold(g, |g, &p| g.max(on.distance(p)))
-                });
+                let gap = self.gap(tris, v as u32, target, positions);
                 if after <= before && gap < distance {
                     positions[v] = target.map(|c| c as f32);
                     on_input[v] = (face, w);
@@ -225,6 +213,25 @@ impl Relax<'_> {
             }
         }
         moved
+    }
+
+    /// The largest distance from the input of the centroids and edge midpoints of the
+    /// triangles `tris` around `v`, with `v` at `at`.
+    fn gap(&self, tris: &[u32], v: u32, at: Vec3d, positions: &[[f32; 3]]) -> f64 {
+        tris.iter().fold(0.0f64, |g, &t| {
+            let c = self.triangles[t as usize].map(|x| {
+                if x == v {
+                    at
+                } else {
+                    from_f32(positions[x as usize])
+                }
+            });
+            let mid = |a: Vec3d, b: Vec3d| scale(add(a, b), 0.5);
+            let centre = scale(add(add(c[0], c[1]), c[2]), 1.0 / 3.0);
+            [centre, mid(c[0], c[1]), mid(c[1], c[2]), mid(c[2], c[0])]
+                .iter()
+                .fold(g, |g, &p| g.max(self.surface.distance(p)))
+        })
     }
 
     /// How many of the triangles `tris` around `v` face against the input, and the worst
@@ -309,21 +316,58 @@ impl Relax<'_> {
                 // few and none is worse shaped than the worst was.
                 // Half way to the centroid; a vertex of a triangle facing the wrong way also
                 // tries all the way, to untangle it.
-                let steps: &[f64] = if before > 0 { &[0.5, 1.0] } else { &[0.5] };
-                for &step in steps {
-                    let target = add(here, scale(tangent, step));
+                // Half way to the centroid; a vertex of a triangle facing the wrong way also
+                // tries all the way, and then half way to each neighbour, to untangle it.
+                let mut targets: Vec<Vec3d> = vec![add(here, scale(tangent, 0.5))];
+                if before > 0 {
+                    targets.push(add(here, tangent));
+                }
+                // In the last rounds over the tangles, half way to each neighbour too (a tip
+                // stays unless the move untangles; it does not wander between neighbours).
+                if tangled && !self.snapped[v as usize] {
+                    for &t in tris {
+                        for &x in &self.triangles[t as usize] {
+                            if x != v {
+                                targets
+                                    .push(scale(add(here, from_f32(positions[x as usize])), 0.5));
+                            }
+                        }
+                    }
+                }
+                let mut best: Option<(u32, u32, [f64; 3], Vec3d)> = None;
+                // In the last rounds an untangling move may not open a gap from the input wider
+                // than there was (measured once a move is worth it).
+                let mut gap = None;
+                for target in targets {
                     let (face, w) = self.project(target, on_input[v as usize].0);
                     let moved = point(self.corners(face), w);
                     let (after, least) =
                         self.facing(tris, v, Some((moved, face)), positions, on_input);
-                    // A vertex of a tangle may also move without untangling it yet: the moves
-                    // of its neighbours may.
-                    let drift = before > 0 && after <= before;
-                    if drift || after < before || (after == before && least >= worst.min(0.5)) {
-                        positions[v as usize] = moved.map(|x| x as f32);
-                        on_input[v as usize] = (face, w);
+                    if before == 0 {
+                        if after == 0 && least >= worst.min(0.5) {
+                            best = Some((after, face, w, moved));
+                        }
                         break;
                     }
+                    // A vertex of a tangle takes the move that leaves fewest triangles facing
+                    // the wrong way, even if no fewer yet: its neighbours' moves may finish it.
+                    let enough = if self.snapped[v as usize] {
+                        after < before
+                    } else {
+                        after <= before
+                    };
+                    if enough
+                        && best.is_none_or(|(a, ..)| after < a)
+                        && (!tangled
+                            || self.gap(tris, v, moved, positions)
+                                <= *gap.get_or_insert_with(|| self.gap(tris, v, here, positions)))
+                    {
+                        best = Some((after, face, w, moved));
+                    }
+                }
+                if let Some((_, face, w, moved)) = best {
+                    positions[v as usize] = moved.map(|x| x as f32);
+                    on_input[v as usize] = (face, w);
                 }
             }
         }
