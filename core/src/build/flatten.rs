@@ -230,14 +230,17 @@ pub fn flatten(
     // The projection cannot keep the polygon when both ends are on it (the parent would have
     // to lie on a straight line through them): that case always takes the convex map.
     let border_edge = on_ring(a).is_some() && on_ring(b).is_some();
+    let region = Region {
+        faces: &faces,
+        ring: &ring,
+        children: [a, b],
+        at,
+        pos,
+    };
     let maps = [
-        (!border_edge)
-            .then(|| conformal(&faces, &ring, [a, b], at, pos))
-            .flatten(),
-        (!border_edge)
-            .then(|| projected(&faces, &ring, [a, b], at, pos))
-            .flatten(),
-        convex(&faces, &ring, [a, b], at, pos),
+        (!border_edge).then(|| conformal(&region)).flatten(),
+        (!border_edge).then(|| projected(&region)).flatten(),
+        convex(&region),
     ];
     for uv in maps.into_iter().flatten() {
         // The parent was pushed as u32::MAX; it is the newest vertex, so under its own id the
@@ -267,6 +270,17 @@ fn after_faces(faces: &[[u32; 3]], [a, b]: [u32; 2]) -> Vec<[u32; 3]> {
         .filter(|t| !(t.contains(&a) && t.contains(&b)))
         .map(|t| t.map(|x| if x == a || x == b { u32::MAX } else { x }))
         .collect()
+}
+
+/// What every map of a collapse reads: the region's faces and boundary loop, the merged
+/// vertices, the parent's position and every vertex's.
+#[derive(Clone, Copy)]
+struct Region<'a> {
+    faces: &'a [[u32; 3]],
+    ring: &'a [u32],
+    children: [u32; 2],
+    at: Vec3d,
+    pos: &'a dyn Fn(u32) -> Vec3d,
 }
 
 /// Every point sorted by vertex, with the parent's.
@@ -307,13 +321,14 @@ fn parent_on_border(
 /// and the parent where the same energy over the triangles after the collapse puts it (or, on a
 /// border, where the boundary fixes it). Isometric where the region is developable, so a region
 /// wrapped round a thin part (a leg, an ear) is unrolled rather than squashed.
-fn conformal(
-    faces: &[[u32; 3]],
-    ring: &[u32],
-    [a, b]: [u32; 2],
-    at: Vec3d,
-    pos: &dyn Fn(u32) -> Vec3d,
-) -> Option<Vec<(u32, Uv)>> {
+fn conformal(region: &Region<'_>) -> Option<Vec<(u32, Uv)>> {
+    let Region {
+        faces,
+        ring,
+        children: [a, b],
+        at,
+        pos,
+    } = *region;
     let ab = len(sub(pos(b), pos(a)));
     let pinned = [(a, [0.0, 0.0]), (b, [ab, 0.0])];
     let mut free: Vec<u32> = faces.iter().flatten().copied().collect();
@@ -455,13 +470,14 @@ fn solve(m: &mut [f64], r: &mut [f64], n: usize) -> Option<Vec<f64>> {
 
 /// The region projected onto its mean plane, the parent at its own position's projection (or,
 /// on a border, where the boundary fixes it).
-fn projected(
-    faces: &[[u32; 3]],
-    ring: &[u32],
-    [a, b]: [u32; 2],
-    at: Vec3d,
-    pos: &dyn Fn(u32) -> Vec3d,
-) -> Option<Vec<(u32, Uv)>> {
+fn projected(region: &Region<'_>) -> Option<Vec<(u32, Uv)>> {
+    let Region {
+        faces,
+        ring,
+        children: [a, b],
+        at,
+        pos,
+    } = *region;
     let mut n = [0.0; 3];
     for t in faces {
         let [p, q, r] = t.map(pos);
@@ -497,13 +513,14 @@ fn projected(
 
 /// The map that cannot fold: the boundary on a convex polygon, inner vertices at mean-value
 /// combinations of their neighbours.
-fn convex(
-    faces: &[[u32; 3]],
-    ring: &[u32],
-    [a, b]: [u32; 2],
-    at: Vec3d,
-    pos: &dyn Fn(u32) -> Vec3d,
-) -> Option<Vec<(u32, Uv)>> {
+fn convex(region: &Region<'_>) -> Option<Vec<(u32, Uv)>> {
+    let Region {
+        faces,
+        ring,
+        children: [a, b],
+        at,
+        pos,
+    } = *region;
     let m = ring.len();
     let length = |i: usize| len(sub(pos(ring[(i + 1) % m]), pos(ring[i])));
     let mut uv: Vec<(u32, Uv)> = Vec::with_capacity(m + 3);
