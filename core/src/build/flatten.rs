@@ -8,9 +8,9 @@
 //! the input surface, one collapse at a time (Lee, Sweldens, Schröder, Cowsar and Dobkin's MAPS,
 //! 1998, does the same per removed vertex with a conformal map of its star).
 //!
-//! [`flatten`] builds both maps. Where the region is nearly flat it projects it onto its mean
-//! plane (no distortion beyond the projection's); when that folds a triangle, it falls back to a
-//! map that cannot fold: the boundary on a convex polygon (a circle, spaced by the 3D lengths of
+//! [`flatten`] builds both maps. It tries a least-squares conformal map first (it unrolls a
+//! region wrapped round a thin part), then the projection onto the region's mean plane, and
+//! last a map that cannot fold: the boundary on a convex polygon (a circle, spaced by the 3D lengths of
 //! its edges; a straight side for the border edge of an open mesh) and the inner vertices at
 //! Floater's mean-value combinations of their neighbours ("Mean value coordinates", 2003), which
 //! Tutte's theorem makes an embedding. Both maps are checked triangle by triangle before they are
@@ -234,6 +234,7 @@ pub fn flatten(
         faces: &faces,
         ring: &ring,
         children: [a, b],
+        parent,
         at,
         pos,
     };
@@ -243,13 +244,7 @@ pub fn flatten(
         convex(&region),
     ];
     for uv in maps.into_iter().flatten() {
-        // The parent was pushed as u32::MAX; it is the newest vertex, so under its own id the
-        // list stays sorted.
-        collapse.uv = uv
-            .into_iter()
-            .map(|(v, p)| (if v == u32::MAX { parent } else { v }, p))
-            .collect();
-        collapse.uv.sort_by_key(|&(v, _)| v);
+        collapse.uv = uv;
         if valid(&collapse, &ring) {
             return Some(collapse);
         }
@@ -273,12 +268,13 @@ fn after_faces(faces: &[[u32; 3]], [a, b]: [u32; 2]) -> Vec<[u32; 3]> {
 }
 
 /// What every map of a collapse reads: the region's faces and boundary loop, the merged
-/// vertices, the parent's position and every vertex's.
+/// vertices, the parent and its position, and every other vertex's.
 #[derive(Clone, Copy)]
 struct Region<'a> {
     faces: &'a [[u32; 3]],
     ring: &'a [u32],
     children: [u32; 2],
+    parent: u32,
     at: Vec3d,
     pos: &'a dyn Fn(u32) -> Vec3d,
 }
@@ -290,30 +286,39 @@ fn finish(mut uv: Vec<(u32, Uv)>) -> Vec<(u32, Uv)> {
     uv
 }
 
-/// The parent's point where the boundary fixes it: on a border, where the collapse keeps the
-/// polygon the same.
-fn parent_on_border(
-    ring: &[u32],
-    [a, b]: [u32; 2],
-    uv: &dyn Fn(u32) -> Option<Uv>,
-    at: Vec3d,
-    pos: &dyn Fn(u32) -> Vec3d,
-) -> Option<Option<Uv>> {
-    let (ia, ib) = (ring.contains(&a), ring.contains(&b));
-    Some(match (ia, ib) {
-        (false, false) => None,
-        (true, false) => Some(uv(a)?),
-        (false, true) => Some(uv(b)?),
+/// `uv` (the region's points) sorted, with the parent's point: on a border where the boundary
+/// fixes it (so the collapse keeps the polygon the same), inside where `inside` puts it.
+fn with_parent(
+    region: &Region<'_>,
+    uv: Vec<(u32, Uv)>,
+    inside: impl FnOnce(&[(u32, Uv)]) -> Option<Uv>,
+) -> Option<Vec<(u32, Uv)>> {
+    let Region {
+        ring,
+        children: [a, b],
+        at,
+        pos,
+        ..
+    } = *region;
+    let mut uv = finish(uv);
+    let p = match (ring.contains(&a), ring.contains(&b)) {
+        (false, false) => inside(&uv)?,
+        (true, false) => lookup(&uv, a)?,
+        (false, true) => lookup(&uv, b)?,
         (true, true) => {
             // Both on the border: the parent on the segment between them, where it lies along
             // the edge in 3D.
-            let (pa, pb) = (uv(a)?, uv(b)?);
+            let (pa, pb) = (lookup(&uv, a)?, lookup(&uv, b)?);
             let (da, db) = (len(sub(at, pos(a))), len(sub(at, pos(b))));
             let t = if da + db > 0.0 { da / (da + db) } else { 0.5 };
             let t = t.clamp(0.05, 0.95);
-            Some([pa[0] + t * (pb[0] - pa[0]), pa[1] + t * (pb[1] - pa[1])])
+            [pa[0] + t * (pb[0] - pa[0]), pa[1] + t * (pb[1] - pa[1])]
         }
-    })
+    };
+    uv.push((region.parent, p));
+    // The parent is the newest vertex, so this is already sorted; kept sorted regardless.
+    uv.sort_by_key(|&(v, _)| v);
+    Some(uv)
 }
 
 /// The least-squares conformal map (Lévy, Petitjean, Ray and Maillot, "Least squares conformal
@@ -328,6 +333,7 @@ fn conformal(region: &Region<'_>) -> Option<Vec<(u32, Uv)>> {
         children: [a, b],
         at,
         pos,
+        ..
     } = *region;
     let ab = len(sub(pos(b), pos(a)));
     let pinned = [(a, [0.0, 0.0]), (b, [ab, 0.0])];
@@ -337,24 +343,19 @@ fn conformal(region: &Region<'_>) -> Option<Vec<(u32, Uv)>> {
     free.retain(|&v| v != a && v != b);
     let mut uv = least_squares_conformal(faces, pos, &pinned, &free)?;
     uv.extend_from_slice(&pinned);
-    uv = finish(uv);
-    let find = |v: u32| lookup(&uv, v);
-    let p = match parent_on_border(ring, [a, b], &find, at, pos)? {
-        Some(p) => p,
-        None => {
-            let after = after_faces(faces, [a, b]);
-            let with_parent = |v: u32| if v == u32::MAX { at } else { pos(v) };
-            let fixed: Vec<(u32, Uv)> = ring
-                .iter()
-                .map(|&v| Some((v, find(v)?)))
-                .collect::<Option<_>>()?;
+    with_parent(region, uv, |uv| {
+        let after = after_faces(faces, [a, b]);
+        let with_parent = |v: u32| if v == u32::MAX { at } else { pos(v) };
+        let fixed: Vec<(u32, Uv)> = ring
+            .iter()
+            .map(|&v| Some((v, lookup(uv, v)?)))
+            .collect::<Option<_>>()?;
+        Some(
             least_squares_conformal(&after, &with_parent, &fixed, &[u32::MAX])?
                 .first()?
-                .1
-        }
-    };
-    uv.push((u32::MAX, p));
-    Some(uv)
+                .1,
+        )
+    })
 }
 
 /// The points of the `free` vertices minimising the conformal energy of `faces` (each
@@ -473,10 +474,10 @@ fn solve(m: &mut [f64], r: &mut [f64], n: usize) -> Option<Vec<f64>> {
 fn projected(region: &Region<'_>) -> Option<Vec<(u32, Uv)>> {
     let Region {
         faces,
-        ring,
-        children: [a, b],
+        children: [a, _],
         at,
         pos,
+        ..
     } = *region;
     let mut n = [0.0; 3];
     for t in faces {
@@ -497,18 +498,12 @@ fn projected(region: &Region<'_>) -> Option<Vec<(u32, Uv)>> {
         let d = sub(p, origin);
         [dot(d, u), dot(d, w)]
     };
-    let mut uv: Vec<(u32, Uv)> = faces
+    let uv: Vec<(u32, Uv)> = faces
         .iter()
         .flatten()
         .map(|&v| (v, project(pos(v))))
         .collect();
-    uv = finish(uv);
-    let p = match parent_on_border(ring, [a, b], &|v| lookup(&uv, v), at, pos)? {
-        Some(p) => p,
-        None => project(at),
-    };
-    uv.push((u32::MAX, p));
-    Some(uv)
+    with_parent(region, uv, |_| Some(project(at)))
 }
 
 /// The map that cannot fold: the boundary on a convex polygon, inner vertices at mean-value
@@ -520,6 +515,7 @@ fn convex(region: &Region<'_>) -> Option<Vec<(u32, Uv)>> {
         children: [a, b],
         at,
         pos,
+        ..
     } = *region;
     let m = ring.len();
     let length = |i: usize| len(sub(pos(ring[(i + 1) % m]), pos(ring[i])));
@@ -611,30 +607,19 @@ fn convex(region: &Region<'_>) -> Option<Vec<(u32, Uv)>> {
         }
         _ => return None,
     }
-    let all = finish(uv.clone());
-    let find = |v: u32| lookup(&all, v);
-    let p = match parent_on_border(ring, [a, b], &find, at, pos)? {
-        Some(p) => p,
-        None => {
-            // Inside the strictly convex polygon at its mean-value combination of the ring.
-            let after = after_faces(faces, [a, b]);
-            let fake = |v: u32| if v == u32::MAX { at } else { pos(v) };
-            let w = mean_value(u32::MAX, at, &after, &fake);
-            let total: f64 = w.iter().map(|(_, x)| x).sum();
-            let mut sum = [0.0; 2];
-            for &(x, wx) in &w {
-                let p = find(x)?;
-                sum = [sum[0] + wx * p[0], sum[1] + wx * p[1]];
-            }
-            if !(total > 0.0 && total.is_finite()) {
-                return None;
-            }
-            scale2(sum, 1.0 / total)
+    with_parent(region, uv, |uv| {
+        // Inside the strictly convex polygon at its mean-value combination of the ring.
+        let after = after_faces(faces, [a, b]);
+        let fake = |v: u32| if v == u32::MAX { at } else { pos(v) };
+        let w = mean_value(u32::MAX, at, &after, &fake);
+        let total: f64 = w.iter().map(|(_, x)| x).sum();
+        let mut sum = [0.0; 2];
+        for &(x, wx) in &w {
+            let p = lookup(uv, x)?;
+            sum = [sum[0] + wx * p[0], sum[1] + wx * p[1]];
         }
-    };
-    let mut uv = all;
-    uv.push((u32::MAX, p));
-    Some(uv)
+        (total > 0.0 && total.is_finite()).then(|| scale2(sum, 1.0 / total))
+    })
 }
 
 fn scale2(p: Uv, s: f64) -> Uv {

@@ -328,6 +328,8 @@ fn relaxed(input: &InputMesh<'_>, mesh: &mut SemiRegular, on_input: &mut [(u32, 
         fixed,
         snapped: vec![false; n],
         surface: &surface,
+        normals: relax::Relax::normals(input),
+        around_remesh: relax::Around::new(n, &triangles),
     };
     relax.run(RELAX_ROUNDS, false, &mut mesh.positions, on_input);
     // Past the chord error a remesh this fine has anyway: its mean edge.
@@ -396,11 +398,6 @@ fn unwind(
     let every = (total / 200).max(1);
     let mut worst = 0.0f64;
     for (done, step) in planar.iter().rev().enumerate() {
-        let before: Vec<(u32, [Uv; 3])> = step
-            .before
-            .iter()
-            .filter_map(|&(f, t)| Some((f, corners(step, t)?)))
-            .collect();
         // All the region's points leave their faces first: the faces before and after share
         // ids, and a point placed in one must not be moved again.
         let mut moving: Vec<(u32, Uv)> = Vec::new();
@@ -414,6 +411,14 @@ fn unwind(
                 moving.push((i, uv));
             }
         }
+        let before: Vec<(u32, [Uv; 3])> = if moving.is_empty() {
+            Vec::new()
+        } else {
+            step.before
+                .iter()
+                .filter_map(|&(f, t)| Some((f, corners(step, t)?)))
+                .collect()
+        };
         for (i, uv) in moving {
             let p = &mut points[i as usize];
             match locate(&before, uv) {

@@ -9,7 +9,7 @@
 use super::Remesh;
 use crate::build::closest::Surface;
 use crate::build::vec3::{cross, dot, from_f32, len, normalize, sub, Vec3d};
-use crate::build::InputMesh;
+use crate::build::{validate, InputMesh};
 
 /// A remesh measured against its input.
 #[derive(Clone, Debug, PartialEq)]
@@ -32,9 +32,22 @@ pub struct Quality {
 }
 
 impl Remesh {
-    /// Measures this remesh against `input`, the mesh it was made from.
+    /// Measures this remesh against `input`, the mesh it was made from. Against a mesh that is
+    /// not valid input or has fewer triangles than this remesh's places name, the distances are
+    /// infinite and nothing else is measured.
     #[must_use]
     pub fn quality(&self, input: &InputMesh<'_>) -> Quality {
+        let faces = input.triangles.len();
+        if validate(input).is_err() || self.on_input.iter().any(|&(f, _)| f as usize >= faces) {
+            return Quality {
+                hausdorff: f64::INFINITY,
+                rms: f64::INFINITY,
+                flipped: 0,
+                shapes: [0; 10],
+                samples: 0,
+                farthest: ([0.0; 3], true),
+            };
+        }
         let finest = self.mesh.finest_triangles();
         let positions = &self.mesh.positions;
         let to_input = Surface::new(input.positions, input.triangles);

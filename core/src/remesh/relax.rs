@@ -113,6 +113,10 @@ pub(super) struct Relax<'a> {
     pub snapped: Vec<bool>,
     /// The input, for distances.
     pub surface: &'a Surface,
+    /// The input triangles' unit normals.
+    pub normals: Vec<Vec3d>,
+    /// The remesh's triangles around each of its vertices.
+    pub around_remesh: Around,
 }
 
 impl Relax<'_> {
@@ -120,9 +124,16 @@ impl Relax<'_> {
         self.input.triangles[f as usize].map(|v| from_f32(self.input.positions[v as usize]))
     }
 
-    fn normal(&self, f: u32) -> Vec3d {
-        let t = self.corners(f);
-        normalize(cross(sub(t[1], t[0]), sub(t[2], t[0]))).unwrap_or([0.0; 3])
+    /// The unit normals of `input`'s triangles (zero for a degenerate one).
+    pub(super) fn normals(input: &InputMesh<'_>) -> Vec<Vec3d> {
+        input
+            .triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|v| from_f32(input.positions[v as usize]));
+                normalize(cross(sub(b, a), sub(c, a))).unwrap_or([0.0; 3])
+            })
+            .collect()
     }
 
     /// The closest point to `p` on the input triangles around `face`, walking on while a
@@ -165,7 +176,6 @@ impl Relax<'_> {
             .filter(|&(d, _)| d > reach)
             .collect();
         far.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
-        let around_remesh = Around::new(positions.len(), self.triangles);
         let mut moved = 0;
         for (distance, x) in far {
             let Some(&face) = self.around.of(x).first() else {
@@ -196,7 +206,7 @@ impl Relax<'_> {
             nearest.truncate(tried);
             nearest.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
             for (_, v) in nearest {
-                let tris = around_remesh.of(v as u32);
+                let tris = self.around_remesh.of(v as u32);
                 let (before, _) = self.facing(tris, v as u32, None, positions, on_input);
                 let (after, _) =
                     self.facing(tris, v as u32, Some((target, face)), positions, on_input);
@@ -258,7 +268,7 @@ impl Relax<'_> {
                     Some((_, face)) if x == v => face,
                     _ => on_input[x as usize].0,
                 };
-                add(s, self.normal(f))
+                add(s, self.normals[f as usize])
             });
             against += u32::from(dot(n, seen) <= 0.0);
             least = least.min(shape(c));
@@ -277,13 +287,13 @@ impl Relax<'_> {
     ) {
         let n = positions.len();
         // Triangles around each remesh vertex, flat.
-        let around_remesh = Around::new(n, self.triangles);
+        let mut targets: Vec<Vec3d> = Vec::new();
         for _ in 0..rounds {
             for v in 0..n as u32 {
                 if self.fixed[v as usize] {
                     continue;
                 }
-                let tris = around_remesh.of(v);
+                let tris = self.around_remesh.of(v);
                 let (before, _) = self.facing(tris, v, None, positions, on_input);
                 if (self.snapped[v as usize] || tangled) && before == 0 {
                     continue;
@@ -312,13 +322,11 @@ impl Relax<'_> {
                 }
                 let towards = sub(scale(centroid, 1.0 / count), here);
                 let tangent = sub(towards, scale(normal, dot(towards, normal)));
-                // Kept when fewer triangles around face against the input than before, or as
-                // few and none is worse shaped than the worst was.
                 // Half way to the centroid; a vertex of a triangle facing the wrong way also
-                // tries all the way, to untangle it.
-                // Half way to the centroid; a vertex of a triangle facing the wrong way also
-                // tries all the way, and then half way to each neighbour, to untangle it.
-                let mut targets: Vec<Vec3d> = vec![add(here, scale(tangent, 0.5))];
+                // tries all the way. A move is kept when it leaves fewer triangles around facing
+                // against the input, or as few and none worse shaped than the worst was.
+                targets.clear();
+                targets.push(add(here, scale(tangent, 0.5)));
                 if before > 0 {
                     targets.push(add(here, tangent));
                 }
@@ -338,7 +346,7 @@ impl Relax<'_> {
                 // In the last rounds an untangling move may not open a gap from the input wider
                 // than there was (measured once a move is worth it).
                 let mut gap = None;
-                for target in targets {
+                for &target in &targets {
                     let (face, w) = self.project(target, on_input[v as usize].0);
                     let moved = point(self.corners(face), w);
                     let (after, least) =

@@ -141,6 +141,10 @@ fn bad_requests_are_typed_errors() {
     assert!(matches!(ask(2, 2), Err(RemeshError::BaseSize { .. })));
     assert_eq!(ask(20, 0).unwrap_err(), RemeshError::Levels(0));
     assert_eq!(ask(20, 13).unwrap_err(), RemeshError::Levels(13));
+    // Measured against the wrong mesh: no panic, infinite distances.
+    let out = ask(40, 1).unwrap();
+    let tiny = input(&p[..4], &t[..1]);
+    assert_eq!(out.quality(&tiny).hausdorff, f64::INFINITY);
     // A non-manifold edge: three triangles on 0-1.
     let p3 = [
         [0.0, 0.0, 0.0],
