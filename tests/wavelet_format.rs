@@ -18,7 +18,7 @@ fn sphere_bytes() -> &'static [u8] {
 }
 
 /// An open mesh: a square of two faces, subdivided twice, so borders are covered too.
-fn square_bytes() -> Vec<u8> {
+fn square() -> SemiRegular {
     let base = [
         [0.0, 0.0, 0.0],
         [1.0, 0.0, 0.0],
@@ -32,8 +32,15 @@ fn square_bytes() -> Vec<u8> {
         [p[0], p[1], 0.1 * (p[0] * 7.0).sin() * (p[1] * 5.0).cos()]
     })
     .unwrap()
-    .to_bytes()
-    .unwrap()
+}
+
+fn square_bytes() -> Vec<u8> {
+    square().to_bytes().unwrap()
+}
+
+/// The square as a height field (z up).
+fn heights_bytes() -> Vec<u8> {
+    square().to_height_bytes(2).unwrap()
 }
 
 /// Flies a small cut over whatever parsed; its invariants hold after every frame (on a mesh
@@ -74,6 +81,38 @@ fn valid_files_parse_and_fly() {
     let view = SemiRegularView::parse(&square).unwrap();
     assert_eq!(view.counts().base_edges, 5);
     fly(&view);
+    let heights = heights_bytes();
+    let view = SemiRegularView::parse(&heights).unwrap();
+    assert!(view.is_height_field());
+    fly(&view);
+}
+
+#[test]
+fn a_height_fields_header_is_checked() {
+    let good = heights_bytes();
+    let forge = |at: usize, value: u8| {
+        let mut bytes = good.clone();
+        bytes[at] = value;
+        reseal(&mut bytes);
+        SemiRegularView::parse(&bytes).err()
+    };
+    // Up axis 3, no fine level, more fine levels than levels, a reserved byte set.
+    for (at, value) in [(56, 3), (57, 0), (57, 3), (58, 1)] {
+        assert!(
+            matches!(forge(at, value), Some(SemiRegularError::BadCounts(_))),
+            "byte {at} = {value}"
+        );
+    }
+    // Hoppe's bounds have no place in a height field.
+    assert!(matches!(
+        forge(6, 4 | 2),
+        Some(SemiRegularError::BadCounts(_))
+    ));
+    // Fewer fine levels mean more coarse records: the sizes no longer match.
+    assert!(matches!(
+        forge(57, 1),
+        Some(SemiRegularError::Truncated { .. } | SemiRegularError::TrailingBytes { .. })
+    ));
 }
 
 #[test]
@@ -126,9 +165,13 @@ proptest! {
     fn corrupted_files_are_rejected_or_flyable(
         edits in prop::collection::vec((any::<prop::sample::Index>(), any::<u8>()), 1..8),
         resealed in any::<bool>(),
-        square in any::<bool>(),
+        kind in 0..3u8,
     ) {
-        let mut bytes = if square { square_bytes() } else { sphere_bytes().to_vec() };
+        let mut bytes = match kind {
+            0 => sphere_bytes().to_vec(),
+            1 => square_bytes(),
+            _ => heights_bytes(),
+        };
         for (at, value) in &edits {
             let i = at.index(bytes.len());
             bytes[i] = *value;

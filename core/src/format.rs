@@ -381,7 +381,6 @@ impl ModelBox {
     }
 
     /// The length unit of the bound codes.
-    #[cfg(feature = "build")]
     pub(crate) fn unit(&self) -> f32 {
         self.unit
     }

@@ -747,7 +747,7 @@ fn terrain_command(args: TerrainArgs) -> Result<(), String> {
                     land.width, land.depth
                 )
             })?
-            .to_bytes()
+            .to_height_bytes(terrain::UP_AXIS)
             .map_err(|e| format!("{name}: {e}"))?,
     };
     say!(

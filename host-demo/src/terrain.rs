@@ -25,6 +25,10 @@ pub const MAX_SAMPLES: usize = 2049 * 2049;
 /// The default vertical scale: a white pixel stands a tenth of the width high.
 pub const DEFAULT_VERTICAL_SCALE: f32 = 0.1;
 
+/// The coordinate axis heights stand along (`y`): what a terrain's semi-regular file is a height
+/// field over ([`vdlod_core::wavelet::SemiRegular::to_height_bytes`]).
+pub const UP_AXIS: usize = 1;
+
 /// A height field with optional colours, row by row.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Terrain {

@@ -38,7 +38,7 @@ use crate::hierarchy::build_with_progress;
 use crate::lod::{new_triangles, psnr, triangle_set};
 use crate::mesh::IndexedMesh;
 use crate::render::style;
-use crate::terrain::{FlyOver, Terrain, DEFAULT_VERTICAL_SCALE};
+use crate::terrain::{FlyOver, Terrain, DEFAULT_VERTICAL_SCALE, UP_AXIS};
 use crate::wavelet::{mean, median, DemoWaveletCut};
 
 /// The terrain's seed (the `terrain` command's default).
@@ -123,6 +123,8 @@ pub(crate) struct Flight {
     pub(crate) drawn: Style,
     pub(crate) sbytes: Vec<u8>,
     pub(crate) hbytes: Vec<u8>,
+    /// The two files' sizes without their colours: heights (or positions) and hierarchy.
+    pub(crate) shape_bytes: [usize; 2],
     pub(crate) wavelet_build_s: f64,
     pub(crate) forest_build_s: f64,
 }
@@ -140,13 +142,19 @@ impl Flight {
             .semi_regular()
             .ok_or("the terrain is not 2^k + 1 samples square")?;
         let start = Instant::now();
-        let sbytes = semi.to_bytes().map_err(|e| e.to_string())?;
+        let sbytes = semi.to_height_bytes(UP_AXIS).map_err(|e| e.to_string())?;
         let wavelet_build_s = start.elapsed().as_secs_f64();
         drop(semi);
         let mut full = land.mesh();
-        let (_, hbytes, forest_build_s) =
+        let (hierarchy, hbytes, forest_build_s) =
             build_with_progress(&full, &BuildOptions::default(), progress)
                 .map_err(|e| format!("terrain: {e}"))?;
+        let colours = if land.colors.is_some() {
+            3 * side * side
+        } else {
+            0
+        };
+        let shape_bytes = [sbytes.len() - colours, hierarchy.to_bytes(false).len()];
         full.reorder_for_locality();
         let fly_over = FlyOver::new(&land, frames, width, height);
         Ok(Flight {
@@ -158,6 +166,7 @@ impl Flight {
             },
             sbytes,
             hbytes,
+            shape_bytes,
             wavelet_build_s,
             forest_build_s,
             land,
@@ -200,6 +209,7 @@ pub fn terrain_engines(out: &Path, setup: Setup) -> Result<Vec<String>, String> 
         drawn,
         sbytes,
         hbytes,
+        shape_bytes,
         wavelet_build_s,
         forest_build_s,
         ..
@@ -292,14 +302,14 @@ pub fn terrain_engines(out: &Path, setup: Setup) -> Result<Vec<String>, String> 
     let engines = [
         (
             "wavelet",
-            sbytes.len(),
+            [sbytes.len(), shape_bytes[0]],
             DemoWaveletCut::BYTES,
             60_000,
             wavelet_build_s,
         ),
         (
             "forest",
-            hbytes.len(),
+            [hbytes.len(), shape_bytes[1]],
             ForestCut::BYTES,
             32_000,
             forest_build_s,
@@ -313,13 +323,14 @@ pub fn terrain_engines(out: &Path, setup: Setup) -> Result<Vec<String>, String> 
             .map(|f| 100.0 * f.new as f64 / f.triangles.max(1) as f64)
             .collect();
         lines.push(format!(
-            "experiment=terrain-engines engine={engine} grid={side}x{side} frames={count} triangles_mean={:.0} psnr_db_mean={:.2} new_triangles_pct_median={:.2} new_triangles_pct_max={:.2} adapt_us_median={:.0} build_s={build_s:.2} file_bytes_per_sample={:.2} cut_bytes_per_triangle={:.1}",
+            "experiment=terrain-engines engine={engine} grid={side}x{side} frames={count} triangles_mean={:.0} psnr_db_mean={:.2} new_triangles_pct_median={:.2} new_triangles_pct_max={:.2} adapt_us_median={:.0} build_s={build_s:.2} file_bytes_per_sample={:.2} without_colors_bytes_per_sample={:.3} cut_bytes_per_triangle={:.1}",
             mean(after_first().map(|f| f.triangles as f64)),
             mean(after_first().map(|f| f.psnr_db.min(99.0))),
             median(new_pct.clone()),
             new_pct.iter().copied().fold(0.0, f64::max),
             median(after_first().map(|f| f.adapt_us).collect()),
-            file as f64 / samples,
+            file[0] as f64 / samples,
+            file[1] as f64 / samples,
             cut as f64 / capacity as f64,
         ));
     }
@@ -509,8 +520,16 @@ mod tests {
             assert!(new <= v[1].parse().unwrap());
         }
         assert!((field(w, "triangles_mean") - field(f, "triangles_mean")).abs() <= 1.0);
-        // Heights on a grid need no connectivity: the wavelet file is the smaller.
+        // Heights on a grid need no connectivity: the wavelet file is the smaller, two bytes a
+        // sample and under a tenth of hierarchy and header beside the colours on a grid this
+        // small.
         assert!(field(w, "file_bytes_per_sample") < field(f, "file_bytes_per_sample"));
+        let heights = field(w, "without_colors_bytes_per_sample");
+        assert!(heights > 2.0 && heights <= 2.1, "{w}");
+        assert!(
+            (field(w, "file_bytes_per_sample") - heights - 3.0).abs() < 0.01,
+            "{w}"
+        );
         for line in &lines {
             let pct = field(line, "new_triangles_pct_median");
             assert!((0.0..=100.0).contains(&pct), "{line}");

@@ -209,7 +209,7 @@ pub fn textures(out: &Path, setup: Setup, pictured: u32) -> Result<Vec<String>, 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::terrain::{Terrain, DEFAULT_VERTICAL_SCALE};
+    use crate::terrain::{Terrain, DEFAULT_VERTICAL_SCALE, UP_AXIS};
     use crate::wavelet::DemoWaveletCut;
     use vdlod::Orbit;
     use vdlod_core::adapt::Budget;
@@ -223,7 +223,11 @@ mod tests {
         // its wavelet stands, has the coordinates of the sample its lattice point names.
         let side = 17;
         let land = Terrain::procedural(side, 3, DEFAULT_VERTICAL_SCALE);
-        let bytes = land.semi_regular().unwrap().to_bytes().unwrap();
+        let bytes = land
+            .semi_regular()
+            .unwrap()
+            .to_height_bytes(UP_AXIS)
+            .unwrap();
         let s = SemiRegularView::parse(&bytes).unwrap();
         let base_uvs: Vec<Uv> = (0..s.counts().base_vertices)
             .map(|v| planar(s.position(v), side))

@@ -58,6 +58,9 @@ pub enum SemiRegularBuildError {
         /// What the levels and base mesh need.
         needed: usize,
     },
+    /// Asked for a height field ([`SemiRegular::to_height_bytes`]): the up axis is not 0 to 2,
+    /// or this vertex does not lie over the point of its base face that its weights name.
+    NotHeightField(u32),
 }
 
 impl fmt::Display for SemiRegularBuildError {
@@ -73,6 +76,11 @@ impl fmt::Display for SemiRegularBuildError {
             Self::TooLarge => write!(f, "levels must be 1 to 12 and the mesh below 2^31 vertices"),
             Self::NotFinite(v) => write!(f, "vertex {v}'s position is not finite"),
             Self::Count { given, needed } => write!(f, "{given} values given, {needed} needed"),
+            Self::NotHeightField(v) => write!(
+                f,
+                "not a height field: vertex {v} does not lie over its point of the base face \
+                 (or the up axis is not 0, 1 or 2)"
+            ),
         }
     }
 }
@@ -210,10 +218,27 @@ fn file_bytes(
     hoppe: bool,
     model: &ModelBox,
 ) -> Vec<u8> {
+    let flags = if colors.is_some() { FLAG_COLORS } else { 0 } | if hoppe { FLAG_HOPPE } else { 0 };
+    let mut out = header(counts, flags, model);
+    out.extend_from_slice(faces);
+    out.extend_from_slice(edges);
+    for r in records {
+        out.extend_from_slice(r);
+    }
+    if let Some(c) = colors {
+        for x in c {
+            out.extend_from_slice(x);
+        }
+    }
+    seal(&mut out);
+    out
+}
+
+/// A header with `counts`, `flags` and `model`, the checksum not yet filled in.
+pub(super) fn header(counts: Counts, flags: u16, model: &ModelBox) -> Vec<u8> {
     let mut out = vec![0u8; HEADER_SIZE];
     out[0..4].copy_from_slice(&MAGIC);
     out[4..6].copy_from_slice(&VERSION.to_le_bytes());
-    let flags = if colors.is_some() { FLAG_COLORS } else { 0 } | if hoppe { FLAG_HOPPE } else { 0 };
     out[6..8].copy_from_slice(&flags.to_le_bytes());
     for (k, v) in [
         counts.levels,
@@ -227,19 +252,23 @@ fn file_bytes(
         out[8 + 4 * k..12 + 4 * k].copy_from_slice(&v.to_le_bytes());
     }
     model.write(&mut out, super::format::BOX_OFFSET);
-    out.extend_from_slice(faces);
-    out.extend_from_slice(edges);
-    for r in records {
-        out.extend_from_slice(r);
+    out
+}
+
+/// The code of a cone of half-angle `angle` (radians): its sine rounded up, 255 past a right
+/// angle.
+pub(super) fn cone_code(angle: f32) -> u8 {
+    if angle >= core::f32::consts::FRAC_PI_2 {
+        255
+    } else {
+        libm::ceilf(libm::sinf(angle) * 255.0).clamp(0.0, 255.0) as u8
     }
-    if let Some(c) = colors {
-        for x in c {
-            out.extend_from_slice(x);
-        }
-    }
+}
+
+/// Fills in the checksum of everything after the header.
+pub(super) fn seal(out: &mut [u8]) {
     let crc = crc32(&out[HEADER_SIZE..]);
     out[CRC_OFFSET..CRC_OFFSET + 4].copy_from_slice(&crc.to_le_bytes());
-    out
 }
 
 impl SemiRegular {
@@ -427,8 +456,19 @@ impl SemiRegular {
 
     /// The lattice of this mesh (every record zero); `from_fn` validated these bytes, so this
     /// is never `None`.
-    fn view(&self) -> Option<SemiRegularView<'_>> {
+    pub(super) fn view(&self) -> Option<SemiRegularView<'_>> {
         SemiRegularView::parse(&self.skeleton).ok()
+    }
+
+    /// The file's face and edge sections.
+    pub(super) fn topology_bytes(&self) -> (&[u8], &[u8]) {
+        let faces_at = HEADER_SIZE;
+        let edges_at = faces_at + self.counts.base_faces as usize * FACE_SIZE;
+        let records_at = edges_at + self.counts.base_edges as usize * super::format::EDGE_SIZE;
+        (
+            &self.skeleton[faces_at..edges_at],
+            &self.skeleton[edges_at..records_at],
+        )
     }
 
     /// The header's counts.
@@ -470,11 +510,7 @@ impl SemiRegular {
             }
         }
         let model = ModelBox::around(self.positions.iter().copied());
-        let faces_at = HEADER_SIZE;
-        let edges_at = faces_at + counts.base_faces as usize * FACE_SIZE;
-        let records_at = edges_at + counts.base_edges as usize * super::format::EDGE_SIZE;
-        let face_bytes = &self.skeleton[faces_at..edges_at];
-        let edge_bytes = &self.skeleton[edges_at..records_at];
+        let (face_bytes, edge_bytes) = self.topology_bytes();
         // Quantized positions first: every bound is measured on what the file will hold.
         let quantized: Vec<[u16; 3]> = self.positions.iter().map(|&p| model.quantize(p)).collect();
         let positions: Vec<[f32; 3]> = quantized.iter().map(|&q| model.dequantize(q)).collect();
@@ -510,11 +546,7 @@ impl SemiRegular {
             };
             r[9] = encode_length(a / model.unit());
             r[10] = encode_length(bb / model.unit());
-            r[11] = if b.cone >= core::f32::consts::FRAC_PI_2 {
-                255
-            } else {
-                libm::ceilf(libm::sinf(b.cone) * 255.0).clamp(0.0, 255.0) as u8
-            };
+            r[11] = cone_code(b.cone);
         }
         Ok(file_bytes(
             counts,
@@ -607,15 +639,15 @@ fn vertex_normals(view: &SemiRegularView<'_>, positions: &[[f32; 3]]) -> Vec<[f3
 
 /// One wavelet's bounds before encoding.
 #[derive(Clone, Copy, Debug, Default)]
-struct WaveletBounds {
-    radius: f32,
-    a: f32,
-    b: f32,
+pub(super) struct WaveletBounds {
+    pub(super) radius: f32,
+    pub(super) a: f32,
+    pub(super) b: f32,
     /// Hoppe's `delta` (largest error along the normal) and `mu` (largest across it).
-    delta: f32,
-    mu: f32,
+    pub(super) delta: f32,
+    pub(super) mu: f32,
     /// Cone half-angle in radians.
-    cone: f32,
+    pub(super) cone: f32,
 }
 
 /// How a wavelet relates to the one being bounded.
@@ -630,7 +662,7 @@ enum Kin {
 }
 
 /// The bounds of every wavelet (index = vertex id - base vertices).
-fn wavelet_bounds(
+pub(super) fn wavelet_bounds(
     view: &SemiRegularView<'_>,
     positions: &[[f32; 3]],
     axes: &[[f32; 3]],
@@ -818,7 +850,7 @@ fn containing(q: Point, s: i32) -> [(Point, i32); 3] {
 }
 
 /// Makes bounds monotonic down the dependency graph, finest level first.
-fn monotonic(
+pub(super) fn monotonic(
     view: &SemiRegularView<'_>,
     positions: &[[f32; 3]],
     axes: &[[f32; 3]],

@@ -353,20 +353,25 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         self.positions.get(i).copied().unwrap_or([0.0; 3])
     }
 
-    /// The policy's demand for wavelet vertex `id`. A policy that judges triangles
+    /// The policy's demand for wavelet vertex `id` (canonical point `p`). A policy that judges triangles
     /// ([`Policy::judges_triangles`], the importance paper's) also speaks through the two
     /// triangles of the level above that the wavelet subdivides (the ones around its parent
     /// edge): when either is important the wavelet is wanted, which is the paper's rule that an
     /// important triangle splits everything it can. Those triangles are coarser than the
     /// wavelet, so its coming and going never changes its own verdict.
     #[inline]
-    fn demand<P: Policy>(s: &SemiRegularView<'_>, id: u32, view: &View, policy: &P) -> Demand {
-        let b = s.bounds(id);
+    fn demand<P: Policy>(
+        s: &SemiRegularView<'_>,
+        id: u32,
+        p: Point,
+        view: &View,
+        policy: &P,
+    ) -> Demand {
+        let b = s.bounds_at(p, id);
         let d = policy.demand(&b, view);
         if !policy.judges_triangles() {
             return d;
         }
-        let Some(p) = s.point(id) else { return d };
         let [x, y] = s.parent_edge(p, s.level(p));
         let at = |q: Point| {
             s.canonical(q)
@@ -394,11 +399,12 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
     fn wants<P: Policy>(
         s: &SemiRegularView<'_>,
         id: u32,
+        p: Point,
         view: &View,
         policy: &P,
         t: f32,
     ) -> Option<f32> {
-        let d = Self::demand(s, id, view, policy);
+        let d = Self::demand(s, id, p, view, policy);
         (d.visible && d.error > t).then_some(d.error)
     }
 
@@ -689,7 +695,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
                 if !leaving && self.any_child_in(s, p, level, true) {
                     continue;
                 }
-                let d = Self::demand(s, id, view, policy);
+                let d = Self::demand(s, id, p, view, policy);
                 let wanted = d.visible && d.error > t;
                 if leaving {
                     if wanted {
@@ -735,8 +741,8 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         let n = s.steps() as u32;
         for e in 0..s.counts().base_edges {
             let id = self.base_vertices + e * (n - 1) + n / 2 - 1;
-            if !self.includes(id) {
-                self.offer(s, id, view, policy, t, &mut stats);
+            if let (false, Some(p)) = (self.includes(id), s.point(id)) {
+                self.offer(s, (id, p), view, policy, t, &mut stats);
             }
         }
         let mut next = 0;
@@ -770,7 +776,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
             // It blends in unless it just came into view.
             if self.geomorph_frames > 0
                 && self.has_previous
-                && policy.demand(&s.bounds(id), &self.previous).visible
+                && policy.demand(&s.bounds_at(p, id), &self.previous).visible
                 && !self.start_morph(id, false, self.geomorph_frames)
             {
                 stats.blend_limited = true;
@@ -807,8 +813,8 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         max_vertices: u32,
         stats: &mut FrameStats,
     ) {
-        let priority = |id: u32| {
-            let d = Self::demand(s, id, view, policy);
+        let priority = |id: u32, p: Point| {
+            let d = Self::demand(s, id, p, view, policy);
             !(if d.visible { d.error.max(0.0) } else { 0.0 }).to_bits()
         };
         self.heap.clear();
@@ -817,7 +823,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
             next = id - self.base_vertices + 1;
             let Some(p) = s.point(id) else { continue };
             if !self.any_child_in(s, p, s.level(p), false)
-                && self.heap.heap_push((priority(id), id)).is_err()
+                && self.heap.heap_push((priority(id, p), id)).is_err()
             {
                 stats.queue_overflow = true;
             }
@@ -839,7 +845,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
                 let Some(pq) = s.point(q) else { continue };
                 if self.includes(q)
                     && !self.any_child_in(s, pq, s.level(pq), false)
-                    && self.heap.heap_push((priority(q), q)).is_err()
+                    && self.heap.heap_push((priority(q, pq), q)).is_err()
                 {
                     stats.queue_overflow = true;
                 }
@@ -848,17 +854,17 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         self.heap.clear();
     }
 
-    /// Puts wavelet `id` on the heap if the policy wants it.
+    /// Puts wavelet `id` (canonical point `p`) on the heap if the policy wants it.
     fn offer<P: Policy>(
         &mut self,
         s: &SemiRegularView<'_>,
-        id: u32,
+        (id, p): (u32, Point),
         view: &View,
         policy: &P,
         t: f32,
         stats: &mut FrameStats,
     ) {
-        if let Some(error) = Self::wants(s, id, view, policy, t) {
+        if let Some(error) = Self::wants(s, id, p, view, policy, t) {
             if self.heap.heap_push((error.to_bits(), id)).is_err() {
                 stats.queue_overflow = true;
             }
@@ -884,7 +890,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
             let Some(cid) = s.vertex_id(c) else { continue };
             let from = if sweep { id } else { NIL };
             if !self.includes(cid) && self.joinable_from(s, c, level + 1, from) {
-                self.offer(s, cid, view, policy, t, stats);
+                self.offer(s, (cid, c), view, policy, t, stats);
             }
         }
     }

@@ -24,10 +24,16 @@
 //! | colours | 3 per vertex, only with flag bit 0 | `3 x u8` |
 //!
 //! Header: offset 0 magic `VDLW`; 4 version `u16` = 1; 6 flags `u16` (bit 0: colours; bit 1:
-//! the `a` and `b` codes hold Hoppe's `delta` and `mu` instead of the spheroid's radii); 8
-//! `levels` (`J`, 1 to [`MAX_LEVELS`]), 12 `base_vertices`, 16 `base_faces`, 20 `base_edges`
-//! (`u32` each); 24 CRC-32 of everything after the header; 28 bounding-box origin `3 x f32`; 40
-//! extent `3 x f32` (non-negative); 52 the length unit of the bound codes, `f32`; 56 to 63 zero.
+//! the `a` and `b` codes hold Hoppe's `delta` and `mu` instead of the spheroid's radii; bit 2:
+//! a height field); 8 `levels` (`J`, 1 to [`MAX_LEVELS`]), 12 `base_vertices`, 16
+//! `base_faces`, 20 `base_edges` (`u32` each); 24 CRC-32 of everything after the header; 28
+//! bounding-box origin `3 x f32`; 40 extent `3 x f32` (non-negative); 52 the length unit of the
+//! bound codes, `f32`; 56 to 63 zero, but for a height field 56 its up axis and 57 its fine
+//! levels.
+//!
+//! A height field (flag bit 2, [`super::heights`]) replaces the vertex section by a record per
+//! base vertex, one `u16` height per wavelet and bounds per coarse wavelet and per block of
+//! fine ones: about two bytes per vertex instead of twelve.
 //!
 //! Edge ids are numbered in the order the face sides first name them (face 0's edges 0, 1, 2,
 //! then face 1's, ...; a side names a new edge unless its across side comes earlier), so that
@@ -39,6 +45,7 @@
 
 use core::fmt;
 
+use super::lattice::Point;
 use crate::format::{cone_sine, crc32, oct_decode, u16_at, u32_at, ModelBox};
 use crate::policy::Bounds;
 
@@ -65,6 +72,13 @@ pub const FLAG_COLORS: u16 = 1;
 /// Header flag: the `a` and `b` codes are Hoppe's `delta` and `mu` (see
 /// [`crate::policy::HoppeError`]), not the spheroid's radii.
 pub const FLAG_HOPPE: u16 = 2;
+/// Header flag: a height field (see [`super::heights`]): one height per wavelet, and bounds per
+/// coarse wavelet and per block of fine ones, instead of a record per vertex.
+pub const FLAG_HEIGHTS: u16 = 4;
+/// Bytes per height of a height field.
+pub const HEIGHT_SIZE: usize = 2;
+/// Bytes per bound record of a height field: the codes of the radius, `a` and the cone's sine.
+pub const CODES_SIZE: usize = 3;
 /// The most subdivision levels a file may have (`N = 4096` steps per base edge).
 pub const MAX_LEVELS: u32 = 12;
 /// "No face" in the across fields.
@@ -172,7 +186,7 @@ impl Counts {
     #[must_use]
     pub const fn inner_points(&self) -> u64 {
         let n = self.steps() as u64;
-        (n - 1) * (n - 2) / 2
+        (n - 1) * n.saturating_sub(2) / 2
     }
 
     /// Vertices of `K^J` (base vertices and wavelets).
@@ -190,19 +204,55 @@ impl Counts {
         self.base_faces as u64 * (1u64 << (2 * self.levels))
     }
 
-    /// Byte offsets of the face, edge, vertex and colour sections and of the end.
+    /// Byte offsets of the face, edge, vertex and colour sections and of the end (a file
+    /// without [`FLAG_HEIGHTS`]).
     #[must_use]
     pub fn layout(&self, colors: bool) -> [u64; 5] {
+        let s = self.sections(if colors { FLAG_COLORS } else { 0 }, 0);
+        [s[0], s[1], s[2], s[6], s[7]]
+    }
+
+    /// Byte offsets of the face, edge, vertex record, height, coarse bound, fine bound and
+    /// colour sections and of the end, for a file with header flags `flags` and (for a height
+    /// field) `fine` fine levels (`fine <= J`).
+    #[must_use]
+    pub fn sections(&self, flags: u16, fine: u32) -> [u64; 8] {
+        let heights = flags & FLAG_HEIGHTS != 0;
         let f = HEADER_SIZE as u64;
         let e = f + self.base_faces as u64 * FACE_SIZE as u64;
         let v = e + self.base_edges as u64 * EDGE_SIZE as u64;
-        let c = v + self.vertices() * VERTEX_SIZE as u64;
-        let end = c + if colors {
-            self.vertices() * COLOR_SIZE as u64
+        let records = if heights {
+            self.base_vertices as u64
         } else {
-            0
+            self.vertices()
         };
-        [f, e, v, c, end]
+        let h = v + records * VERTEX_SIZE as u64;
+        let (height_bytes, coarse, blocks) = if heights {
+            let coarse = Counts {
+                levels: self.levels.saturating_sub(fine),
+                ..*self
+            };
+            let wavelets = self.vertices() - self.base_vertices as u64;
+            let coarse_wavelets = coarse.vertices() - self.base_vertices as u64;
+            // Blocks: the triangles of the coarse mesh, a record for each finer level.
+            (
+                wavelets * HEIGHT_SIZE as u64,
+                coarse_wavelets * CODES_SIZE as u64,
+                coarse.finest_faces() * fine as u64 * CODES_SIZE as u64,
+            )
+        } else {
+            (0, 0, 0)
+        };
+        let c = h + height_bytes;
+        let b = c + coarse;
+        let colours = b + blocks;
+        let end = colours
+            + if flags & FLAG_COLORS != 0 {
+                self.vertices() * COLOR_SIZE as u64
+            } else {
+                0
+            };
+        [f, e, v, h, c, b, colours, end]
     }
 }
 
@@ -212,10 +262,14 @@ pub struct SemiRegularView<'a> {
     pub(super) bytes: &'a [u8],
     pub(super) counts: Counts,
     flags: u16,
-    /// Offsets of the face, edge, vertex and colour sections.
-    offsets: [usize; 4],
+    /// Offsets of the face, edge, vertex record, height, coarse bound, fine bound and colour
+    /// sections.
+    pub(super) offsets: [usize; 7],
+    /// A height field's up axis and fine levels (see [`super::heights`]); zeros otherwise.
+    pub(super) up: usize,
+    pub(super) fine: u32,
     /// The positions' box and the bounds' unit.
-    model: ModelBox,
+    pub(super) model: ModelBox,
     /// `N`, and the number of vertices (which fits in `u32`).
     pub(super) n: i32,
     pub(super) vertices: u32,
@@ -255,11 +309,21 @@ impl<'a> SemiRegularView<'a> {
             return Err(E::UnsupportedVersion(version));
         }
         let flags = u16_at(bytes, 6);
-        if flags & !(FLAG_COLORS | FLAG_HOPPE) != 0
-            || bytes[56..HEADER_SIZE].iter().any(|&b| b != 0)
+        let heights = flags & FLAG_HEIGHTS != 0;
+        let reserved = if heights { 58 } else { 56 };
+        if flags & !(FLAG_COLORS | FLAG_HOPPE | FLAG_HEIGHTS) != 0
+            || bytes[reserved..HEADER_SIZE].iter().any(|&b| b != 0)
         {
             return Err(E::BadCounts("unknown flags or non-zero reserved bytes"));
         }
+        if heights && flags & FLAG_HOPPE != 0 {
+            return Err(E::BadCounts("a height field has no Hoppe bounds"));
+        }
+        let (up, fine) = if heights {
+            (bytes[56] as usize, bytes[57] as u32)
+        } else {
+            (0, 0)
+        };
         let counts = Counts {
             levels: u32_at(bytes, 8),
             base_vertices: u32_at(bytes, 12),
@@ -278,10 +342,14 @@ impl<'a> SemiRegularView<'a> {
         if counts.vertices() >= 1 << 31 {
             return Err(E::BadCounts("more than 2^31 vertices"));
         }
+        if heights && (up > 2 || fine == 0 || fine > counts.levels) {
+            return Err(E::BadCounts(
+                "a height field's up axis must be 0 to 2 and its fine levels 1 to its levels",
+            ));
+        }
         let model = ModelBox::read(bytes, BOX_OFFSET).ok_or(E::BadBox)?;
-        let colors = flags & FLAG_COLORS != 0;
-        let layout = counts.layout(colors);
-        let (needed, actual) = (layout[4], bytes.len() as u64);
+        let layout = counts.sections(flags, fine);
+        let (needed, actual) = (layout[7], bytes.len() as u64);
         if actual < needed {
             return Err(E::Truncated { needed, actual });
         }
@@ -298,12 +366,9 @@ impl<'a> SemiRegularView<'a> {
             bytes,
             counts,
             flags,
-            offsets: [
-                layout[0] as usize,
-                layout[1] as usize,
-                layout[2] as usize,
-                layout[3] as usize,
-            ],
+            offsets: core::array::from_fn(|k| layout[k] as usize),
+            up,
+            fine,
             model,
             n: 1 << counts.levels,
             vertices: counts.vertices() as u32,
@@ -487,9 +552,13 @@ impl<'a> SemiRegularView<'a> {
             .unwrap_or(usize::MAX)
     }
 
-    /// Vertex `v`'s 12-byte record (zeros out of range).
+    /// Vertex `v`'s 12-byte record (zeros out of range; a height field has records for its base
+    /// vertices only).
     #[inline]
-    fn record(&self, v: u32) -> [u8; VERTEX_SIZE] {
+    pub(super) fn record(&self, v: u32) -> [u8; VERTEX_SIZE] {
+        if self.is_height_field() && v >= self.counts.base_vertices {
+            return [0; VERTEX_SIZE];
+        }
         let o = (v as usize)
             .checked_mul(VERTEX_SIZE)
             .and_then(|o| o.checked_add(self.offsets[2]));
@@ -498,10 +567,20 @@ impl<'a> SemiRegularView<'a> {
             .unwrap_or([0; VERTEX_SIZE])
     }
 
+    /// Whether this is a height field (flag bit 2, see [`super::heights`]).
+    #[inline]
+    #[must_use]
+    pub fn is_height_field(&self) -> bool {
+        self.flags & FLAG_HEIGHTS != 0
+    }
+
     /// Vertex `v`'s position on the finest surface, `rho(v)`.
     #[inline]
     #[must_use]
     pub fn position(&self, v: u32) -> [f32; 3] {
+        if self.is_height_field() && v >= self.counts.base_vertices {
+            return self.height_position(v);
+        }
         self.model.position(&self.record(v))
     }
 
@@ -509,6 +588,9 @@ impl<'a> SemiRegularView<'a> {
     #[inline]
     #[must_use]
     pub fn normal(&self, v: u32) -> [f32; 3] {
+        if self.is_height_field() {
+            return self.height_normal(v);
+        }
         let r = self.record(v);
         oct_decode(r[6] as i8, r[7] as i8)
     }
@@ -522,7 +604,7 @@ impl<'a> SemiRegularView<'a> {
         }
         let o = (v as usize)
             .checked_mul(COLOR_SIZE)
-            .and_then(|o| o.checked_add(self.offsets[3]));
+            .and_then(|o| o.checked_add(self.offsets[6]));
         o.and_then(|o| self.bytes.get(o..o + COLOR_SIZE))
             .and_then(|s| s.try_into().ok())
             .unwrap_or([0; 3])
@@ -541,6 +623,9 @@ impl<'a> SemiRegularView<'a> {
     #[inline]
     #[must_use]
     pub fn bounds(&self, v: u32) -> Bounds {
+        if self.is_height_field() {
+            return self.height_bounds(v);
+        }
         let r = self.record(v);
         let (a, b) = (self.length(r[9]), self.length(r[10]));
         Bounds {
@@ -553,9 +638,24 @@ impl<'a> SemiRegularView<'a> {
         }
     }
 
+    /// [`SemiRegularView::bounds`] of vertex `v` whose canonical point is `p` (a caller that
+    /// has the point saves finding it again).
+    #[inline]
+    #[must_use]
+    pub fn bounds_at(&self, p: Point, v: u32) -> Bounds {
+        if self.is_height_field() {
+            return self.height_bounds_at(p, v);
+        }
+        self.bounds(v)
+    }
+
     /// The raw bound codes of vertex `v` (radius, `a`, `b`, cone sine).
     #[must_use]
     pub fn codes(&self, v: u32) -> [u8; 4] {
+        if self.is_height_field() {
+            let [r, a, c] = self.height_codes(v);
+            return [r, a, 0, c];
+        }
         let r = self.record(v);
         [r[8], r[9], r[10], r[11]]
     }

@@ -188,6 +188,7 @@ impl SemiRegularView<'_> {
 
     /// The vertex id of canonical point `p` (see [`super::format`]); `None` for weights out of
     /// range.
+    #[inline]
     #[must_use]
     pub fn vertex_id(&self, p: Point) -> Option<u32> {
         let n = self.n;
@@ -213,6 +214,38 @@ impl SemiRegularView<'_> {
             }
             Site::Inner => None,
         }
+    }
+
+    /// The id canonical point `p` would have in the mesh of the same base with `n` steps per
+    /// base edge (a power of two, at most `N`): what a height field's coarse bounds are indexed
+    /// by (see [`super::heights`]).
+    #[must_use]
+    pub(super) fn vertex_id_in(&self, p: Point, n: i32) -> Option<u32> {
+        let [w0, w1, w2] = p.w;
+        if w0 < 0 || w1 < 0 || w2 < 0 || w0 > n || w1 > n || w2 > n || n < 1 || n > self.n {
+            return None;
+        }
+        if p.face >= self.counts.base_faces {
+            return None;
+        }
+        let steps = n as u32;
+        if w0 != 0 && w1 != 0 && w2 != 0 {
+            // Inside the face: rows of increasing j, then i.
+            let (i, j) = (w1 as u32, w2 as u32);
+            let row = (j - 1) * (steps - 1) - (j - 1) * j / 2;
+            let first_inner = self.counts.base_vertices + self.counts.base_edges * (steps - 1);
+            let inner = (steps - 1) * (steps - 2) / 2;
+            return Some(first_inner + p.face * inner + row + i - 1);
+        }
+        let at_corner = |k: usize| p.w[k] == n;
+        if let Some(k) = (0..3).find(|&k| at_corner(k)) {
+            return Some(self.corners(p.face)[k]);
+        }
+        let k = (0..3).find(|&k| p.w[(k + 2) % 3] == 0)?;
+        let t = p.w[(k + 1) % 3];
+        let ([a, b], e) = self.edge_of(p.face, k);
+        let t = if a < b { t } else { n - t };
+        Some(self.counts.base_vertices + e * (steps - 1) + t as u32 - 1)
     }
 
     /// The canonical point of vertex `v` when it is a wavelet (not a base vertex).

@@ -11,6 +11,7 @@
 //! rasterizer draws as it draws the vertex forest's cut.
 //!
 //! - [`format`]: the file, read in place and validated (one 12-byte record per vertex).
+//! - [`heights`]: height fields in the same file, about two bytes per vertex.
 //! - [`lattice`]: every level's connectivity, computed from the base mesh.
 //! - [`cut`]: the set of wavelets as bits, its incremental adaptation and the emitted mesh.
 //! - `build` (feature `build`): sources of semi-regular meshes and the per-wavelet bounds.
@@ -41,6 +42,7 @@
 pub mod build;
 pub mod cut;
 pub mod format;
+pub mod heights;
 pub mod lattice;
 
 #[cfg(feature = "build")]
