@@ -129,10 +129,7 @@ enum Command {
     /// Read a mesh (OBJ, OFF, PLY or STL), repair it and write it as OBJ.
     Repair(RepairArgs),
     /// Validate a .vdh hierarchy or .vdw semi-regular file and print its figures.
-    Info {
-        /// The file.
-        file: PathBuf,
-    },
+    Info(InfoArgs),
     /// Write the unit sphere as a semi-regular mesh for the wavelet engine: an octahedron
     /// subdivided LEVELS times (8,192 faces at 5 levels).
     Sphere(SphereArgs),
@@ -146,6 +143,19 @@ enum Command {
     /// Run one of the papers' experiments: pictures and CSV into OUT/NAME/, one `key=value`
     /// summary line per engine or setting.
     Reproduce(ReproduceArgs),
+}
+
+#[derive(clap::Args)]
+struct InfoArgs {
+    /// The file.
+    file: PathBuf,
+    /// Also measure the file's full detail against this mesh (OBJ, OFF, PLY or STL; the one it
+    /// was made from): two-sided Hausdorff and RMS distances as percentages of the mesh's
+    /// bounding-box diagonal.
+    #[arg(long, value_name = "MESH")]
+    against: Option<PathBuf>,
+    #[command(flatten)]
+    input: InputArgs,
 }
 
 #[derive(clap::Args)]
@@ -906,18 +916,42 @@ fn repair(args: RepairArgs) -> Result<(), String> {
     Ok(())
 }
 
-fn info(file: PathBuf) -> Result<(), String> {
-    let raw = std::fs::read(&file).map_err(|e| format!("{}: cannot read: {e}", file.display()))?;
-    if raw.starts_with(&vdlod_core::wavelet::format::MAGIC) {
+fn info(args: InfoArgs) -> Result<(), String> {
+    let file = &args.file;
+    let raw = std::fs::read(file).map_err(|e| format!("{}: cannot read: {e}", file.display()))?;
+    let full = if raw.starts_with(&vdlod_core::wavelet::format::MAGIC) {
         let s = SemiRegularView::parse(&raw).map_err(|e| format!("{}: {e}", file.display()))?;
         say!("{}: {}", file.display(), wavelet::summarize(&s));
-        return Ok(());
+        wavelet::finest_of(&s)
+    } else {
+        let bytes = hierarchy::read(file)?;
+        let view = HierarchyView::parse(&bytes).map_err(|e| format!("{}: {e}", file.display()))?;
+        // What `orbit` would reject, `info` rejects: refine it fully and check the mesh.
+        let full = lod::full_detail(&view).map_err(|e| format!("{}: {e}", file.display()))?;
+        say!("{}: {}", file.display(), hierarchy::summarize(&view));
+        full
+    };
+    if let Some(against) = &args.against {
+        let (name, mesh) = load(Some(against), args.input)?;
+        let reference = vdlod_core::build::InputMesh {
+            positions: &mesh.positions,
+            colors: None,
+            triangles: &mesh.triangles,
+        };
+        let d = vdlod_core::remesh::distances(&full.positions, &full.triangles, &reference);
+        if d.samples == 0 {
+            return Err(format!(
+                "{name}: not a mesh the file can be measured against"
+            ));
+        }
+        say!(
+            "{}: full detail against {name}: hausdorff_pct={:.3} rms_pct={:.4} (of its bounding-box diagonal, {} samples both ways)",
+            file.display(),
+            100.0 * d.hausdorff,
+            100.0 * d.rms,
+            d.samples
+        );
     }
-    let bytes = hierarchy::read(&file)?;
-    let view = HierarchyView::parse(&bytes).map_err(|e| format!("{}: {e}", file.display()))?;
-    // What `orbit` would reject, `info` rejects: refine it fully and check the mesh.
-    lod::full_detail(&view).map_err(|e| format!("{}: {e}", file.display()))?;
-    say!("{}: {}", file.display(), hierarchy::summarize(&view));
     Ok(())
 }
 
@@ -1034,7 +1068,7 @@ fn main() -> ExitCode {
         Some(Command::Render(args)) => render(args),
         Some(Command::Build(args)) => build_command(args),
         Some(Command::Repair(args)) => repair(args),
-        Some(Command::Info { file }) => info(file),
+        Some(Command::Info(args)) => info(args),
         Some(Command::Sphere(args)) => sphere(args),
         Some(Command::Subdivide(args)) => subdivide(args),
         Some(Command::Remesh(args)) => remesh_command(args),

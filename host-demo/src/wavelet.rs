@@ -29,8 +29,17 @@ pub type DemoWaveletCut = WaveletCut<8192, 60_000, 30_000, 8_192>;
 /// The figures of a semi-regular file, one line.
 pub fn summarize(s: &SemiRegularView<'_>) -> String {
     let c = s.counts();
+    let layout = if s.is_height_field() {
+        format!(
+            "; a height field along axis {}, bounds per block for its {} finest levels",
+            s.up_axis(),
+            s.fine_levels()
+        )
+    } else {
+        String::new()
+    };
     format!(
-        "semi-regular mesh: base {} vertices, {} faces, {} edges; {} levels ({} faces at full detail); {} wavelets; {} bytes, {:.1} per wavelet",
+        "semi-regular mesh: base {} vertices, {} faces, {} edges; {} levels ({} faces at full detail); {} wavelets; {} bytes, {:.1} per wavelet{layout}",
         c.base_vertices,
         c.base_faces,
         c.base_edges,

@@ -493,6 +493,33 @@ fn sphere_info_and_subdivide_write_semi_regular_files() {
     assert_eq!(obj.lines().filter(|l| l.starts_with("f ")).count(), 512);
     let info = demo(&["info", "s.vdw"], &dir);
     assert!(String::from_utf8_lossy(&info.stdout).contains("252 wavelets"));
+    // Measured against its own finest level (within the 16-bit positions), then against that
+    // level subdivided once more (Loop moves the vertices inwards): the distances say so.
+    let pct = |args: &[&str]| {
+        let out = succeed(args, &dir);
+        let text = String::from_utf8_lossy(&out.stdout).into_owned();
+        let field = text
+            .split("hausdorff_pct=")
+            .nth(1)
+            .unwrap_or_else(|| panic!("{text}"));
+        field.split(' ').next().unwrap().parse::<f64>().unwrap()
+    };
+    assert!(pct(&["info", "s.vdw", "--against", "s.obj"]) < 0.01);
+    succeed(
+        &[
+            "subdivide",
+            "s.obj",
+            "--levels",
+            "1",
+            "-o",
+            "u.vdw",
+            "--obj",
+            "u.obj",
+        ],
+        &dir,
+    );
+    let apart = pct(&["info", "s.vdw", "--against", "u.obj"]);
+    assert!(apart > 0.1 && apart < 10.0, "{apart}");
     // A corrupted file: one line, the file and the problem.
     let mut bytes = std::fs::read(dir.join("s.vdw")).unwrap();
     let last = bytes.len() - 1;

@@ -66,7 +66,7 @@ use crate::build::{validate, BuildError, BuildOptions, InputMesh, NONE};
 use crate::wavelet::format::MAX_LEVELS;
 use crate::wavelet::{SemiRegular, SemiRegularBuildError};
 
-pub use quality::Quality;
+pub use quality::{distances, Distances, Quality};
 
 /// The worst base triangle shape a collapse may make (unless its region had one as bad).
 const MIN_SHAPE: f64 = 0.3;

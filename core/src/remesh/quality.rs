@@ -50,21 +50,7 @@ impl Remesh {
         }
         let finest = self.mesh.finest_triangles();
         let positions = &self.mesh.positions;
-        let to_input = Surface::new(input.positions, input.triangles);
-        let to_remesh = Surface::new(positions, &finest);
-        let diagonal = diagonal(input.positions).max(f64::MIN_POSITIVE);
-        let mut largest = 0.0f64;
-        let mut squares = 0.0f64;
-        let mut samples = 0u64;
-        let mut farthest = ([0.0f32; 3], false);
-        let mut add = |d: f64, at: Vec3d, on_input: bool| {
-            if d > largest {
-                farthest = (at.map(|x| x as f32), on_input);
-            }
-            largest = largest.max(d);
-            squares += d * d;
-            samples += 1;
-        };
+        let d = distances(positions, &finest, input);
         let mut flipped = 0;
         let mut shapes = [0u32; 10];
         let input_normal = |v: u32| -> Vec3d {
@@ -74,14 +60,6 @@ impl Remesh {
         };
         for t in &finest {
             let [a, b, c] = t.map(|v| from_f32(positions[v as usize]));
-            for p in [
-                centroid(&[a, b, c]),
-                centroid(&[a, b]),
-                centroid(&[b, c]),
-                centroid(&[c, a]),
-            ] {
-                add(to_input.distance(p), p, false);
-            }
             let n = cross(sub(b, a), sub(c, a));
             let seen = t.iter().fold([0.0; 3], |s, &v| {
                 let m = input_normal(v);
@@ -99,21 +77,101 @@ impl Remesh {
             };
             shapes[((shape * 10.0) as usize).min(9)] += 1;
         }
-        for p in input.positions {
-            add(to_remesh.distance(from_f32(*p)), from_f32(*p), true);
-        }
-        for t in input.triangles {
-            let c = t.map(|v| from_f32(input.positions[v as usize]));
-            add(to_remesh.distance(centroid(&c)), centroid(&c), true);
-        }
         Quality {
-            hausdorff: largest / diagonal,
-            rms: libm::sqrt(squares / samples.max(1) as f64) / diagonal,
+            hausdorff: d.hausdorff,
+            rms: d.rms,
             flipped,
             shapes,
-            samples,
-            farthest,
+            samples: d.samples,
+            farthest: d.farthest,
         }
+    }
+}
+
+/// Two-sided distances between a triangle mesh and a reference surface.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Distances {
+    /// The largest distance, as a fraction of the reference's bounding-box diagonal.
+    pub hausdorff: f64,
+    /// The root-mean-square distance, as a fraction of the diagonal.
+    pub rms: f64,
+    /// Distances sampled.
+    pub samples: u64,
+    /// Where the largest distance was found: a point of the reference (`true`) or of the mesh
+    /// (`false`).
+    pub farthest: ([f32; 3], bool),
+}
+
+/// The two-sided distances between the mesh `positions`, `triangles` and the valid mesh
+/// `reference`: from the mesh at every triangle's centroid and edge midpoints, from the
+/// reference at every vertex and triangle centroid (a mesh whose vertices lie on the reference,
+/// as a remesh's do, is measured where it may leave it). Infinite when `reference` is not valid
+/// input or `triangles` name a vertex that is not there.
+///
+/// ```
+/// use vdlod_core::build::InputMesh;
+/// use vdlod_core::remesh::distances;
+/// let positions = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+/// let triangles = [[0, 1, 2]];
+/// let flat = InputMesh { positions: &positions, colors: None, triangles: &triangles };
+/// assert_eq!(distances(&positions, &triangles, &flat).hausdorff, 0.0);
+/// let raised = [[0.0, 0.0, 0.1], [1.0, 0.0, 0.1], [0.0, 1.0, 0.1]];
+/// let d = distances(&raised, &triangles, &flat);
+/// assert!((d.hausdorff - 0.1 / 2f64.sqrt()).abs() < 1e-6);
+/// ```
+#[must_use]
+pub fn distances(
+    positions: &[[f32; 3]],
+    triangles: &[[u32; 3]],
+    reference: &InputMesh<'_>,
+) -> Distances {
+    let named = |t: &[u32; 3]| t.iter().all(|&v| (v as usize) < positions.len());
+    if validate(reference).is_err() || !triangles.iter().all(named) {
+        return Distances {
+            hausdorff: f64::INFINITY,
+            rms: f64::INFINITY,
+            samples: 0,
+            farthest: ([0.0; 3], true),
+        };
+    }
+    let to_reference = Surface::new(reference.positions, reference.triangles);
+    let to_mesh = Surface::new(positions, triangles);
+    let diagonal = diagonal(reference.positions).max(f64::MIN_POSITIVE);
+    let mut largest = 0.0f64;
+    let mut squares = 0.0f64;
+    let mut samples = 0u64;
+    let mut farthest = ([0.0f32; 3], false);
+    let mut add = |d: f64, at: Vec3d, on_reference: bool| {
+        if d > largest {
+            farthest = (at.map(|x| x as f32), on_reference);
+        }
+        largest = largest.max(d);
+        squares += d * d;
+        samples += 1;
+    };
+    for t in triangles {
+        let [a, b, c] = t.map(|v| from_f32(positions[v as usize]));
+        for p in [
+            centroid(&[a, b, c]),
+            centroid(&[a, b]),
+            centroid(&[b, c]),
+            centroid(&[c, a]),
+        ] {
+            add(to_reference.distance(p), p, false);
+        }
+    }
+    for p in reference.positions {
+        add(to_mesh.distance(from_f32(*p)), from_f32(*p), true);
+    }
+    for t in reference.triangles {
+        let c = t.map(|v| from_f32(reference.positions[v as usize]));
+        add(to_mesh.distance(centroid(&c)), centroid(&c), true);
+    }
+    Distances {
+        hausdorff: largest / diagonal,
+        rms: libm::sqrt(squares / samples.max(1) as f64) / diagonal,
+        samples,
+        farthest,
     }
 }
 
