@@ -180,23 +180,27 @@ impl Surface {
             }
             let lo = c.map(|x| x.saturating_sub(r));
             let hi = [0, 1, 2].map(|k| (c[k] + r).min(self.dims[k] - 1));
+            let mut search = |x: usize, y: usize, z: usize| {
+                let i = self.index([x, y, z]);
+                let cell = &self.items[self.starts[i] as usize..self.starts[i + 1] as usize];
+                for &t in cell {
+                    best = best.min(triangle_distance2(p, &self.corners[t as usize]));
+                }
+            };
+            // Only the cells of ring r: a whole row where y or z is on the ring, else its two
+            // ends (inner cells were searched in earlier rings).
             for z in lo[2]..=hi[2] {
                 for y in lo[1]..=hi[1] {
-                    for x in lo[0]..=hi[0] {
-                        let ring = [x, y, z]
-                            .iter()
-                            .zip(&c)
-                            .map(|(&a, &b)| a.abs_diff(b))
-                            .max()
-                            .unwrap_or(0);
-                        if ring != r {
-                            continue; // searched in an earlier ring
+                    if z.abs_diff(c[2]) == r || y.abs_diff(c[1]) == r {
+                        for x in lo[0]..=hi[0] {
+                            search(x, y, z);
                         }
-                        let i = self.index([x, y, z]);
-                        let cell =
-                            &self.items[self.starts[i] as usize..self.starts[i + 1] as usize];
-                        for &t in cell {
-                            best = best.min(triangle_distance2(p, &self.corners[t as usize]));
+                    } else if r > 0 {
+                        if c[0] >= r {
+                            search(c[0] - r, y, z);
+                        }
+                        if c[0] + r < self.dims[0] {
+                            search(c[0] + r, y, z);
                         }
                     }
                 }

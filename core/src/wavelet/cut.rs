@@ -923,11 +923,16 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
     /// or a member, else at the midpoint of the slots `ends` (its parent edge).
     fn slot(&mut self, s: &SemiRegularView<'_>, p: Point, ends: [u32; 2]) -> Result<u32, Full> {
         let id = s.canonical(p).and_then(|q| s.vertex_id(q)).ok_or(Full)?;
-        self.slot_of(s, id, ends)
+        self.slot_of(s, (id, p), ends)
     }
 
-    /// [`WaveletCut::slot`] of vertex `id`.
-    fn slot_of(&mut self, s: &SemiRegularView<'_>, id: u32, ends: [u32; 2]) -> Result<u32, Full> {
+    /// [`WaveletCut::slot`] of vertex `id` at point `p` (in any frame holding it).
+    fn slot_of(
+        &mut self,
+        s: &SemiRegularView<'_>,
+        (id, p): (u32, Point),
+        ends: [u32; 2],
+    ) -> Result<u32, Full> {
         if let Some(slot) = self.map.get(id, self.ids.as_slice()) {
             return Ok(slot);
         }
@@ -936,7 +941,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         let at_own =
             id < self.base_vertices || (self.includes(id) && !ends_moved && !self.morphing_bit(id));
         let (position, moved) = if at_own {
-            (s.position(id), false)
+            (s.position_at(p, id), false)
         } else {
             // rho_t at this vertex: the midpoint of its parent edge as drawn, plus its
             // coefficient (its own position minus its parent edge's midpoint) scaled by its
@@ -948,18 +953,18 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
             } else {
                 0.0
             };
-            let mut p = [0, 1, 2].map(|k| (a[k] + b[k]) * 0.5);
+            let mut at = [0, 1, 2].map(|k| (a[k] + b[k]) * 0.5);
             if w > 0.0 {
                 let (own, x, y) = (
-                    s.position(id),
+                    s.position_at(p, id),
                     s.position(self.vertex_id(end(0))),
                     s.position(self.vertex_id(end(1))),
                 );
                 for k in 0..3 {
-                    p[k] += w * (own[k] - (x[k] + y[k]) * 0.5);
+                    at[k] += w * (own[k] - (x[k] + y[k]) * 0.5);
                 }
             }
-            (p, true)
+            (at, true)
         };
         let slot = self.ids.push(id).map_err(|_| Full)?;
         self.positions[slot as usize] = position;
@@ -991,7 +996,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         let mut mv = [0; 3];
         for k in 0..3 {
             let id = ids[k].ok_or(Full)?;
-            mv[k] = self.slot_of(s, id, [v[k], v[(k + 1) % 3]])?;
+            mv[k] = self.slot_of(s, (id, m[k]), [v[k], v[(k + 1) % 3]])?;
         }
         let next = level + 1;
         self.emit_triangle(s, [p[0], m[0], m[2]], [v[0], mv[0], mv[2]], next)?;
@@ -1025,7 +1030,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
             if !self.is_present(mid) {
                 continue;
             }
-            let mv = self.slot_of(s, mid, [v[i], v[j]])?;
+            let mv = self.slot_of(s, (mid, m), [v[i], v[j]])?;
             let finer = levels[i] + 1;
             self.emit_piece(
                 s,

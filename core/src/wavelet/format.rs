@@ -584,6 +584,17 @@ impl<'a> SemiRegularView<'a> {
         self.model.position(&self.record(v))
     }
 
+    /// [`SemiRegularView::position`] of vertex `v` at lattice point `p` (in the frame of any
+    /// base face holding it; a caller that has the point saves finding it again).
+    #[inline]
+    #[must_use]
+    pub fn position_at(&self, p: Point, v: u32) -> [f32; 3] {
+        if self.is_height_field() {
+            return self.height_position_at(p, v);
+        }
+        self.position(v)
+    }
+
     /// Vertex `v`'s normal (unit length).
     #[inline]
     #[must_use]

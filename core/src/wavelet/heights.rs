@@ -54,7 +54,8 @@ impl SemiRegularView<'_> {
     /// The position of wavelet vertex `v`: its base face's corners interpolated at its weights
     /// across the up axis, its height along it.
     pub(super) fn height_position(&self, v: u32) -> [f32; 3] {
-        self.point(v).map_or([0.0; 3], |p| self.position_at(p, v))
+        self.point(v)
+            .map_or([0.0; 3], |p| self.height_position_at(p, v))
     }
 
     /// The point at `p`'s weights on its base face's plane.
@@ -80,12 +81,12 @@ impl SemiRegularView<'_> {
         let Some(p) = self.point(v) else {
             return up;
         };
-        let c = self.position_at(p, v);
+        let c = self.height_position_at(p, v);
         let around = |d: [i32; 3]| {
             self.canonical(p.offset(d, 1))
                 .and_then(|q| Some((q, self.vertex_id(q)?)))
                 .map(|(q, id)| {
-                    let x = self.position_at(q, id);
+                    let x = self.height_position_at(q, id);
                     [x[0] - c[0], x[1] - c[1], x[2] - c[2]]
                 })
         };
@@ -197,7 +198,7 @@ impl SemiRegularView<'_> {
             self.length(a)
         };
         Bounds {
-            center: self.position_at(p, v),
+            center: self.height_position_at(p, v),
             radius: self.length(r),
             axis: self.up_vector(),
             cone_sin: cone_sine(c),
@@ -208,7 +209,7 @@ impl SemiRegularView<'_> {
 
     /// The position of vertex `id`, whose canonical point is `p` (without finding the point
     /// from the id).
-    fn position_at(&self, p: Point, id: u32) -> [f32; 3] {
+    pub(super) fn height_position_at(&self, p: Point, id: u32) -> [f32; 3] {
         if id < self.counts.base_vertices {
             return self.model.position(&self.record(id));
         }
