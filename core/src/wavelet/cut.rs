@@ -375,8 +375,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         let [x, y] = s.parent_edge(p, s.level(p));
         let at = |q: Point| {
             s.canonical(q)
-                .and_then(|c| s.vertex_id(c))
-                .map(|v| s.position(v))
+                .and_then(|c| Some(s.position_at(c, s.vertex_id(c)?)))
         };
         let (Some(a), Some(c)) = (at(x), at(y)) else {
             return d;
@@ -392,20 +391,6 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
             e.max(policy.triangle(&corners, b.radius, view))
         });
         d.raised(triangles)
-    }
-
-    /// The policy's verdict on wavelet vertex `id` at threshold `t`: wanted, and how much.
-    #[inline]
-    fn wants<P: Policy>(
-        s: &SemiRegularView<'_>,
-        id: u32,
-        p: Point,
-        view: &View,
-        policy: &P,
-        t: f32,
-    ) -> Option<f32> {
-        let d = Self::demand(s, id, p, view, policy);
-        (d.visible && d.error > t).then_some(d.error)
     }
 
     #[inline]
@@ -864,10 +849,9 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         t: f32,
         stats: &mut FrameStats,
     ) {
-        if let Some(error) = Self::wants(s, id, p, view, policy, t) {
-            if self.heap.heap_push((error.to_bits(), id)).is_err() {
-                stats.queue_overflow = true;
-            }
+        let d = Self::demand(s, id, p, view, policy);
+        if d.visible && d.error > t && self.heap.heap_push((d.error.to_bits(), id)).is_err() {
+            stats.queue_overflow = true;
         }
     }
 
