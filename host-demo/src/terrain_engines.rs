@@ -150,7 +150,7 @@ impl Flight {
             build_with_progress(&full, &BuildOptions::default(), progress)
                 .map_err(|e| format!("terrain: {e}"))?;
         let colours = if land.colors.is_some() {
-            3 * side * side
+            vdlod_core::wavelet::format::COLOR_SIZE * side * side
         } else {
             0
         };

@@ -313,7 +313,7 @@ mod write {
         /// let faces = [[0, 1, 2], [0, 2, 3]];
         /// let mesh = SemiRegular::from_fn(&base, &faces, 6, |f, w| {
         ///     let [x, y, _] = interpolate(faces[f as usize].map(|v| base[v as usize]), w, 64.0);
-        ///     [x, y, 0.1 * (7.0 * x).sin() * (5.0 * y).cos()]
+        ///     [x, y, 0.1 * libm::sinf(7.0 * x) * libm::cosf(5.0 * y)]
         /// })
         /// .unwrap();
         /// let bytes = mesh.to_height_bytes(2).unwrap();

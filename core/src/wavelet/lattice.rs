@@ -191,29 +191,7 @@ impl SemiRegularView<'_> {
     #[inline]
     #[must_use]
     pub fn vertex_id(&self, p: Point) -> Option<u32> {
-        let n = self.n;
-        let [w0, w1, w2] = p.w;
-        if w0 < 0 || w1 < 0 || w2 < 0 || w0 > n || w1 > n || w2 > n {
-            return None;
-        }
-        if p.face >= self.counts.base_faces {
-            return None;
-        }
-        if w0 != 0 && w1 != 0 && w2 != 0 {
-            // Inside the face: rows of increasing j, then i.
-            let (i, j, n) = (w1 as u32, w2 as u32, n as u32);
-            let row = (j - 1) * (n - 1) - (j - 1) * j / 2;
-            return Some(self.first_inner + p.face * self.inner + row + i - 1);
-        }
-        match self.site(p) {
-            Site::Corner(k) => Some(self.corners(p.face)[k]),
-            Site::Edge(k, t) => {
-                let ([a, b], e) = self.edge_of(p.face, k);
-                let t = if a < b { t } else { n - t };
-                Some(self.counts.base_vertices + e * (n as u32 - 1) + t as u32 - 1)
-            }
-            Site::Inner => None,
-        }
+        self.id_on_grid(p, self.n, self.first_inner, self.inner)
     }
 
     /// The id canonical point `p` would have in the mesh of the same base with `n` steps per
@@ -221,8 +199,21 @@ impl SemiRegularView<'_> {
     /// by (see [`super::heights`]).
     #[must_use]
     pub(super) fn vertex_id_in(&self, p: Point, n: i32) -> Option<u32> {
+        if n < 1 || n > self.n {
+            return None;
+        }
+        let steps = n as u32;
+        let first_inner = self.counts.base_vertices + self.counts.base_edges * (steps - 1);
+        let inner = (steps - 1) * steps.saturating_sub(2) / 2;
+        self.id_on_grid(p, n, first_inner, inner)
+    }
+
+    /// The id of `p` on the grid of `n` steps per base edge whose first point inside a face has
+    /// id `first_inner` and whose faces hold `inner` points each.
+    #[inline]
+    fn id_on_grid(&self, p: Point, n: i32, first_inner: u32, inner: u32) -> Option<u32> {
         let [w0, w1, w2] = p.w;
-        if w0 < 0 || w1 < 0 || w2 < 0 || w0 > n || w1 > n || w2 > n || n < 1 || n > self.n {
+        if w0 < 0 || w1 < 0 || w2 < 0 || w0 > n || w1 > n || w2 > n {
             return None;
         }
         if p.face >= self.counts.base_faces {
@@ -233,14 +224,12 @@ impl SemiRegularView<'_> {
             // Inside the face: rows of increasing j, then i.
             let (i, j) = (w1 as u32, w2 as u32);
             let row = (j - 1) * (steps - 1) - (j - 1) * j / 2;
-            let first_inner = self.counts.base_vertices + self.counts.base_edges * (steps - 1);
-            let inner = (steps - 1) * (steps - 2) / 2;
             return Some(first_inner + p.face * inner + row + i - 1);
         }
-        let at_corner = |k: usize| p.w[k] == n;
-        if let Some(k) = (0..3).find(|&k| at_corner(k)) {
+        if let Some(k) = p.w.iter().position(|&x| x == n) {
             return Some(self.corners(p.face)[k]);
         }
+        // On edge `k`, `t` steps from corner `k`.
         let k = (0..3).find(|&k| p.w[(k + 2) % 3] == 0)?;
         let t = p.w[(k + 1) % 3];
         let ([a, b], e) = self.edge_of(p.face, k);
