@@ -9,10 +9,8 @@
 //!    (`om_vdpm` from `../shared/peers/run.sh`, when built; `VDLOD_PEERS` names its directory,
 //!    default `$TMPDIR/vdlod-peers`), and the ratio compares our median of both runs with its
 //!    median, at equal tolerance and at the nearest triangle count.
-//! 2. **Adapted vs full detail** on the Loop-subdivided bunny (301,632 triangles): adapt plus
-//!    render at 640x480 against rendering every triangle, frame by frame over the merge-tree
-//!    paper's orbit, with its `shouldRefine` ([`MergeTree`]: everything in the frustum, to the
-//!    leaves) at frustum sizes 0.4, 0.2 and 0.1 (its Table 1 measured 5x, 10x and 12.5x).
+//! 2. (The merge-tree paper's Table 1, adapted vs full detail on the Loop-subdivided bunny, is
+//!    `vdlod-demo reproduce table1`.)
 //! 3. **Image quality at equal triangles**: PSNR against the full-detail frame of the adapted
 //!    frame and of the bunny simplified uniformly by meshoptimizer (`meshopt` 0.7) to the same
 //!    triangle count, over 20 frames of the peer orbit.
@@ -30,7 +28,7 @@
 //! 7. **Settled vertices** skipped or asked (`Cut::set_settling`), without and with geomorphs.
 //!
 //! Run: `../shared/peers/run.sh` and `../shared/peers/hoppe/run.sh` once (they build the peers),
-//! then `cargo bench --bench lod` (`-- adaptation`, `-- quality`, `-- full`, `-- policies` or
+//! then `cargo bench --bench lod` (`-- adaptation`, `-- quality`, `-- policies` or
 //! `-- srmesh`, `-- settling` for one section).
 
 use std::path::PathBuf;
@@ -41,8 +39,8 @@ use meshopt::{SimplifyOptions, VertexDataAdapter};
 use vdlod_core::adapt::Budget;
 use vdlod_core::cut::Cut;
 use vdlod_core::format::HierarchyView;
-use vdlod_core::policy::{Frustum, Importance, MergeTree, Policy, QRefine, ScreenError};
-use vdlod_demo::camera::{merge_tree_orbit, peer_orbit};
+use vdlod_core::policy::{Frustum, Importance, Policy, QRefine, ScreenError};
+use vdlod_demo::camera::peer_orbit;
 use vdlod_demo::frame::Frame;
 use vdlod_demo::hierarchy::build_with_progress;
 use vdlod_demo::lod::psnr;
@@ -52,7 +50,7 @@ use vdlod_raster::Shading;
 
 /// The cut of the adaptation benchmark: room for the bunny at 0.25 px with margin.
 type BunnyCut = Cut<16384, 32768, 2048>;
-/// The cut of the Loop-subdivided bunny, which refines fully inside the frustum.
+/// A cut that holds the Loop-subdivided bunny at full detail (section 4's figure).
 type BigCut = Cut<{ 1 << 18 }, { 1 << 19 }, { 1 << 15 }, u32>;
 
 const TOLERANCES: [f32; 5] = [0.25, 0.5, 1.0, 2.0, 4.0];
@@ -433,57 +431,6 @@ fn policies(h: &HierarchyView<'_>, mesh: &IndexedMesh) {
     );
 }
 
-fn full_vs_adapted(mesh: &IndexedMesh) {
-    println!("\n## 2. Adapted vs full detail, Loop-subdivided bunny, merge-tree orbit, 640x480\n");
-    let mut big = mesh.loop_subdivide();
-    let (_, bytes, secs) = build_with_progress(&big, &Default::default(), false).expect("builds");
-    big.reorder_for_locality();
-    println!(
-        "{} triangles; hierarchy built in {secs:.1} s, {} bytes ({:.1} bytes per input vertex)\n",
-        big.triangles.len(),
-        bytes.len(),
-        bytes.len() as f64 / big.positions.len() as f64
-    );
-    let h = HierarchyView::parse(&bytes).expect("valid");
-    println!("| frustum | mean tris | adapt + render ms (median) | full detail ms (median) | speed-up | merge-tree paper |");
-    println!("|---|---|---|---|---|---|");
-    for (frustum, paper) in [(0.4f32, "5x"), (0.2, "10x"), (0.1, "12.5x")] {
-        let orbit = merge_tree_orbit(&big.bounds(), 100, W, H);
-        let mut cut = BigCut::boxed();
-        cut.reset(&h).expect("fits");
-        let mut frame = Frame::new(W, H).expect("frame");
-        let (mut ours, mut full, mut tris) = (Vec::new(), Vec::new(), Vec::new());
-        let policy = MergeTree {
-            near: f32::INFINITY,
-        };
-        for i in 0..100 {
-            let camera = orbit.camera(i);
-            let view = camera.view_scaled(frustum);
-            let params = camera_params(&camera, Shading::Gouraud, false);
-            let start = Instant::now();
-            let s = cut.adapt(&h, &view, &policy, &Budget::default());
-            frame
-                .draw_cut(&cut, &h, &camera, &style(Shading::Gouraud, false))
-                .expect("draws");
-            let t_ours = start.elapsed().as_secs_f64() * 1e3;
-            let start = Instant::now();
-            frame.draw(&big.as_raster_mesh(), &params).expect("draws");
-            let t_full = start.elapsed().as_secs_f64() * 1e3;
-            if i > 0 {
-                ours.push(t_ours);
-                full.push(t_full);
-                tris.push(s.triangles as f64);
-            }
-        }
-        let (o, f) = (median(ours), median(full));
-        println!(
-            "| {frustum} | {:.0} | {o:.2} | {f:.2} | {:.1}x | {paper} |",
-            mean(&tris),
-            f / o
-        );
-    }
-}
-
 fn quality(h: &HierarchyView<'_>, mesh: &IndexedMesh) {
     println!("\n## 3. PSNR against full detail at equal triangles, peer orbit, 20 frames\n");
     let indices: Vec<u32> = mesh.triangles.iter().flatten().copied().collect();
@@ -605,9 +552,6 @@ fn main() {
         }
         if wanted("quality") {
             quality(&h, &mesh);
-        }
-        if wanted("full") {
-            full_vs_adapted(&mesh);
         }
         if wanted("policies") {
             policies(&h, &mesh);

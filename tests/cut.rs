@@ -440,3 +440,78 @@ fn regulation_does_not_overshoot_with_geomorphs() {
     assert!(least >= 1800, "fell to {least} triangles");
     assert!((1900..=2100).contains(&last), "ended at {last} triangles");
 }
+
+/// A policy that reads only bounding spheres is answered from the cut's digests instead of the
+/// file's records ([`vdlod_core::policy::Policy::sphere_only`]): the same cut, stats and
+/// positions in every frame as when the same policy does not say so, over the merge-tree
+/// paper's level orbit (scaled frustums, near limits) and a random path, with and without
+/// geomorphs.
+#[test]
+fn sphere_only_policies_decide_from_digests_exactly() {
+    use vdlod_core::policy::{Bounds, Demand, Envelope, MergeTree, Policy, View};
+    use vdlod_demo::camera::merge_tree_orbit;
+    /// The same demand, without the promise.
+    struct Opaque(MergeTree);
+    impl Policy for Opaque {
+        fn demand(&self, b: &Bounds, view: &View) -> Demand {
+            self.0.demand(b, view)
+        }
+        fn envelope(&self, view: &View) -> Option<Envelope> {
+            self.0.envelope(view)
+        }
+    }
+    type C = Cut<32_767, 65_534, 4096>;
+    for name in ["bunny.obj", "head.obj"] {
+        let mesh = fixture(name);
+        let bytes = hierarchy_bytes(&mesh);
+        let h = HierarchyView::parse(&bytes).unwrap();
+        let b = mesh.bounds();
+        let (c, r) = (b.center().to_array(), b.radius());
+        let orbit = merge_tree_orbit(&b, 60, 640, 480);
+        let mut path = Path::new(5);
+        let views: Vec<(View, f32)> = (0..240u32)
+            .map(|i| {
+                let near = [f32::INFINITY, 2.0 * r, 1.5 * r][(i / 40) as usize % 3];
+                if i < 120 {
+                    let size = [0.4, 0.2, 0.1][(i / 20) as usize % 3];
+                    (orbit.camera(i).view_scaled(size), near)
+                } else {
+                    (path.view(c, r), near)
+                }
+            })
+            .collect();
+        let [mut digest, mut records] = [C::boxed(), C::boxed()];
+        for cut in [&mut digest, &mut records] {
+            cut.reset(&h).unwrap();
+        }
+        let mut changed = 0;
+        for (i, (view, near)) in views.iter().enumerate() {
+            let frames = if (60..100).contains(&i) || i >= 200 {
+                4
+            } else {
+                0
+            };
+            digest.set_geomorph_frames(frames);
+            records.set_geomorph_frames(frames);
+            let policy = MergeTree { near: *near };
+            assert!(policy.sphere_only() && !Opaque(policy).sphere_only());
+            let d = digest.adapt(&h, view, &policy, &Budget::default());
+            let a = records.adapt(&h, view, &Opaque(policy), &Budget::default());
+            assert_eq!(d, a, "{name}, frame {i}: the stats differ");
+            assert_eq!(
+                node_triangles(&digest),
+                node_triangles(&records),
+                "{name}, frame {i}: the cuts differ"
+            );
+            for s in 0..digest.vertex_count() {
+                let (x, y) = (digest.vertex(&h, s), records.vertex(&h, s));
+                assert_eq!(x.position.map(f32::to_bits), y.position.map(f32::to_bits));
+            }
+            changed += (d.vsplits + d.ecols > 0) as u32;
+        }
+        assert!(
+            changed > 100,
+            "{name}: the cut hardly moved ({changed} frames)"
+        );
+    }
+}

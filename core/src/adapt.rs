@@ -311,6 +311,9 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             policy.envelope(view)
         };
         let upper = envelope.map_or(f32::INFINITY, |e| e.upper);
+        // A policy that reads only the bounding sphere is answered from the digest's copy of it:
+        // the same floats the record decodes to, so the same demand, without reading the file.
+        let sphere_only = policy.sphere_only() && !policy.judges_triangles();
         // Settled vertices are skipped while the anchor holds; otherwise an anchor frame marks
         // them anew (see `crate::cut::steady`).
         let model = h.bounding_sphere();
@@ -351,11 +354,27 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 let radius = h.length(digest.radius);
                 let r = sub(center, view.eye);
                 let d2 = dot(r, r);
-                let wants_none = s * s * upper * SLACK <= t * d2;
+                let sphere = if sphere_only {
+                    let b = Bounds {
+                        center,
+                        radius,
+                        ..Bounds::default()
+                    };
+                    Some(policy.demand(&b, view))
+                } else {
+                    None
+                };
+                let wants_none = match sphere {
+                    Some(d) => d.error <= t,
+                    None => s * s * upper * SLACK <= t * d2,
+                };
                 let alone = (flags & (BLENDING | COLLAPSING) == 0)
                     & ((self.v.mate(i) == NIL) | (calm & (flags & FIRST_CHILD == 0)));
                 let done = wants_none & alone;
-                let visible = blends && view.sphere_visible(center, radius);
+                let visible = match sphere {
+                    Some(d) => d.visible,
+                    None => blends && view.sphere_visible(center, radius),
+                };
                 let mut next_flags = if done { seen(flags, visible) } else { flags };
                 if let Some(m) = &anchor {
                     // Wants no split wherever the eye gets; with geomorphs also seen (or not)
@@ -376,11 +395,11 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 slow[ns] = n;
                 bounds[n].center = center;
                 bounds[n].radius = radius;
-                demands[n] = Demand {
+                demands[n] = sphere.unwrap_or(Demand {
                     visible,
                     error: 0.0,
-                };
-                ns += !wants_none as usize;
+                });
+                ns += (!wants_none & sphere.is_none()) as usize;
                 n += !done as usize;
             }
             let (listed, slow) = (&listed[..n], &slow[..ns]);

@@ -340,6 +340,14 @@ pub trait Policy {
         None
     }
 
+    /// Whether the demand reads nothing of the bounds but the bounding sphere (`center` and
+    /// `radius`), so that a cut may decide from its own copy of each vertex's sphere without
+    /// reading the hierarchy; `false` (the default) promises nothing.
+    #[inline]
+    fn sphere_only(&self) -> bool {
+        false
+    }
+
     /// Whether the policy also judges triangles ([`Policy::triangle`]); `false` (the default)
     /// lets the cut skip the walk around each vertex that judging them costs.
     #[inline]
@@ -384,6 +392,11 @@ impl<A: Policy, B: Policy> Policy for (A, B) {
     }
 
     #[inline]
+    fn sphere_only(&self) -> bool {
+        self.0.sphere_only() && self.1.sphere_only()
+    }
+
+    #[inline]
     fn judges_triangles(&self) -> bool {
         self.0.judges_triangles() || self.1.judges_triangles()
     }
@@ -405,6 +418,11 @@ impl<P: Policy + ?Sized> Policy for &P {
     #[inline]
     fn envelope(&self, view: &View) -> Option<Envelope> {
         (**self).envelope(view)
+    }
+
+    #[inline]
+    fn sphere_only(&self) -> bool {
+        (**self).sphere_only()
     }
 
     #[inline]
@@ -438,6 +456,11 @@ impl Policy for Frustum {
             frustum: true,
             ..Envelope::ZERO
         })
+    }
+
+    #[inline]
+    fn sphere_only(&self) -> bool {
+        true
     }
 }
 
@@ -654,6 +677,11 @@ impl Policy for MergeTree {
                 0.0
             },
         }
+    }
+
+    #[inline]
+    fn sphere_only(&self) -> bool {
+        true
     }
 }
 

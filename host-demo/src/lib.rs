@@ -16,6 +16,7 @@ pub mod mesh;
 pub mod remesh;
 pub mod render;
 pub mod repair;
+pub mod table1;
 pub mod terrain;
 pub mod terrain_engines;
 pub mod textures;

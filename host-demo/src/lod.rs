@@ -79,8 +79,13 @@ pub enum PolicyChoice {
         /// Interior tolerance in pixels.
         interior: f32,
     },
-    /// The merge-tree paper's `shouldRefine`: everything in the (scaled) frustum, to the leaves.
-    MergeTree,
+    /// The merge-tree paper's `shouldRefine`: everything in the (scaled) frustum and near the
+    /// eye, to the leaves.
+    MergeTree {
+        /// How near, in radii of the model's bounding sphere (infinite: everything in the
+        /// frustum).
+        near: f32,
+    },
     /// The importance paper's triangle importance over a threshold, in the frustum.
     Importance {
         /// Threshold.
@@ -293,6 +298,15 @@ impl Policy for DemoPolicy {
     }
 
     #[inline]
+    fn sphere_only(&self) -> bool {
+        match self {
+            DemoPolicy::Screen(p) => p.sphere_only(),
+            DemoPolicy::MergeTree(p) => p.sphere_only(),
+            DemoPolicy::Importance(p) => p.sphere_only(),
+        }
+    }
+
+    #[inline]
     fn judges_triangles(&self) -> bool {
         matches!(self, DemoPolicy::Importance(_))
     }
@@ -319,9 +333,14 @@ pub fn make_policy(choice: PolicyChoice, bounding_box: ([f32; 3], [f32; 3])) -> 
                 interior,
             },
         }),
-        PolicyChoice::MergeTree => DemoPolicy::MergeTree(MergeTree {
-            near: f32::INFINITY,
-        }),
+        PolicyChoice::MergeTree { near } => {
+            let radius = (glam::Vec3::from(bounding_box.1) - glam::Vec3::from(bounding_box.0))
+                .length()
+                * 0.5;
+            DemoPolicy::MergeTree(MergeTree {
+                near: near * radius,
+            })
+        }
         PolicyChoice::Importance { threshold } => {
             DemoPolicy::Importance((Frustum, Importance::for_box(threshold, bounding_box)))
         }

@@ -20,6 +20,7 @@ use vdlod_demo::lod::{self, OrbitOptions, PolicyChoice};
 use vdlod_demo::mesh::Bounds;
 use vdlod_demo::mesh::{self, load_obj_bytes, IndexedMesh, LoadOptions, Up, BUNNY_NAME, BUNNY_OBJ};
 use vdlod_demo::render::{render_orbit, RenderOptions};
+use vdlod_demo::table1;
 use vdlod_demo::terrain::{self, FlyOver, Terrain};
 use vdlod_demo::terrain_engines;
 use vdlod_demo::textures;
@@ -134,7 +135,10 @@ enum Command {
     /// subdivided LEVELS times (8,192 faces at 5 levels).
     Sphere(SphereArgs),
     /// Subdivide a mesh into a semi-regular one for the wavelet engine: its triangles (or, with
-    /// --base, a simplification of it to about that many faces) become the base mesh.
+    /// --base, a simplification of it to about that many faces) become the base mesh. With an
+    /// output ending in .obj, the mesh itself after LEVELS steps of Loop subdivision (the
+    /// merge-tree paper's subdivided bunny: `subdivide fixtures/bunny.obj --levels 1 -o
+    /// bunny_loop.obj`).
     Subdivide(SubdivideArgs),
     /// Remesh any mesh into a semi-regular one for the wavelet engine: a simplification of it
     /// to about --base faces, subdivided --levels times, every vertex on the input surface
@@ -206,7 +210,7 @@ struct SubdivideArgs {
     /// Simplify the mesh to about this many faces first (0: use it as it is).
     #[arg(long, default_value_t = 0)]
     base: u32,
-    /// Output file (.vdw).
+    /// Output file: .vdw (semi-regular), or .obj (the subdivided mesh, Loop scheme, no base).
     #[arg(long, short)]
     out: PathBuf,
     /// Also write the finest level as an OBJ file.
@@ -253,6 +257,11 @@ enum Experiment {
     /// Both engines (wavelets, vertex forest) on the same meshes at equal triangle counts: PSNR,
     /// adaptation time, file and cut sizes.
     Engines,
+    /// The merge-tree paper's Table 1: the Loop-subdivided bunny (301,632 triangles, hierarchy by
+    /// shortest edge with balancing) refined inside a frustum moving on a level orbit and near
+    /// the camera, at frustum sizes 0.4 / 0.2 / 0.1 (0.2 calibrated to hold 10% of the
+    /// leaves): adapt + render against drawing every triangle (paper: 5x / 10x / 12.5x).
+    Table1,
     /// The importance paper (Ng et al.), Figs. 3-10: a 20,000-triangle terrain reduced to 25%
     /// and 10% with its colour cost and with QEM, then refined with its importance test at its
     /// threshold of 0.3; the figure set and PSNR against full detail.
@@ -314,7 +323,8 @@ struct BuildArgs {
 enum PolicyArg {
     /// Frustum, back-face and screen-space error (--tolerance, --interior).
     Screen,
-    /// The merge-tree paper's shouldRefine: everything in the frustum, to the leaves.
+    /// The merge-tree paper's shouldRefine: everything in the frustum (--frustum) and near the
+    /// eye (--near), to the leaves.
     MergeTree,
     /// The importance paper's triangle importance over --threshold.
     Importance,
@@ -350,6 +360,11 @@ struct FlightArgs {
     /// (the merge-tree paper's Table 1 uses 0.4, 0.2, 0.1; above 0).
     #[arg(long, default_value_t = 1.0, allow_negative_numbers = true, value_parser = positive)]
     frustum: f32,
+    /// With --policy merge-tree: refine only what comes within this distance of the eye, in
+    /// radii of the model's bounding sphere (the merge-tree orbit's eye is 2 radii from the
+    /// centre; default: no limit).
+    #[arg(long, allow_negative_numbers = true, value_parser = positive)]
+    near: Option<f32>,
     /// Frames in one revolution (with --path, the file's rows set the frames).
     #[arg(long, default_value_t = 72, value_parser = clap::value_parser!(u32).range(1..=100_000))]
     frames: u32,
@@ -397,6 +412,7 @@ impl Default for FlightArgs {
             policy: PolicyArg::Screen,
             threshold: 0.3,
             frustum: 1.0,
+            near: None,
             frames: 72,
             width: 640,
             height: 480,
@@ -412,6 +428,14 @@ impl Default for FlightArgs {
 }
 
 impl FlightArgs {
+    /// What clap cannot check: options that only mean something together.
+    fn check(&self) -> Result<(), String> {
+        if self.near.is_some() && !matches!(self.policy, PolicyArg::MergeTree) {
+            return Err("--near needs --policy merge-tree".into());
+        }
+        Ok(())
+    }
+
     /// The options of a flight, with `path`'s cameras when there is one.
     fn options(&self, path: Option<Vec<Camera>>, peer_orbit: bool) -> OrbitOptions {
         let mut budget = Budget::default();
@@ -434,7 +458,9 @@ impl FlightArgs {
                     silhouette: self.tolerance,
                     interior: self.interior.unwrap_or(self.tolerance),
                 },
-                PolicyArg::MergeTree => PolicyChoice::MergeTree,
+                PolicyArg::MergeTree => PolicyChoice::MergeTree {
+                    near: self.near.unwrap_or(f32::INFINITY),
+                },
                 PolicyArg::Importance => PolicyChoice::Importance {
                     threshold: self.threshold,
                 },
@@ -713,6 +739,7 @@ fn load_lod(
 }
 
 fn orbit_command(args: OrbitArgs) -> Result<(), String> {
+    args.flight.check()?;
     let (name, bytes, full) = load_lod(args.mesh.as_ref(), args.input)?;
     let path = args.flight.path(&full.bounds())?;
     let opts = args.flight.options(path, args.peer_orbit);
@@ -720,6 +747,7 @@ fn orbit_command(args: OrbitArgs) -> Result<(), String> {
 }
 
 fn terrain_command(args: TerrainArgs) -> Result<(), String> {
+    args.flight.check()?;
     let (name, land) = match &args.heightmap {
         Some(file) => {
             let read = |p: &Path| {
@@ -980,6 +1008,13 @@ fn write_semi_regular(
 
 fn subdivide(args: SubdivideArgs) -> Result<(), String> {
     let (_, mesh) = load(Some(&args.mesh), args.input)?;
+    let plain = args
+        .out
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("obj"));
+    if plain {
+        return subdivide_plain(&args, mesh);
+    }
     let base = if args.base > 0 {
         wavelet::simplified_base(&mesh, args.base)
             .map_err(|e| format!("{}: {e}", args.mesh.display()))?
@@ -997,6 +1032,37 @@ fn subdivide(args: SubdivideArgs) -> Result<(), String> {
         .map_err(|e| format!("{}: {e}", args.mesh.display()))?;
     let source = args.mesh.display().to_string();
     write_semi_regular(&semi, &source, &args.out, args.obj.as_deref())
+}
+
+/// `subdivide` into an OBJ file: the whole mesh, Loop-subdivided `levels` times.
+fn subdivide_plain(args: &SubdivideArgs, mut mesh: IndexedMesh) -> Result<(), String> {
+    if args.base > 0 || args.obj.is_some() || !matches!(args.scheme, SchemeArg::Loop) {
+        return Err(format!(
+            "{}: an .obj output is the whole mesh Loop-subdivided: --base, --obj and --scheme are for .vdw outputs",
+            args.out.display()
+        ));
+    }
+    let bar = indicatif::ProgressBar::new(u64::from(args.levels));
+    for _ in 0..args.levels {
+        mesh = mesh.loop_subdivide();
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    let text = mesh::obj_text(
+        &mesh.positions,
+        mesh.colors.as_deref(),
+        mesh.triangles.iter().copied(),
+    );
+    std::fs::write(&args.out, text).map_err(|e| format!("{}: {e}", args.out.display()))?;
+    say!(
+        "{}: {} vertices, {} triangles ({} Loop subdivision steps of {})",
+        args.out.display(),
+        mesh.positions.len(),
+        mesh.triangles.len(),
+        args.levels,
+        args.mesh.display()
+    );
+    Ok(())
 }
 
 fn remesh_command(args: RemeshArgs) -> Result<(), String> {
@@ -1021,6 +1087,14 @@ fn reproduce(args: ReproduceArgs) -> Result<(), String> {
         Experiment::Fig9 => ("fig9", wavelet::fig9(&args.out.join("fig9"))?),
         Experiment::Fig10 => ("fig10", wavelet::fig10(&args.out.join("fig10"))?),
         Experiment::Engines => ("engines", wavelet::engines(&args.out.join("engines"))?),
+        Experiment::Table1 => (
+            "table1",
+            table1::table1(
+                &args.out.join("table1"),
+                load_obj_bytes(BUNNY_NAME, BUNNY_OBJ).map_err(|e| e.to_string())?,
+                table1::Setup::REPRODUCE,
+            )?,
+        ),
         Experiment::Terrain => ("terrain", importance::terrain(&args.out.join("terrain"))?),
         Experiment::TerrainEngines => (
             "terrain-engines",

@@ -553,6 +553,47 @@ fn subdivide_rejects_a_non_manifold_mesh_in_one_line() {
 }
 
 #[test]
+fn subdivide_to_obj_writes_the_loop_subdivided_mesh() {
+    let dir = scratch_dir("cli_subdivide_obj");
+    let tetra = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+    std::fs::write(dir.join("tetra.obj"), tetra).unwrap();
+    let out = succeed(
+        &["subdivide", "tetra.obj", "--levels", "2", "-o", "fine.obj"],
+        &dir,
+    );
+    let said = String::from_utf8_lossy(&out.stdout);
+    assert!(said.contains("34 vertices, 64 triangles"), "{said}");
+    let text = std::fs::read_to_string(dir.join("fine.obj")).unwrap();
+    // Each step makes four triangles of one and a vertex on every edge: 4 -> 16 -> 64
+    // triangles, 4 -> 10 -> 34 vertices.
+    assert_eq!(text.lines().filter(|l| l.starts_with("f ")).count(), 64);
+    assert_eq!(text.lines().filter(|l| l.starts_with("v ")).count(), 34);
+    // It reads back and builds like any mesh.
+    succeed(&["build", "fine.obj", "-o", "fine.vdh"], &dir);
+    // Options that only a semi-regular output has are refused, in one line.
+    let out = demo(
+        &["subdivide", "tetra.obj", "--base", "2", "-o", "x.obj"],
+        &dir,
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && err.contains("--base"), "{err}");
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    assert!(!dir.join("x.obj").exists());
+}
+
+#[test]
+fn near_needs_the_merge_tree_policy() {
+    let dir = scratch_dir("cli_near");
+    let out = demo(&["orbit", "--near", "2", "-o", "out"], &dir);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("--near needs --policy merge-tree"), "{err}");
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    let out = demo(&["orbit", "--policy", "merge-tree", "--near", "-1"], &dir);
+    assert!(!out.status.success());
+}
+
+#[test]
 fn reproduce_fig11_writes_pictures_csv_and_summary_lines() {
     let dir = scratch_dir("cli_reproduce");
     let help = demo(&["reproduce", "--help"], &dir);
@@ -561,6 +602,7 @@ fn reproduce_fig11_writes_pictures_csv_and_summary_lines() {
         "fig11",
         "fig9",
         "fig10",
+        "table1",
         "engines",
         "terrain",
         "Azuma",

@@ -1,0 +1,431 @@
+//! The merge-tree paper's Table 1 (`vdlod-demo reproduce table1`).
+//!
+//! Kuo and Nathan's merge-tree paper ("View-dependent simplification using merge trees",
+//! `../shared/seeds/000_*.txt`, §3.4 and §4) refines a Loop-subdivided bunny wherever a vertex's
+//! bounding sphere is inside a modelled view frustum *and* near the camera, lets everything else
+//! simplify, and moves that frustum on a circle in the xz-plane at the height of the model's
+//! centre. Its Table 1: drawing every triangle ran at 4 frames per second; with frustum sizes
+//! 0.4, 0.2 and 0.1 (each a quarter of the area of the one before) the adapted model ran at 20,
+//! 40 and 50 (5x, 10x, 12.5x).
+//!
+//! Here, faithfully to that set-up:
+//!
+//! - the input is the bunny after one step of Loop subdivision (`vdlod-demo subdivide
+//!   fixtures/bunny.obj --levels 1 -o bunny_loop.obj` writes the same mesh), its hierarchy built
+//!   with the paper's cost (shortest edge first, region-of-influence balancing: `--cost edge
+//!   --balanced`);
+//! - the policy is [`MergeTree`] with `near` = the eye's distance from the model's centre (the
+//!   half of the model that faces the eye is near);
+//! - the frustum size `s` scales the width and height of the orbit camera's frustum by `c s`,
+//!   where the calibration `c` is found by bisection so that at `s` = 0.2 the frustum and the
+//!   near test hold 10% of the leaves (the input's vertices), averaged over the orbit: the
+//!   paper's 4 -> 40 frames per second implies about a tenth of the model drawn. Sizes 0.4 and
+//!   0.1 then have four times and a quarter of that cross-section;
+//! - the whole adapted model is drawn from the orbit camera (the paper's Fig. 2), at 640x480,
+//!   against drawing every triangle from the same camera, in the same frame.
+//!
+//! The summary gives, per frustum size, the triangles kept, the operations per frame, and the
+//! median adapt, render and full-detail milliseconds; the speed-up is the full-detail frame's
+//! median over the adapted frame's (adapt + render).
+
+use std::fmt::Write as _;
+use std::path::Path;
+use std::time::Instant;
+
+use vdlod::{Camera, Orbit};
+use vdlod_core::adapt::{Budget, FrameStats};
+use vdlod_core::build::{BuildOptions, Cost};
+use vdlod_core::cut::Cut;
+use vdlod_core::format::HierarchyView;
+use vdlod_core::policy::{MergeTree, View};
+use vdlod_raster::Shading;
+
+use crate::camera::merge_tree_orbit;
+use crate::frame::Frame;
+use crate::hierarchy::build_with_progress;
+use crate::mesh::IndexedMesh;
+use crate::render::{camera_params, style};
+use crate::wavelet::{mean, median};
+
+/// The frustum sizes of the paper's Table 1, with the speed-up it measured at each.
+pub const SIZES: [(f32, f32); 3] = [(0.4, 5.0), (0.2, 10.0), (0.1, 12.5)];
+/// The share of the leaves the 0.2 frustum holds once calibrated.
+pub const CALIBRATED_SHARE: f64 = 0.10;
+/// The frames' size.
+const WIDTH: usize = 640;
+const HEIGHT: usize = 480;
+
+/// The cut: the Loop-subdivided bunny at full detail fits.
+type BigCut = Cut<{ 1 << 18 }, { 1 << 19 }, { 1 << 15 }, u32>;
+
+/// What to run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Setup {
+    /// Loop subdivision steps applied to the input (the paper: one, on its bunny).
+    pub loop_steps: u32,
+    /// Frames in one revolution of the orbit, one flight per entry: how fast the frustum moves.
+    pub frames: &'static [u32],
+}
+
+impl Setup {
+    /// What `reproduce table1` runs on the bundled bunny: one subdivision step (301,632
+    /// triangles); one revolution in 100 frames (3.6 degrees a frame) and in 400 (0.9). The
+    /// paper does not say how fast its frustum moved.
+    pub const REPRODUCE: Setup = Setup {
+        loop_steps: 1,
+        frames: &[100, 400],
+    };
+}
+
+/// The model of the experiment and its hierarchy.
+pub struct Model {
+    /// The subdivided input, its triangles in a locality order (as a renderer prepares a mesh).
+    pub mesh: IndexedMesh,
+    /// Its hierarchy (`--cost edge --balanced`).
+    pub bytes: Vec<u8>,
+    /// Seconds the build took.
+    pub build_seconds: f64,
+}
+
+impl Model {
+    /// `input` after `loop_steps` steps of Loop subdivision, and its hierarchy.
+    pub fn new(mut mesh: IndexedMesh, loop_steps: u32, progress: bool) -> Result<Model, String> {
+        for _ in 0..loop_steps {
+            mesh = mesh.loop_subdivide();
+        }
+        let options = BuildOptions {
+            cost: Cost::ShortestEdge,
+            balanced: true,
+            ..BuildOptions::default()
+        };
+        let (_, bytes, build_seconds) =
+            build_with_progress(&mesh, &options, progress).map_err(|e| e.to_string())?;
+        mesh.reorder_for_locality();
+        Ok(Model {
+            mesh,
+            bytes,
+            build_seconds,
+        })
+    }
+}
+
+/// The modelled frustum of `camera` at frustum size `scale` (already calibrated).
+fn modelled(camera: &Camera, scale: f32) -> View {
+    camera.view_scaled(scale)
+}
+
+/// The share of `points` inside the frustum of size `scale` and within `near` of the eye,
+/// averaged over `cameras`.
+pub fn share_in_view(points: &[[f32; 3]], cameras: &[Camera], scale: f32, near: f32) -> f64 {
+    let inside: usize = cameras
+        .iter()
+        .map(|camera| {
+            let view = modelled(camera, scale);
+            points
+                .iter()
+                .filter(|&&p| {
+                    let r = glam::Vec3::from(p) - camera.eye;
+                    r.length_squared() < near * near && view.sphere_visible(p, 0.0)
+                })
+                .count()
+        })
+        .sum();
+    inside as f64 / (points.len() * cameras.len()).max(1) as f64
+}
+
+/// The calibration `c`: the frustum scale per unit of frustum size at which size 0.2 holds
+/// [`CALIBRATED_SHARE`] of `points` within `near` of the eyes of `cameras` (bisection: the share
+/// grows with the scale).
+pub fn calibrate(points: &[[f32; 3]], cameras: &[Camera], near: f32) -> f32 {
+    let (mut lo, mut hi) = (0.0f32, 40.0f32);
+    for _ in 0..20 {
+        let mid = 0.5 * (lo + hi);
+        if share_in_view(points, cameras, 0.2 * mid, near) < CALIBRATED_SHARE {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+/// One frustum size's flight.
+#[derive(Clone, Debug, Default)]
+pub struct Row {
+    /// Frustum size.
+    pub size: f32,
+    /// Mean triangles of the adapted model, per frame after the first.
+    pub triangles: f64,
+    /// Mean splits + collapses per frame after the first.
+    pub ops: f64,
+    /// Median milliseconds adapting, drawing the cut, drawing every triangle.
+    pub adapt_ms: f64,
+    /// See `adapt_ms`.
+    pub render_ms: f64,
+    /// See `adapt_ms`.
+    pub full_ms: f64,
+    /// The first frame's adapt milliseconds (from the base mesh).
+    pub first_adapt_ms: f64,
+}
+
+impl Row {
+    /// Full detail's median frame over the adapted frame's.
+    pub fn speedup(&self) -> f64 {
+        self.full_ms / (self.adapt_ms + self.render_ms).max(1e-9)
+    }
+
+    /// The share of the adapted frame spent adapting.
+    pub fn adapt_share(&self) -> f64 {
+        self.adapt_ms / (self.adapt_ms + self.render_ms).max(1e-9)
+    }
+}
+
+/// Where a flight goes and what it refines: one revolution of `orbit`, the merge-tree policy
+/// with `near`, the frustum of size `size` scaled by the calibration `c`.
+struct Flight<'a> {
+    orbit: &'a Orbit,
+    near: f32,
+    c: f32,
+    size: f32,
+}
+
+/// Flies `flight`, timing the cut's adaptation, its drawing and full detail's drawing in each
+/// frame (a row of `csv` each); the cut at frame `picture` is drawn into `shot` with its edges.
+fn fly(
+    model: &Model,
+    h: &HierarchyView<'_>,
+    flight: &Flight<'_>,
+    picture: u32,
+    shot: &mut Frame,
+    csv: &mut String,
+) -> Result<Row, String> {
+    let Flight {
+        orbit,
+        near,
+        c,
+        size,
+    } = *flight;
+    let mut cut = BigCut::boxed();
+    cut.reset(h).map_err(|e| e.to_string())?;
+    let policy = MergeTree { near };
+    let mut frame = Frame::new(WIDTH, HEIGHT).map_err(|e| e.to_string())?;
+    let mut reference = Frame::new(WIDTH, HEIGHT).map_err(|e| e.to_string())?;
+    let full_mesh = model.mesh.as_raster_mesh();
+    let (mut adapt, mut render, mut full) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut tris, mut ops) = (Vec::new(), Vec::new());
+    let mut first_adapt_ms = 0.0;
+    let look = style(Shading::Gouraud, false);
+    for i in 0..orbit.frames {
+        let camera = orbit.camera(i);
+        let view = modelled(&camera, c * size);
+        let start = Instant::now();
+        let stats: FrameStats = cut.adapt(h, &view, &policy, &Budget::default());
+        let t_adapt = start.elapsed().as_secs_f64() * 1e3;
+        let start = Instant::now();
+        frame
+            .draw_cut(&cut, h, &camera, &look)
+            .map_err(|e| e.to_string())?;
+        let t_render = start.elapsed().as_secs_f64() * 1e3;
+        let start = Instant::now();
+        reference
+            .draw(&full_mesh, &camera_params(&camera, Shading::Gouraud, false))
+            .map_err(|e| e.to_string())?;
+        let t_full = start.elapsed().as_secs_f64() * 1e3;
+        let _ = writeln!(
+            csv,
+            "{},{size},{i},{},{},{},{t_adapt:.3},{t_render:.3},{t_full:.3}",
+            orbit.frames, stats.triangles, stats.vsplits, stats.ecols
+        );
+        if i == picture {
+            shot.draw_cut(&cut, h, &camera, &style(Shading::Gouraud, true))
+                .map_err(|e| e.to_string())?;
+        }
+        if i == 0 {
+            first_adapt_ms = t_adapt;
+            continue;
+        }
+        adapt.push(t_adapt);
+        render.push(t_render);
+        full.push(t_full);
+        tris.push(f64::from(stats.triangles));
+        ops.push(f64::from(stats.vsplits + stats.ecols));
+    }
+    Ok(Row {
+        size,
+        triangles: mean(tris.into_iter()),
+        ops: mean(ops.into_iter()),
+        adapt_ms: median(adapt),
+        render_ms: median(render),
+        full_ms: median(full),
+        first_adapt_ms,
+    })
+}
+
+/// Runs the experiment on `input` into `out_dir` (`table1.csv`; for the first speed,
+/// `frustum_S.png` per size and `full.png`, all of the same frame) and returns its summary
+/// lines.
+pub fn table1(out_dir: &Path, input: IndexedMesh, setup: Setup) -> Result<Vec<String>, String> {
+    let io = |e: std::io::Error| format!("{}: {e}", out_dir.display());
+    std::fs::create_dir_all(out_dir).map_err(io)?;
+    let model = Model::new(input, setup.loop_steps, true)?;
+    let h = HierarchyView::parse(&model.bytes).map_err(|e| e.to_string())?;
+    let bounds = model.mesh.bounds();
+    // The calibration and the near distance depend on the circle, not on the speed.
+    let circle = merge_tree_orbit(&bounds, 36, WIDTH, HEIGHT);
+    let near = circle.distance;
+    let cameras: Vec<Camera> = (0..circle.frames).map(|i| circle.camera(i)).collect();
+    let c = calibrate(&model.mesh.positions, &cameras, near);
+    let mut lines = vec![format!(
+        "experiment=table1 triangles={} vertices={} build_s={:.2} hierarchy_bytes={} bytes_per_vertex={:.2} near_radii={:.1} calibration={c:.4} leaves_pct_0.2={:.1}",
+        model.mesh.triangles.len(),
+        model.mesh.positions.len(),
+        model.build_seconds,
+        model.bytes.len(),
+        model.bytes.len() as f64 / model.mesh.positions.len().max(1) as f64,
+        near / circle.radius,
+        100.0 * share_in_view(&model.mesh.positions, &cameras, 0.2 * c, near),
+    )];
+    let mut csv =
+        String::from("frames,size,frame,triangles,vsplits,ecols,adapt_ms,render_ms,full_ms\n");
+    let mut shot = Frame::new(WIDTH, HEIGHT).map_err(|e| e.to_string())?;
+    for (run, &frames) in setup.frames.iter().enumerate() {
+        let orbit = merge_tree_orbit(&bounds, frames.max(2), WIDTH, HEIGHT);
+        let picture = if run == 0 {
+            (orbit.frames / 8).max(1)
+        } else {
+            u32::MAX
+        };
+        for (size, paper) in SIZES {
+            let flight = Flight {
+                orbit: &orbit,
+                near,
+                c,
+                size,
+            };
+            let row = fly(&model, &h, &flight, picture, &mut shot, &mut csv)?;
+            if run == 0 {
+                shot.save_png(&out_dir.join(format!("frustum_{size}.png")))
+                    .map_err(|e| e.to_string())?;
+            }
+            lines.push(format!(
+                "experiment=table1 frames={} degrees_per_frame={:.1} frustum={size} kept_pct={:.1} triangles={:.0} ops={:.0} adapt_ms={:.2} render_ms={:.2} full_ms={:.2} speedup={:.2} adapt_share_pct={:.0} first_adapt_ms={:.1} paper_speedup={paper}",
+                orbit.frames,
+                360.0 / orbit.frames as f64,
+                100.0 * row.triangles / model.mesh.triangles.len().max(1) as f64,
+                row.triangles,
+                row.ops,
+                row.adapt_ms,
+                row.render_ms,
+                row.full_ms,
+                row.speedup(),
+                100.0 * row.adapt_share(),
+                row.first_adapt_ms,
+            ));
+        }
+        if run == 0 {
+            shot.draw(
+                &model.mesh.as_raster_mesh(),
+                &camera_params(&orbit.camera(picture), Shading::Gouraud, false),
+            )
+            .map_err(|e| e.to_string())?;
+            shot.save_png(&out_dir.join("full.png"))
+                .map_err(|e| e.to_string())?;
+        }
+    }
+    std::fs::write(out_dir.join("table1.csv"), csv).map_err(io)?;
+    Ok(lines)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::{load_obj_bytes, COW_NAME, COW_OBJ};
+    use crate::summary_value;
+
+    fn cow() -> IndexedMesh {
+        load_obj_bytes(COW_NAME, COW_OBJ).unwrap()
+    }
+
+    #[test]
+    fn the_frustum_and_the_near_test_refine_to_every_leaf_they_hold() {
+        let model = Model::new(cow(), 0, false).unwrap();
+        let h = HierarchyView::parse(&model.bytes).unwrap();
+        let orbit = merge_tree_orbit(&model.mesh.bounds(), 12, WIDTH, HEIGHT);
+        let near = orbit.distance;
+        let mut cut = BigCut::boxed();
+        cut.reset(&h).unwrap();
+        let policy = MergeTree { near };
+        let mut inside_somewhere = 0;
+        for i in 0..orbit.frames {
+            let camera = orbit.camera(i);
+            let view = modelled(&camera, 0.3);
+            let stats = cut.adapt(&h, &view, &policy, &Budget::default());
+            assert!(!stats.capacity_limited && !stats.queue_overflow);
+            let active: std::collections::BTreeSet<u32> = cut.nodes().iter().copied().collect();
+            // Every leaf whose own position is in the frustum and near is drawn as it is: its
+            // ancestors' spheres hold it, so each of them was wanted and split.
+            for leaf in h.leaf_nodes() {
+                let (p, _, _) = h.vertex(leaf);
+                let r = glam::Vec3::from(p) - camera.eye;
+                if r.length() < near && view.sphere_visible(p, 0.0) {
+                    inside_somewhere += 1;
+                    assert!(active.contains(&leaf), "frame {i}: leaf {leaf} not refined");
+                }
+            }
+            // And the rest simplifies: far fewer triangles than the model.
+            assert!(
+                stats.triangles < model.mesh.triangles.len() as u32 / 2,
+                "{stats:?}"
+            );
+        }
+        assert!(inside_somewhere > 100, "{inside_somewhere}");
+    }
+
+    #[test]
+    fn the_calibration_puts_a_tenth_of_the_leaves_in_the_frustum() {
+        let mesh = cow();
+        let orbit = merge_tree_orbit(&mesh.bounds(), 8, WIDTH, HEIGHT);
+        let cameras: Vec<Camera> = (0..8).map(|i| orbit.camera(i)).collect();
+        let c = calibrate(&mesh.positions, &cameras, orbit.distance);
+        let share = share_in_view(&mesh.positions, &cameras, 0.2 * c, orbit.distance);
+        assert!((share - CALIBRATED_SHARE).abs() < 0.005, "{share}");
+        // Twice the size holds more, half the size less.
+        assert!(share_in_view(&mesh.positions, &cameras, 0.4 * c, orbit.distance) > 2.0 * share);
+        assert!(share_in_view(&mesh.positions, &cameras, 0.1 * c, orbit.distance) < 0.5 * share);
+    }
+
+    #[test]
+    fn smaller_frustums_keep_fewer_triangles() {
+        let out = std::env::temp_dir().join(format!("vdlod_table1_{}", std::process::id()));
+        let setup = Setup {
+            loop_steps: 1,
+            frames: &[16],
+        };
+        let lines = table1(&out, cow(), setup).unwrap();
+        assert_eq!(lines.len(), 4);
+        let leaves: f64 = summary_value(&lines[0], "leaves_pct_0.2").unwrap();
+        assert!((leaves - 10.0).abs() <= 0.5, "{}", lines[0]);
+        let kept: Vec<f64> = lines[1..]
+            .iter()
+            .map(|l| summary_value(l, "kept_pct").unwrap())
+            .collect();
+        assert!(kept[0] > kept[1] && kept[1] > kept[2], "{kept:?}");
+        // The 0.2 frustum holds a tenth of the leaves; the coarse rest adds some.
+        assert!((10.0..40.0).contains(&kept[1]), "{kept:?}");
+        for l in &lines[1..] {
+            assert!(summary_value::<f64>(l, "ops").unwrap() > 0.0, "{l}");
+            assert!(summary_value::<f64>(l, "speedup").unwrap() > 0.0, "{l}");
+        }
+        for name in [
+            "frustum_0.4.png",
+            "frustum_0.2.png",
+            "frustum_0.1.png",
+            "full.png",
+        ] {
+            assert!(out.join(name).exists(), "{name}");
+        }
+        let csv = std::fs::read_to_string(out.join("table1.csv")).unwrap();
+        assert_eq!(csv.lines().count(), 1 + 3 * 16);
+        std::fs::remove_dir_all(&out).ok();
+    }
+}
