@@ -173,8 +173,7 @@ fn draw_full(
     Ok(frame.pixels().to_vec())
 }
 
-/// A picture of the sheet: its caption and pixels (`WIDTH` x `HEIGHT`).
-/// A picture of a figure sheet, with its caption.
+/// A picture of a figure sheet ([`sheet`]), with its caption.
 pub(crate) struct Panel {
     pub(crate) caption: String,
     pub(crate) pixels: Vec<Rgba8>,

@@ -43,6 +43,7 @@ use vdlod_raster::Shading;
 use crate::camera::merge_tree_orbit;
 use crate::frame::Frame;
 use crate::hierarchy::build_with_progress;
+use crate::importance::{sheet, Panel};
 use crate::mesh::IndexedMesh;
 use crate::render::{camera_params, style};
 use crate::wavelet::{mean, median};
@@ -261,9 +262,26 @@ fn fly(
     })
 }
 
+/// The part of a frame the sheet shows: the middle, where the model is.
+const CROP: [usize; 2] = [320, 300];
+
+/// The middle [`CROP`] of `frame`, captioned.
+fn panel(frame: &Frame, caption: String) -> Panel {
+    let [w, h] = CROP;
+    let (x0, y0) = ((WIDTH - w) / 2, (HEIGHT - h) / 2);
+    let pixels = (y0..y0 + h)
+        .flat_map(|y| {
+            frame.pixels()[y * WIDTH + x0..y * WIDTH + x0 + w]
+                .iter()
+                .copied()
+        })
+        .collect();
+    Panel { caption, pixels }
+}
+
 /// Runs the experiment on `input` into `out_dir` (`table1.csv`; for the first speed,
-/// `frustum_S.png` per size and `full.png`, all of the same frame) and returns its summary
-/// lines.
+/// `frustum_S.png` per size and `full.png`, all of the same frame, and `table1.png`, their
+/// middles side by side as in the paper's Fig. 2) and returns its summary lines.
 pub fn table1(out_dir: &Path, input: IndexedMesh, setup: Setup) -> Result<Vec<String>, String> {
     let io = |e: std::io::Error| format!("{}: {e}", out_dir.display());
     std::fs::create_dir_all(out_dir).map_err(io)?;
@@ -288,6 +306,7 @@ pub fn table1(out_dir: &Path, input: IndexedMesh, setup: Setup) -> Result<Vec<St
     let mut csv =
         String::from("frames,size,frame,triangles,vsplits,ecols,adapt_ms,render_ms,full_ms\n");
     let mut shot = Frame::new(WIDTH, HEIGHT).map_err(|e| e.to_string())?;
+    let mut panels = Vec::new();
     for (run, &frames) in setup.frames.iter().enumerate() {
         let orbit = merge_tree_orbit(&bounds, frames.max(2), WIDTH, HEIGHT);
         let picture = if run == 0 {
@@ -306,6 +325,7 @@ pub fn table1(out_dir: &Path, input: IndexedMesh, setup: Setup) -> Result<Vec<St
             if run == 0 {
                 shot.save_png(&out_dir.join(format!("frustum_{size}.png")))
                     .map_err(|e| e.to_string())?;
+                panels.push(panel(&shot, format!("frustum {size}")));
             }
             lines.push(format!(
                 "experiment=table1 frames={} degrees_per_frame={:.1} frustum={size} kept_pct={:.1} triangles={:.0} ops={:.0} adapt_ms={:.2} render_ms={:.2} full_ms={:.2} speedup={:.2} adapt_share_pct={:.0} first_adapt_ms={:.1} paper_speedup={paper}",
@@ -330,6 +350,9 @@ pub fn table1(out_dir: &Path, input: IndexedMesh, setup: Setup) -> Result<Vec<St
             .map_err(|e| e.to_string())?;
             shot.save_png(&out_dir.join("full.png"))
                 .map_err(|e| e.to_string())?;
+            panels.push(panel(&shot, "full detail".into()));
+            let png = sheet(&panels, panels.len(), CROP)?;
+            std::fs::write(out_dir.join("table1.png"), png).map_err(io)?;
         }
     }
     std::fs::write(out_dir.join("table1.csv"), csv).map_err(io)?;
