@@ -523,6 +523,12 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
 
     /// Makes slot `s` hold `node` in place of the node it held (no blend; links redone).
     fn rename_vertex(&mut self, h: &HierarchyView<'_>, s: usize, node: u32) {
+        self.reassign(s, node);
+        self.link_family(h, s as u32);
+    }
+
+    /// [`Cut::rename_vertex`] without the links: the caller sets them.
+    fn reassign(&mut self, s: usize, node: u32) {
         self.map.remove(self.v.node[s], self.v.nodes());
         self.unlink_mate(s);
         self.free_blend(s);
@@ -530,7 +536,19 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         // The old entry was removed, so there is room.
         self.map.insert(s as u32, self.v.nodes());
         self.v.flags[s] &= VISIBLE | WAS_VISIBLE;
-        self.link_family(h, s as u32);
+    }
+
+    /// Links slots `first` and `second`, just given a split's two children (in the order
+    /// [`HierarchyView::split`] lists them), as mates: what [`Cut::link_family`] finds for each,
+    /// without looking up their parent or each other (both records are adjacent in the file).
+    fn link_children(&mut self, h: &HierarchyView<'_>, [first, second]: [u32; 2]) {
+        let (a, b) = (first as usize, second as usize);
+        self.v.digest[a] = h.digest(self.v.node[a]);
+        self.v.digest[b] = h.digest(self.v.node[b]);
+        self.v.flags[a] |= FIRST_CHILD;
+        self.v.flags[b] &= !FIRST_CHILD;
+        self.v.set_mate(a, second);
+        self.v.set_mate(b, first);
     }
 
     /// Swap-removes vertex slot `v` (its node already out of the map, its triangles gone or

@@ -165,7 +165,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         let start = (frames > 0 && self.blends.len() + 2 <= Q).then(|| self.vertex(h, ps as usize));
         // Room was proven: the vertex arena has a slot, and the node map takes the second child
         // because the first replaces the parent's entry.
-        self.rename_vertex(h, ps as usize, c0);
+        self.reassign(ps as usize, c0);
         let Some(c1s) = self.push_vertex(c1) else {
             // `split_legal` proved room in the vertex arena and the node map, so this cannot
             // happen; should it, the parent comes back rather than the cut breaking.
@@ -173,7 +173,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             self.rename_vertex(h, ps as usize, node);
             return [ps, ps];
         };
-        self.link_family(h, c1s);
+        self.link_children(h, [ps, c1s]);
         if let Some(from) = start {
             self.start_blend_from(ps as usize, &from, frames, false);
             self.start_blend_from(c1s as usize, &from, frames, false);
