@@ -295,7 +295,8 @@ fn open_borders_honour_the_tolerance() {
 }
 
 /// A policy that asks every vertex every frame: the same demands as the one it wraps, but no
-/// envelope, so the cut neither decides vertices from their digests nor skips settled ones.
+/// envelope and no sphere-only promise, so the cut neither decides vertices from their digests
+/// nor skips settled ones.
 struct Opaque<P>(P);
 
 impl<P: vdlod_core::policy::Policy> vdlod_core::policy::Policy for Opaque<P> {
@@ -448,18 +449,8 @@ fn regulation_does_not_overshoot_with_geomorphs() {
 /// geomorphs.
 #[test]
 fn sphere_only_policies_decide_from_digests_exactly() {
-    use vdlod_core::policy::{Bounds, Demand, Envelope, MergeTree, Policy, View};
+    use vdlod_core::policy::{MergeTree, Policy, View};
     use vdlod_demo::camera::merge_tree_orbit;
-    /// The same demand, without the promise.
-    struct Opaque(MergeTree);
-    impl Policy for Opaque {
-        fn demand(&self, b: &Bounds, view: &View) -> Demand {
-            self.0.demand(b, view)
-        }
-        fn envelope(&self, view: &View) -> Option<Envelope> {
-            self.0.envelope(view)
-        }
-    }
     type C = Cut<32_767, 65_534, 4096>;
     for name in ["bunny.obj", "head.obj"] {
         let mesh = fixture(name);

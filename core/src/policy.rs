@@ -653,8 +653,20 @@ impl Policy for QRefine {
 }
 
 /// The merge-tree paper's `shouldRefine` (§3.4): refine while the bounding sphere reaches into
-/// the frustum and comes within `near` of the eye; nearer is more urgent. With `near` infinite,
-/// everything in the frustum refines to the leaves, as in the paper's Table 1.
+/// the frustum and comes within `near` of the eye; nearer is more urgent. Everything so placed
+/// refines to the leaves (`vdlod-demo reproduce table1` uses `near` = the eye's distance from
+/// the model's centre; with `near` infinite, the whole frustum refines). It reads only bounding
+/// spheres ([`Policy::sphere_only`]), so a cut decides most vertices without reading the file.
+///
+/// ```
+/// use vdlod_core::policy::{Bounds, MergeTree, Policy, View};
+/// let view = View::look_at([0.0, 0.0, 10.0], [0.0; 3], [0.0, 1.0, 0.0], 1.0, 1.0, 480.0);
+/// let policy = MergeTree { near: 5.0 };
+/// let at = |z: f32| Bounds { center: [0.0, 0.0, z], radius: 0.5, ..Bounds::default() };
+/// assert!(policy.demand(&at(6.0), &view).error > 1.0); // 3.5 from the eye: refine
+/// assert_eq!(policy.demand(&at(-6.0), &view).error, 0.0); // too far: simplify
+/// assert!(!policy.demand(&at(20.0), &view).visible); // behind the eye
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct MergeTree {
     /// Distance from the eye within which detail is wanted.
