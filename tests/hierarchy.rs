@@ -64,7 +64,7 @@ fn open_and_higher_genus_meshes_keep_their_topology() {
                     BuildOptions {
                         cost,
                         balanced,
-                        base_vertices: 0,
+                        ..BuildOptions::default()
                     },
                 );
             }

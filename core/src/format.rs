@@ -29,13 +29,14 @@
 //! |---|---|---|
 //! | header | 64 | see below |
 //! | kinds | 12 per block of 64 nodes | the number of parents among the nodes before the block (`u32`), then one bit per node of the block, set for a parent (`u64`; bits past `nodes` zero) |
-//! | nodes | 8 per leaf, 12 per parent, in id order (node `i` at `8 i + 4 rank(i)`, `rank(i)` the parents below `i`) | position `3 x u16` (`origin + q * extent / 65535`); normal octahedral `2 x i8` (also the axis of the cone of normals); for a parent then the codes of its radius, spheroid `a`, spheroid `b` ([`decode_length`]) and the cone's sine (`ceil(255 sin)`; 255: no useful cone), 8 bits each, so that everything the refinement test reads of a vertex is one record |
+//! | nodes | 8 per leaf, 12 per parent, in id order (node `i` at `8 i + 4 rank(i)`, `rank(i)` the parents below `i`) | position `3 x u16` (`origin + q * extent / 65535`); normal octahedral `2 x i8` (also the axis of the cone of normals); for a parent then the codes of its radius, spheroid `a`, spheroid `b` ([`decode_length`]; with flag bit 1 Hoppe's `delta`, `mu`) and the cone's sine (`ceil(255 sin)`; 255: no useful cone), 8 bits each, so that everything the refinement test reads of a vertex is one record |
 //! | colours | 3 per node, only with flag bit 0 | `3 x u8` |
 //! | parents | `w_n` bits per sibling pair, padded to a byte | the pair's parent |
 //! | splits | `4 w_f` bits per parent, padded to a byte | neighbour triangles `n0..n3` (`w_f` bits each, all ones for none) |
 //! | base triangles | 12 each | `3 x u32` root ids, counter-clockwise |
 //!
-//! Header: offset 0 magic `VDLH`; 4 version `u16` = 4; 6 flags `u16` (bit 0: colours); 8
+//! Header: offset 0 magic `VDLH`; 4 version `u16` = 4; 6 flags `u16` (bit 0: colours; bit 1:
+//! the `a` and `b` codes are Hoppe's `delta` and `mu`, [`FLAG_HOPPE`]); 8
 //! `leaves`, 12 `nodes`, 16 `base_triangles` (`u32` each); 20 CRC-32 of everything after the
 //! header ([`CRC_OFFSET`]); 24 bounding-box origin `3 x f32`; 36 extent `3 x f32` (non-negative);
 //! 48 the length unit of the bounds, `f32` (the box's diagonal); 52 to 63 zero.
@@ -83,6 +84,10 @@ pub const TRIANGLE_SIZE: usize = 12;
 pub const NONE: u32 = u32::MAX;
 /// Header flag: the nodes carry meaningful colours.
 pub const FLAG_COLORS: u16 = 1;
+/// Header flag: a parent's `a` and `b` codes are Hoppe's `delta` and `mu` (a sphere of radius
+/// `mu` swept along the normal by `delta`, read by [`crate::policy::HoppeError`]) instead of a
+/// normal-aligned spheroid.
+pub const FLAG_HOPPE: u16 = 2;
 /// Quantization steps of a position coordinate over the bounding box.
 pub const POSITION_STEPS: f32 = 65535.0;
 
@@ -683,7 +688,7 @@ impl<'a> HierarchyView<'a> {
         if nodes < leaves
             || nodes - leaves > leaves
             || nodes >= 1 << 31
-            || flags & !FLAG_COLORS != 0
+            || flags & !(FLAG_COLORS | FLAG_HOPPE) != 0
             || (base as u64 + 2 * (nodes - leaves) as u64) >= 1 << 31
             || bytes[52..HEADER_SIZE].iter().any(|&b| b != 0)
         {
@@ -977,6 +982,13 @@ impl<'a> HierarchyView<'a> {
     #[must_use]
     pub fn has_colors(&self) -> bool {
         self.flags & FLAG_COLORS != 0
+    }
+
+    /// Whether the parents' error bounds are Hoppe's ([`FLAG_HOPPE`]): draw with
+    /// [`crate::policy::HoppeError`] rather than [`crate::policy::ScreenError`].
+    #[must_use]
+    pub fn hoppe_bounds(&self) -> bool {
+        self.flags & FLAG_HOPPE != 0
     }
 
     /// Size of the file in bytes.

@@ -571,7 +571,8 @@ impl Policy for ScreenError {
 /// by `delta`, read from [`Bounds::b2`] (`mu^2`) and [`Bounds::a2`] (`delta^2`). A split is
 /// wanted while `mu^2 >= k^2 |d|^2` or `delta^2 (|d|^2 - (d.n)^2) >= k^2 |d|^4`, `k` the
 /// tolerance over the pixels per unit length. For the wavelet paper's comparison (its Fig. 10)
-/// with bounds built as Hoppe's ([`crate::wavelet::build::Bound::Hoppe`]).
+/// with bounds built as Hoppe's (`Bound::Hoppe` for semi-regular files, `ErrorBound::Hoppe`
+/// for vertex hierarchies, both under the `build` feature; such files set a header flag).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct HoppeError {
     /// Screen-space tolerances.

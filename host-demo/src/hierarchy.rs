@@ -26,6 +26,8 @@ pub struct Summary {
     pub mean_depth: f64,
     /// File size.
     pub bytes: usize,
+    /// Whether the error bounds are Hoppe's (else spheroids).
+    pub hoppe_bounds: bool,
 }
 
 impl fmt::Display for Summary {
@@ -42,7 +44,11 @@ impl fmt::Display for Summary {
             self.mean_depth,
             self.bytes,
             self.bytes as f64 / self.vertices.max(1) as f64
-        )
+        )?;
+        if self.hoppe_bounds {
+            write!(f, ", Hoppe's error bounds")?;
+        }
+        Ok(())
     }
 }
 
@@ -69,6 +75,7 @@ pub fn summarize(view: &HierarchyView<'_>) -> Summary {
         max_depth,
         mean_depth: sum as f64 / view.leaves().max(1) as f64,
         bytes: view.size(),
+        hoppe_bounds: view.hoppe_bounds(),
     }
 }
 

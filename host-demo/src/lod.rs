@@ -11,8 +11,8 @@ use vdlod_core::adapt::{Budget, FrameStats};
 use vdlod_core::cut::{Coloring, Cut, SlotIndex};
 use vdlod_core::format::{HierarchyView, NONE};
 use vdlod_core::policy::{
-    Bounds as NodeBounds, Demand, Envelope, Frustum, Importance, MergeTree, Policy, QRefine,
-    ScreenError, View,
+    BackFace, Bounds as NodeBounds, Demand, Envelope, Frustum, HoppeError, Importance, MergeTree,
+    Policy, QRefine, ScreenError, View,
 };
 use vdlod_core::wavelet::{SemiRegularView, WaveletCut};
 use vdlod_raster::{Rgba8, Shading, VertexIndex};
@@ -272,6 +272,9 @@ pub fn leaf_bounds(h: &HierarchyView<'_>) -> Bounds {
 pub enum DemoPolicy {
     /// [`QRefine`].
     Screen(QRefine),
+    /// [`HoppeError`] in the [`Frustum`], facing the eye: `qrefine` for files with Hoppe's
+    /// bounds.
+    Hoppe((Frustum, (BackFace, HoppeError))),
     /// [`MergeTree`].
     MergeTree(MergeTree),
     /// [`Importance`] in the [`Frustum`].
@@ -283,6 +286,7 @@ impl Policy for DemoPolicy {
     fn demand(&self, b: &NodeBounds, view: &View) -> Demand {
         match self {
             DemoPolicy::Screen(p) => p.demand(b, view),
+            DemoPolicy::Hoppe(p) => p.demand(b, view),
             DemoPolicy::MergeTree(p) => p.demand(b, view),
             DemoPolicy::Importance(p) => p.demand(b, view),
         }
@@ -292,6 +296,7 @@ impl Policy for DemoPolicy {
     fn envelope(&self, view: &View) -> Option<Envelope> {
         match self {
             DemoPolicy::Screen(p) => p.envelope(view),
+            DemoPolicy::Hoppe(p) => p.envelope(view),
             DemoPolicy::MergeTree(p) => p.envelope(view),
             DemoPolicy::Importance(p) => p.envelope(view),
         }
@@ -301,6 +306,7 @@ impl Policy for DemoPolicy {
     fn sphere_only(&self) -> bool {
         match self {
             DemoPolicy::Screen(p) => p.sphere_only(),
+            DemoPolicy::Hoppe(p) => p.sphere_only(),
             DemoPolicy::MergeTree(p) => p.sphere_only(),
             DemoPolicy::Importance(p) => p.sphere_only(),
         }
@@ -321,18 +327,28 @@ impl Policy for DemoPolicy {
 }
 
 /// The policy for `choice` on a model in the box `bounding_box` (its diagonal sizes the
-/// importance test).
-pub fn make_policy(choice: PolicyChoice, bounding_box: ([f32; 3], [f32; 3])) -> DemoPolicy {
+/// importance test); screen-space tolerances read Hoppe's bound where the file has it
+/// (`hoppe_bounds`).
+pub fn make_policy(
+    choice: PolicyChoice,
+    bounding_box: ([f32; 3], [f32; 3]),
+    hoppe_bounds: bool,
+) -> DemoPolicy {
     match choice {
         PolicyChoice::Screen {
             silhouette,
             interior,
-        } => DemoPolicy::Screen(QRefine {
-            error: ScreenError {
+        } => {
+            let error = ScreenError {
                 silhouette,
                 interior,
-            },
-        }),
+            };
+            if hoppe_bounds {
+                DemoPolicy::Hoppe((Frustum, (BackFace, HoppeError { error })))
+            } else {
+                DemoPolicy::Screen(QRefine { error })
+            }
+        }
         PolicyChoice::MergeTree { near } => {
             let radius = (glam::Vec3::from(bounding_box.1) - glam::Vec3::from(bounding_box.0))
                 .length()
@@ -592,6 +608,8 @@ trait FlightEngine {
     fn base_triangles(&self) -> u32;
     /// Whether the file has colours.
     fn has_colors(&self) -> bool;
+    /// Whether the file's error bounds are Hoppe's.
+    fn hoppe_bounds(&self) -> bool;
     /// The model's bounding box.
     fn bounding_box(&self) -> ([f32; 3], [f32; 3]);
     fn adapt(&mut self, view: &View, policy: &DemoPolicy, budget: &Budget) -> FrameStats;
@@ -657,6 +675,10 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex + VertexIndex>
 
     fn has_colors(&self) -> bool {
         self.h.has_colors()
+    }
+
+    fn hoppe_bounds(&self) -> bool {
+        self.h.hoppe_bounds()
     }
 
     fn bounding_box(&self) -> ([f32; 3], [f32; 3]) {
@@ -734,6 +756,10 @@ where
         self.s.has_colors()
     }
 
+    fn hoppe_bounds(&self) -> bool {
+        self.s.hoppe_bounds()
+    }
+
     fn bounding_box(&self) -> ([f32; 3], [f32; 3]) {
         self.s.bounding_box()
     }
@@ -799,7 +825,7 @@ fn fly_orbit(
     } else {
         merge_tree_orbit(&bounds, opts.frames, opts.width, opts.height)
     };
-    let policy = make_policy(opts.policy, engine.bounding_box());
+    let policy = make_policy(opts.policy, engine.bounding_box(), engine.hoppe_bounds());
     let mut frame = Frame::new(opts.width, opts.height).map_err(|e| e.to_string())?;
     let mut reference = Frame::new(opts.width, opts.height).map_err(|e| e.to_string())?;
     let full_mesh = full.as_raster_mesh();

@@ -8,7 +8,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand, ValueEnum};
 use vdlod_core::adapt::Budget;
-use vdlod_core::build::{BuildOptions, Cost};
+use vdlod_core::build::{BuildOptions, Cost, ErrorBound};
 use vdlod_core::format::HierarchyView;
 use vdlod_core::policy::Importance;
 use vdlod_core::wavelet::build::{Scheme, SemiRegular};
@@ -317,6 +317,21 @@ struct BuildArgs {
     /// Stop at this many base-mesh vertices (default: as few as topology allows).
     #[arg(long, default_value_t = 0)]
     base: u32,
+    /// The error bound each vertex carries.
+    #[arg(long, value_enum, default_value = "offset")]
+    bound: BoundArg,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum BoundArg {
+    /// The leaves' offsets along the vertex normal, as a sphere (widened across a border).
+    Offset,
+    /// The wavelet paper's spheroid (equation 3) over the leaves' distances to the coarse
+    /// surface around the vertex.
+    Spheroid,
+    /// Hoppe's sphere swept along the normal over the same distances (flights then use his
+    /// screen-space test).
+    Hoppe,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -825,14 +840,24 @@ fn fly(
     opts: &OrbitOptions,
     out: &Path,
 ) -> Result<(), String> {
+    let hoppe = matches!(opts.policy, PolicyChoice::Screen { .. })
+        && HierarchyView::parse(bytes).map_or_else(
+            |_| SemiRegularView::parse(bytes).is_ok_and(|s| s.hoppe_bounds()),
+            |h| h.hoppe_bounds(),
+        );
     say!(
-        "{name}: {} vertices, {} triangles at full detail; {} frames at {}x{} into {}",
+        "{name}: {} vertices, {} triangles at full detail; {} frames at {}x{} into {}{}",
         full.positions.len(),
         full.triangles.len(),
         opts.frames,
         opts.width,
         opts.height,
-        out.display()
+        out.display(),
+        if hoppe {
+            "; Hoppe's error bounds, tested as he does"
+        } else {
+            ""
+        }
     );
     let summary = lod::run_orbit(bytes, full, opts, out, |f| {
         let limits = lod::limits(&f.stats);
@@ -896,6 +921,11 @@ fn build_command(args: BuildArgs) -> Result<(), String> {
         },
         balanced: args.balanced,
         base_vertices: args.base,
+        bound: match args.bound {
+            BoundArg::Offset => ErrorBound::Offset,
+            BoundArg::Spheroid => ErrorBound::Spheroid,
+            BoundArg::Hoppe => ErrorBound::Hoppe,
+        },
     };
     let show = std::io::IsTerminal::is_terminal(&std::io::stderr());
     let (_, bytes, seconds) = hierarchy::build_with_progress(&mesh, &opts, show)

@@ -241,6 +241,33 @@ fn build_and_info_agree_on_an_open_mesh() {
 }
 
 #[test]
+fn hoppe_bounds_are_built_marked_and_flown_with_his_test() {
+    let dir = scratch_dir("cli_bound");
+    let head = fixture("head.obj");
+    for bound in ["spheroid", "hoppe"] {
+        let file = format!("{bound}.vdh");
+        let args = [
+            "build",
+            head.to_str().unwrap(),
+            "-o",
+            &file,
+            "--bound",
+            bound,
+        ];
+        let built = String::from_utf8_lossy(&succeed(&args, &dir).stdout).into_owned();
+        let info = String::from_utf8_lossy(&succeed(&["info", &file], &dir).stdout).into_owned();
+        let marked = bound == "hoppe";
+        assert_eq!(info.contains("Hoppe's error bounds"), marked, "{info}");
+        assert_eq!(built.lines().next(), info.lines().next());
+        let flown = succeed(&["orbit", &file, "--frames", "2", "-o", bound], &dir);
+        let said = String::from_utf8_lossy(&flown.stdout);
+        assert_eq!(said.contains("tested as he does"), marked, "{said}");
+    }
+    let out = demo(&["build", "x.obj", "-o", "x.vdh", "--bound", "box"], &dir);
+    assert!(!out.status.success());
+}
+
+#[test]
 fn info_rejects_corrupted_files_in_one_line() {
     let dir = scratch_dir("cli_info_bad");
     let out = demo(

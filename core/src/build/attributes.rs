@@ -4,19 +4,23 @@
 //!   a parent, the smallest sphere around it holding its children's spheres (merge-tree §3.3);
 //! - cone of normals: a leaf's cone holds the normals of its triangles; a parent's holds its
 //!   children's cones;
-//! - error bounds over the *error vectors* `leaf - node` of all leaves below a node: Hoppe's
-//!   uniform (`mu`, across the normal) and normal (`delta`) deviations, and the wavelet paper's
-//!   normal-aligned spheroid, its axis ratio from equation 3 and its size the smallest that holds
-//!   every vector;
+//! - an error bound over the leaves below a node, as [`ErrorBound`] chooses: their offsets
+//!   along the node's normal, or the *residuals* from each leaf to the closest point of the
+//!   triangles around the node as the builder made it, bounded by the wavelet paper's
+//!   normal-aligned spheroid (equation 3) or Hoppe's sphere swept along the normal (Hoppe,
+//!   "View-dependent refinement of progressive meshes", 1997, measures his deviation space the
+//!   same way: residuals of the fine surface to the coarse neighbourhood);
 //! - all bounds made monotonic up the tree (a parent's bound is at least its children's), which is
 //!   what makes a cut chosen by them consistent.
 
 use alloc::vec;
 use alloc::vec::Vec;
 
+use super::bound::{equation3, hoppe};
+use super::closest::{closest, point};
 use super::collapse::Engine;
 use super::vec3::{add, cross, dot, from_f32, len, normalize, scale, sub, Vec3d};
-use super::{Hierarchy, InputMesh, Node, NONE};
+use super::{ErrorBound, Hierarchy, InputMesh, Node, NONE};
 use crate::format::{oct_decode, oct_encode};
 
 fn to_f32(v: Vec3d) -> [f32; 3] {
@@ -193,41 +197,30 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, e: Engine<'_>) -> Hierarchy {
         k = j;
     }
 
-    for c in &e.collapses {
+    let mut errors: Vec<(f32, f32)> = Vec::new();
+    for (k, c) in e.collapses.iter().enumerate() {
         let p = c.parent as usize;
         let n = axis[p];
-        let (mut along, mut across, mut outline) = (0.0f64, 0.0f64, 0.0f64);
         let (s, t) = range[p];
-        for &leaf in &order[s as usize..t as usize] {
-            let d = sub(pos[leaf as usize], pos[p]);
-            along = along.max(dot(d, n).abs());
-            across = across.max(len(cross(d, n)));
-            if on_border.get(leaf as usize) == Some(&true) {
-                outline = outline.max(len(cross(d, n)));
+        let below = &order[s as usize..t as usize];
+        let own = if e.opts.bound == ErrorBound::Offset {
+            offset_bound(below, &pos, pos[p], n, &on_border)
+        } else {
+            let start = k.checked_sub(1).map_or(0, |j| e.fan_ends[j] as usize);
+            let fan = &e.fans[start..e.fan_ends[k] as usize];
+            errors.clear();
+            errors.extend(below.iter().map(|&leaf| {
+                let x = pos[leaf as usize];
+                let d = sub(x, nearest(x, fan, &pos).unwrap_or(pos[p]));
+                (up(dot(d, n).abs()), up(len(cross(d, n))))
+            }));
+            match e.opts.bound {
+                ErrorBound::Hoppe => hoppe(&errors),
+                _ => equation3(&errors),
             }
-        }
-        // The error of replacing the region by the node: each leaf's offset from the coarse
-        // surface, which near the node is its tangent plane, so the offset lies along the normal
-        // (Hoppe's normal deviation `delta`). A region's extent across the normal is not an
-        // error: a flat region simplifies to nothing visible however wide it is. The spheroid of
-        // equation 3 gets `a` = the largest offset and, across, the same radius `b = a` (Hoppe's
-        // uniform term `mu` = `delta`): with `b = 0` face-on regions cost nothing and lose their
-        // shading, which measured 0.6 to 1.3 dB worse PSNR at equal triangle counts
-        // (`cargo bench --bench lod -- quality`). On a border the extent across the normal is an
-        // error: it is how far the outline moves (a coarse border edge cuts across the notches
-        // of the fine one), so there `b` also bounds the border leaves' offsets across the
-        // normal; without it an open mesh's outline strayed 16 px at a 1 px tolerance.
-        let (a, b) = (along, along.max(outline));
-        let [c0, c1] = c.children.map(|x| &nodes[x as usize]);
-        let mono = |own: f64, f: fn(&Node) -> f32| own.max(f(c0) as f64).max(f(c1) as f64);
-        let mu = mono(across, |n| n.mu);
-        let delta = mono(along, |n| n.delta);
-        let sa = mono(a, |n| n.spheroid[0]);
-        let sb = mono(b, |n| n.spheroid[1]);
-        let node = &mut nodes[p];
-        node.mu = up(mu);
-        node.delta = up(delta);
-        node.spheroid = [up(sa), up(sb)];
+        };
+        let [c0, c1] = c.children.map(|x| nodes[x as usize].spheroid);
+        nodes[p].spheroid = core::array::from_fn(|i| own[i].max(c0[i]).max(c1[i]));
     }
     for (i, node) in nodes.iter_mut().enumerate() {
         node.radius = up(radius[i]);
@@ -247,9 +240,51 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, e: Engine<'_>) -> Hierarchy {
         .map(|(t, _)| *t)
         .collect();
     Hierarchy {
+        bound: e.opts.bound,
         leaves: leaves as u32,
         nodes,
         base_triangles,
         heap_pushes,
     }
+}
+
+/// [`ErrorBound::Offset`] of a node at `center` with normal `n` over the leaves `below`.
+fn offset_bound(
+    below: &[u32],
+    pos: &[Vec3d],
+    center: Vec3d,
+    n: Vec3d,
+    on_border: &[bool],
+) -> [f32; 2] {
+    let (mut along, mut outline) = (0.0f64, 0.0f64);
+    for &leaf in below {
+        let d = sub(pos[leaf as usize], center);
+        along = along.max(dot(d, n).abs());
+        if on_border.get(leaf as usize) == Some(&true) {
+            outline = outline.max(len(cross(d, n)));
+        }
+    }
+    // The error of replacing the region by the node: each leaf's offset from the coarse
+    // surface, which near the node is its tangent plane, so the offset lies along the normal.
+    // A region's extent across the normal is not an error: a flat region simplifies to nothing
+    // visible however wide it is. `b = a`: with `b = 0` face-on regions cost nothing and lose
+    // their shading, which measured 0.6 to 1.3 dB worse PSNR at equal triangle counts
+    // (`cargo bench --bench lod -- quality`). On a border the extent across the normal is an
+    // error: it is how far the outline moves (a coarse border edge cuts across the notches of
+    // the fine one), so there `b` also bounds the border leaves' offsets across the normal;
+    // without it an open mesh's outline strayed 16 px at a 1 px tolerance.
+    [up(along), up(along.max(outline))]
+}
+
+/// The closest point to `x` on the triangles `fan` (corners in `pos`), or `None` for no
+/// triangle.
+fn nearest(x: Vec3d, fan: &[[u32; 3]], pos: &[Vec3d]) -> Option<Vec3d> {
+    fan.iter()
+        .map(|t| {
+            let corners = t.map(|v| pos[v as usize]);
+            let (w, d2) = closest(x, corners);
+            (d2, point(corners, w))
+        })
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+        .map(|(_, q)| q)
 }

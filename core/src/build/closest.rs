@@ -11,7 +11,7 @@
 use alloc::vec;
 use alloc::vec::Vec;
 
-use super::vec3::{cross, dot, from_f32, scale, sub, Vec3d};
+use super::vec3::{add, cross, dot, from_f32, scale, sub, Vec3d};
 
 /// The input triangles, binned for nearest-point queries.
 pub(crate) struct Surface {
@@ -59,6 +59,53 @@ pub(crate) fn triangle_distance2(p: Vec3d, t: &[Vec3d; 3]) -> f64 {
     segment_distance2(p, a, b)
         .min(segment_distance2(p, b, c))
         .min(segment_distance2(p, c, a))
+}
+
+/// The closest point of triangle `t` to `p`: its barycentric weights and squared distance.
+pub(crate) fn closest(p: Vec3d, t: [Vec3d; 3]) -> ([f64; 3], f64) {
+    // Ericson, "Real-time collision detection" (2004), 5.1.5: by the Voronoi regions.
+    let [a, b, c] = t;
+    let (ab, ac, ap) = (sub(b, a), sub(c, a), sub(p, a));
+    let (d1, d2) = (dot(ab, ap), dot(ac, ap));
+    let weights = if d1 <= 0.0 && d2 <= 0.0 {
+        [1.0, 0.0, 0.0]
+    } else {
+        let bp = sub(p, b);
+        let (d3, d4) = (dot(ab, bp), dot(ac, bp));
+        let cp = sub(p, c);
+        let (d5, d6) = (dot(ab, cp), dot(ac, cp));
+        let vc = d1 * d4 - d3 * d2;
+        let vb = d5 * d2 - d1 * d6;
+        let va = d3 * d6 - d5 * d4;
+        if d3 >= 0.0 && d4 <= d3 {
+            [0.0, 1.0, 0.0]
+        } else if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+            let v = d1 / (d1 - d3);
+            [1.0 - v, v, 0.0]
+        } else if d6 >= 0.0 && d5 <= d6 {
+            [0.0, 0.0, 1.0]
+        } else if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+            let w = d2 / (d2 - d6);
+            [1.0 - w, 0.0, w]
+        } else if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+            let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+            [0.0, 1.0 - w, w]
+        } else {
+            let s = va + vb + vc;
+            if s > 0.0 && s.is_finite() {
+                [va / s, vb / s, vc / s]
+            } else {
+                [1.0 / 3.0; 3]
+            }
+        }
+    };
+    let q = point(t, weights);
+    let d = sub(p, q);
+    (weights, dot(d, d))
+}
+
+pub(crate) fn point(t: [Vec3d; 3], w: [f64; 3]) -> Vec3d {
+    add(add(scale(t[0], w[0]), scale(t[1], w[1])), scale(t[2], w[2]))
 }
 
 impl Surface {

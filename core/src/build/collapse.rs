@@ -15,7 +15,7 @@ use super::closest::Surface;
 use super::flatten::{flatten, PlanarCollapse};
 use super::quadric::{place, Quadric};
 use super::vec3::{add, cross, dot, from_f32, len, normalize, scale, sub, Vec3d};
-use super::{BuildOptions, Cost, InputMesh, NONE};
+use super::{BuildOptions, Cost, ErrorBound, InputMesh, NONE};
 
 /// What one collapse did, enough to undo it by a vertex split.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -34,7 +34,7 @@ pub struct Collapse {
 }
 
 pub(crate) struct Engine<'o> {
-    opts: &'o BuildOptions,
+    pub opts: &'o BuildOptions,
     pub pos: Vec<Vec3d>,
     pub quadric: Vec<Quadric>,
     pub area: Vec<f64>,
@@ -56,6 +56,11 @@ pub(crate) struct Engine<'o> {
     /// Edges found illegal, by endpoint: retried when a collapse changes that endpoint's ring.
     rejected: Vec<Vec<u32>>,
     pub collapses: Vec<Collapse>,
+    /// For error bounds measured as residuals ([`ErrorBound::Spheroid`], [`ErrorBound::Hoppe`]):
+    /// the triangles around each collapse's new vertex as it made them, collapse `k`'s at
+    /// `fans[fan_ends[k - 1]..fan_ends[k]]` (vertex ids name one position for ever).
+    pub fans: Vec<[u32; 3]>,
+    pub fan_ends: Vec<u32>,
     /// The input surface, for [`Cost::Color`]'s `Gerr`.
     surface: Option<Surface>,
     /// When set, every collapse's planar maps (for the remesher); an edge whose region has no
@@ -142,6 +147,8 @@ impl<'o> Engine<'o> {
             deferred: Vec::new(),
             rejected: vec![Vec::new(); n],
             collapses: Vec::new(),
+            fans: Vec::new(),
+            fan_ends: Vec::new(),
             surface: (opts.cost == Cost::Color)
                 .then(|| Surface::new(mesh.positions, mesh.triangles)),
             planar: None,
@@ -477,6 +484,10 @@ impl<'o> Engine<'o> {
             for &f in &pf {
                 self.marked[f as usize] = true;
             }
+        }
+        if self.opts.bound != ErrorBound::Offset {
+            self.fans.extend(pf.iter().map(|&f| self.faces[f as usize]));
+            self.fan_ends.push(self.fans.len() as u32);
         }
         self.vfaces.push(pf);
         self.alive[ia] = false;

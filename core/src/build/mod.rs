@@ -15,8 +15,9 @@
 //! blocks further collapses around it until no unblocked collapse is left.
 //!
 //! Each node then gets what the run-time tests need ([`Node`]): a bounding-sphere radius over its
-//! subtree's region (merge-tree §3.3), a cone of normals, Hoppe-style uniform and normal deviation
-//! and the wavelet paper's normal-aligned spheroid (equation 3), colour, depth, and its
+//! subtree's region (merge-tree §3.3), a cone of normals, an error bound ([`ErrorBound`]: the
+//! leaves' offsets, or the wavelet paper's spheroid or Hoppe's deviation space over the
+//! residuals to the coarse surface), colour, depth, and its
 //! neighbouring triangles (Hoppe's `fn0..fn3`). [`Hierarchy::refine_all`] replays every split from the base mesh with nothing but
 //! the nodes' records.
 //!
@@ -39,6 +40,7 @@
 //! ```
 
 mod attributes;
+pub mod bound;
 pub(crate) mod closest;
 pub(crate) mod collapse;
 pub(crate) mod flatten;
@@ -69,6 +71,27 @@ pub enum Cost {
     Color,
 }
 
+/// What a parent's two error-bound lengths hold (the file's `a` and `b` codes), and how they are
+/// measured.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ErrorBound {
+    /// The leaves' offsets from the node along its normal: `a` the largest and `b = a` (a
+    /// sphere of that radius), `b` widened on a border by how far the outline moves. Measures
+    /// the error against the node's tangent plane, so on a curved region it grows with the
+    /// region's width even where the coarse surface follows the fine one.
+    #[default]
+    Offset,
+    /// The wavelet paper's spheroid (equation 3, [`bound::equation3`]) over the *residuals*:
+    /// from each leaf below the node to the closest point of the triangles around the node when
+    /// the builder made it (Hoppe's deviation space, measured the same way). Read by
+    /// [`crate::policy::ScreenError`].
+    Spheroid,
+    /// Hoppe's `delta` and `mu` ([`bound::hoppe`]) over the same residuals, in the `a` and `b`
+    /// fields; the file says so with [`crate::format::FLAG_HOPPE`], and
+    /// [`crate::policy::HoppeError`] reads them.
+    Hoppe,
+}
+
 /// Settings of [`build`].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct BuildOptions {
@@ -78,6 +101,8 @@ pub struct BuildOptions {
     pub balanced: bool,
     /// Stop when this many vertices are left (0: collapse while any collapse is legal).
     pub base_vertices: u32,
+    /// The error bound the parents carry.
+    pub bound: ErrorBound,
 }
 
 /// Progress of a build, for a progress bar.
@@ -113,12 +138,9 @@ pub struct Node {
     pub normal: [f32; 3],
     /// Sine of the cone's half-angle (`1.0` or more: the cone is not a useful bound).
     pub cone_sin: f32,
-    /// Largest distance of a descendant leaf from `position` across the normal (Hoppe's `mu`).
-    pub mu: f32,
-    /// Largest distance of a descendant leaf from `position` along the normal (Hoppe's `delta`).
-    pub delta: f32,
-    /// Normal-aligned spheroid `[a, b]` bounding the descendant leaves' error vectors (wavelet
-    /// paper, equation 3): `a` along the normal, `b` across it.
+    /// The error bound of [`Hierarchy::bound`] over the descendant leaves, `[a, b]`: a
+    /// normal-aligned spheroid (`a` along the normal, `b` across it) or Hoppe's `[delta, mu]`.
+    /// At least the children's, component by component.
     pub spheroid: [f32; 2],
     /// Colour (area-weighted mean of the region's vertex colours).
     pub color: [u8; 3],
@@ -136,6 +158,8 @@ pub struct Hierarchy {
     pub nodes: Vec<Node>,
     /// The triangles left after the last collapse, over root nodes.
     pub base_triangles: Vec<[u32; 3]>,
+    /// What the nodes' [`Node::spheroid`] holds.
+    pub bound: ErrorBound,
     /// Edges pushed on the cost heap during the build: the work done, linear in the mesh size for
     /// meshes of bounded vertex degree.
     pub heap_pushes: u64,
@@ -152,8 +176,6 @@ impl Default for Node {
             radius: 0.0,
             normal: [0.0, 0.0, 1.0],
             cone_sin: 1.0,
-            mu: 0.0,
-            delta: 0.0,
             spheroid: [0.0; 2],
             color: [0; 3],
             depth: 0,

@@ -125,7 +125,7 @@ fn open_grid_round_trips_and_keeps_its_border() {
                 BuildOptions {
                     cost,
                     balanced,
-                    base_vertices: 0,
+                    ..BuildOptions::default()
                 },
             );
             assert_eq!(
@@ -181,13 +181,24 @@ fn base_size_is_respected() {
 #[test]
 fn bounds_are_monotonic_and_hold_the_leaves() {
     let (p, t) = sphere(3);
-    let h = build_it(&p, &t, BuildOptions::default());
+    for bound in [ErrorBound::Offset, ErrorBound::Spheroid, ErrorBound::Hoppe] {
+        bounds_hold(&build_it(
+            &p,
+            &t,
+            BuildOptions {
+                bound,
+                ..BuildOptions::default()
+            },
+        ));
+    }
+}
+
+fn bounds_hold(h: &Hierarchy) {
     for (i, node) in h.nodes.iter().enumerate() {
         if node.parent == NONE {
             continue;
         }
         let parent = &h.nodes[node.parent as usize];
-        assert!(parent.mu >= node.mu && parent.delta >= node.delta);
         assert!(parent.spheroid[0] >= node.spheroid[0] && parent.spheroid[1] >= node.spheroid[1]);
         assert!(parent.depth + 1 == node.depth);
         // The parent's sphere holds the child's.
@@ -199,6 +210,9 @@ fn bounds_are_monotonic_and_hold_the_leaves() {
             d + node.radius as f64 <= parent.radius as f64 * (1.0 + 1e-6),
             "node {i}"
         );
+    }
+    if h.bound != ErrorBound::Offset {
+        return;
     }
     // Every leaf lies within each ancestor's spheroid height of its tangent plane.
     for leaf in 0..h.leaves {
@@ -214,6 +228,48 @@ fn bounds_are_monotonic_and_hold_the_leaves() {
             );
             a = n.parent;
         }
+    }
+}
+
+#[test]
+fn residual_bounds_follow_the_coarse_surface() {
+    // A residual runs from a leaf to the nearest point of the coarse triangles, so it lies
+    // mostly along the normal: the spheroid is flat (`b` well under the offset bound's `b = a`).
+    // The three bounds share one forest; the spheroid holds Hoppe's box.
+    let (p, t) = sphere(3);
+    let of = |bound| {
+        build_it(
+            &p,
+            &t,
+            BuildOptions {
+                bound,
+                ..BuildOptions::default()
+            },
+        )
+    };
+    let (offset, spheroid, hoppe) = (
+        of(ErrorBound::Offset),
+        of(ErrorBound::Spheroid),
+        of(ErrorBound::Hoppe),
+    );
+    let parents = offset.leaves as usize..offset.nodes.len();
+    let mut tighter = 0;
+    for i in parents.clone() {
+        let (o, s, h) = (&offset.nodes[i], &spheroid.nodes[i], &hoppe.nodes[i]);
+        assert_eq!((o.children, s.children), (h.children, h.children));
+        assert!(s.spheroid[0] >= h.spheroid[0] && s.spheroid[1] >= h.spheroid[1]);
+        tighter += usize::from(s.spheroid[1] < 0.5 * o.spheroid[1]);
+    }
+    assert!(
+        tighter * 2 > parents.len(),
+        "{tighter} of {} parents",
+        parents.len()
+    );
+    // Only Hoppe's file says its codes are `delta` and `mu`.
+    for (h, flag) in [(&offset, false), (&spheroid, false), (&hoppe, true)] {
+        let bytes = h.to_bytes(false);
+        let view = crate::format::HierarchyView::parse(&bytes).expect("valid");
+        assert_eq!(view.hoppe_bounds(), flag);
     }
 }
 

@@ -3,10 +3,10 @@
 
 use alloc::vec::Vec;
 
-use super::Hierarchy;
+use super::{ErrorBound, Hierarchy};
 use crate::format::{
     crc32, encode_length, id_width, oct_encode, ModelBox, BOX_OFFSET, COUNT_OFFSETS, CRC_OFFSET,
-    FLAG_COLORS, HEADER_SIZE, KIND_BLOCK, MAGIC, NONE, VERSION,
+    FLAG_COLORS, FLAG_HOPPE, HEADER_SIZE, KIND_BLOCK, MAGIC, NONE, VERSION,
 };
 
 /// The file's numbering of a hierarchy's nodes (see [`crate::format`], "Numbering").
@@ -137,7 +137,9 @@ impl Hierarchy {
         let mut out = Vec::new();
         out.extend_from_slice(&MAGIC);
         out.extend_from_slice(&VERSION.to_le_bytes());
-        out.extend_from_slice(&(if colors { FLAG_COLORS } else { 0 }).to_le_bytes());
+        let hoppe = self.bound == ErrorBound::Hoppe;
+        let flags = if colors { FLAG_COLORS } else { 0 } | if hoppe { FLAG_HOPPE } else { 0 };
+        out.extend_from_slice(&flags.to_le_bytes());
         out.resize(HEADER_SIZE, 0);
         let Some(order) = order else {
             // More parents than leaves: `parse` refuses the counts.

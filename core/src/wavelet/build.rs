@@ -33,6 +33,7 @@ use super::format::{
     MAX_LEVELS, NONE, VERSION, VERTEX_SIZE,
 };
 use super::lattice::{hex_len, Point};
+use crate::build::bound::{equation3, hoppe};
 use crate::format::{crc32, encode_length, oct_decode, oct_encode, ModelBox};
 
 /// Why a semi-regular mesh cannot be made.
@@ -771,21 +772,8 @@ pub(super) fn wavelet_bounds(
                     worst_case(out_part, &either, axis, &mut worst);
                 }
             }
-            let max_a = worst.iter().fold(0.0f32, |m, w| m.max(w.0));
-            let max_b = worst.iter().fold(0.0f32, |m, w| m.max(w.1));
-            (out.delta, out.mu) = (max_a, max_b);
-            if max_b <= 0.0 {
-                out.a = max_a;
-            } else if max_a <= 0.0 {
-                out.b = max_b;
-            } else {
-                // Equation 3's ratio, then scaled so that every worst case is inside.
-                let ratio = max_a / max_b;
-                out.b = worst.iter().fold(0.0f32, |m, &(a, b)| {
-                    m.max(libm::sqrtf((a / ratio) * (a / ratio) + b * b))
-                });
-                out.a = ratio * out.b;
-            }
+            [out.delta, out.mu] = hoppe(&worst);
+            [out.a, out.b] = equation3(&worst);
             out
         })
         .collect()
