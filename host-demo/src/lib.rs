@@ -3,6 +3,7 @@
 //! The `vdlod-demo` binary is a thin command line over this library; the workspace's tests and
 //! benchmarks use it too, so what they render is exactly what the demo renders.
 
+pub mod atlas;
 pub mod camera;
 pub mod chart;
 pub mod frame;

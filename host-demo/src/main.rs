@@ -242,8 +242,8 @@ struct RemeshArgs {
 enum Experiment {
     /// The wavelet paper's fish experiment (Azuma et al. 2003, Fig. 13) on our meshes: the
     /// bunny and the cow remeshed to a ~200-face base and four levels; the adaptive mesh at
-    /// 2 / 10 px against three uniform levels; both engines at equal triangles, PSNR against
-    /// the input.
+    /// 2 / 10 px against three uniform levels, flat and with a checker over the base faces;
+    /// both engines at equal triangles, PSNR against the input.
     Fish,
     /// The wavelet paper (Azuma et al. 2003), Fig. 11: the 8,192-face sphere at 0.5 px
     /// silhouette / 3.5 px interior tolerance (paper: 732 faces), both engines.

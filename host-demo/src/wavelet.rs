@@ -7,7 +7,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use glam::Vec3;
-use vdlod::{Camera, Style, WaveletMesh};
+use vdlod::{Camera, CutMesh, Style, WaveletMesh};
 use vdlod_core::adapt::{Budget, FrameStats};
 use vdlod_core::build::{build, BuildOptions, ErrorBound, InputMesh};
 use vdlod_core::cut::Cut;
@@ -898,6 +898,121 @@ fn wavelet_frame<P: Policy>(
     Ok(frame)
 }
 
+/// Checker cells along each base edge in [`checker_sheet`].
+const CHECKER_CELLS: usize = 8;
+
+/// A checker over the base faces of `s` (each face its own chart, [`crate::atlas`]) from
+/// `camera`: the base mesh, the wavelet engine adapted by `policy`, the vertex forest of the
+/// same finest mesh held to the same triangle count, and full detail, in `NAME_checker.png` in
+/// `out`; returns the summary line.
+fn checker_sheet(
+    name: &str,
+    s: &SemiRegularView<'_>,
+    camera: &Camera,
+    policy: &impl Policy,
+    out: &Path,
+) -> Result<String, String> {
+    use crate::atlas::corners;
+    use crate::importance::{sheet, Panel};
+    use vdlod_raster::texture::{Filter, Texture, Wrap};
+    let cells = CHECKER_CELLS;
+    let texels: Vec<Rgba8> = (0..cells * cells)
+        .map(|k| match (k % cells + k / cells) % 2 {
+            0 => Rgba8([236, 232, 220, 255]),
+            _ => Rgba8([60, 70, 110, 255]),
+        })
+        .collect();
+    let checker = Texture::new(&texels, cells, cells, Filter::Nearest, Wrap::Repeat)
+        .map_err(|e| e.to_string())?;
+    let style = Style {
+        base_color: [255; 3],
+        ..Style::default()
+    };
+    let mut frame = Frame::new(camera.width, camera.height).map_err(|e| e.to_string())?;
+    let mut draw = |mesh: &crate::atlas::CornerMesh| -> Result<Vec<Rgba8>, String> {
+        frame
+            .draw_textured(&mesh.as_raster_mesh(), camera, &style, &checker)
+            .map_err(|e| e.to_string())?;
+        Ok(frame.pixels().to_vec())
+    };
+
+    let full = finest_of(s);
+    let reference = draw(&corners(&full.as_raster_mesh(), s, |i| i as u32))?;
+
+    let mut wavelet = DemoWaveletCut::boxed();
+    wavelet.reset(s).map_err(|e| e.to_string())?;
+    let base = corners(&WaveletMesh::new(&wavelet, s, false), s, |i| {
+        wavelet.vertex_id(i)
+    });
+    let base_pixels = draw(&base)?;
+    let w = wavelet.adapt(s, &camera.view(), policy, &Budget::default());
+    let w_mesh = WaveletMesh::new(&wavelet, s, false);
+    let w_corners = corners(&w_mesh, s, |i| wavelet.vertex_id(i));
+    let w_pixels = draw(&w_corners)?;
+
+    let input = InputMesh {
+        positions: &full.positions,
+        colors: None,
+        triangles: &full.triangles,
+    };
+    let hierarchy =
+        build(&input, &BuildOptions::default(), &mut |_| {}).map_err(|e| e.to_string())?;
+    let hbytes = hierarchy.to_bytes(false);
+    let h = HierarchyView::parse(&hbytes).map_err(|e| e.to_string())?;
+    // A node stands for the leaf down its first children: a point of the surface it covers.
+    // Leaves are input vertices, that is semi-regular vertex ids, numbered anew in the file.
+    let mut leaf_of = vec![0u32; h.nodes() as usize];
+    for (v, &id) in hierarchy.file_ids().iter().enumerate() {
+        leaf_of[id as usize] = v as u32;
+    }
+    for i in (0..h.nodes()).rev().filter(|&i| h.is_parent(i)) {
+        leaf_of[i as usize] = leaf_of[h.children(i)[0] as usize];
+    }
+    let mut forest = ForestCut::boxed();
+    forest.reset(&h).map_err(|e| e.to_string())?;
+    let budget = Budget {
+        max_triangles: w.triangles,
+        ..Budget::default()
+    };
+    let f = forest.adapt(&h, &camera.view(), &QRefine::new(0.1), &budget);
+    let f_mesh = CutMesh::new(&forest, &h, false);
+    let nodes = forest.nodes();
+    let f_corners = corners(&f_mesh, s, |i| leaf_of[nodes[i] as usize]);
+    let f_pixels = draw(&f_corners)?;
+
+    let (w_db, f_db) = (
+        psnr(&w_pixels, &reference).min(99.0),
+        psnr(&f_pixels, &reference).min(99.0),
+    );
+    let panels = [
+        Panel {
+            caption: format!("base mesh: {} triangles", base.triangles.len()),
+            pixels: base_pixels,
+        },
+        Panel {
+            caption: format!("wavelets: {} triangles, {w_db:.1} dB", w.triangles),
+            pixels: w_pixels,
+        },
+        Panel {
+            caption: format!("vertex forest: {} triangles, {f_db:.1} dB", f.triangles),
+            pixels: f_pixels,
+        },
+        Panel {
+            caption: format!("full detail: {} triangles", full.triangles.len()),
+            pixels: reference,
+        },
+    ];
+    let png = sheet(&panels, 2, [camera.width, camera.height])?;
+    save(out, &format!("{name}_checker.png"), &png)?;
+    Ok(format!(
+        "experiment=fish mesh={name} stage=checker wavelet_triangles={} forest_triangles={} \
+         wavelet_checker_psnr_db={w_db:.2} forest_checker_psnr_db={f_db:.2} \
+         forest_triangles_across_faces={} forest_triangles_torn={} \
+         wavelet_triangles_across_faces={}",
+        w.triangles, f.triangles, f_corners.across, f_corners.torn, w_corners.across
+    ))
+}
+
 /// The wavelet paper's fish experiment (its Fig. 13 and §4) on our meshes: the bunny and the
 /// cow remeshed over a base of about 200 faces with four levels (the fish: 199 base faces,
 /// 50,944 at four levels); the remesh's distances to the input; from the session's first
@@ -905,7 +1020,8 @@ fn wavelet_frame<P: Policy>(
 /// uniform levels (paper: 3,943 against 12,736 faces); and over the whole session both engines
 /// at equal triangle counts, PSNR against the *input* (the vertex forest built from the input
 /// itself). Writes `NAME.csv` and `NAME_coarse.png`, `NAME_adapted.png` and `NAME_fine.png`
-/// (wireframe, from that first camera) per mesh into `out`.
+/// (wireframe, from that first camera), and `NAME_checker.png` (the same with a checker over
+/// the base faces, and the vertex forest beside them: [`checker_sheet`]) per mesh into `out`.
 pub fn fish(out: &Path) -> Result<Vec<String>, String> {
     use crate::mesh::{BUNNY_NAME, BUNNY_OBJ};
     use vdlod_core::remesh::RemeshOptions;
@@ -952,6 +1068,7 @@ pub fn fish(out: &Path) -> Result<Vec<String>, String> {
         ] {
             save(out, &format!("{name}_{picture}.png"), &frame_png(&frame)?)?;
         }
+        lines.push(checker_sheet(name, &s, &cameras[0], &coarse, out)?);
         lines.push(format!(
             "experiment=fish mesh={name} stage=fig13 adaptive_2_10px_faces={} uniform3_faces={} \
              full_faces={} psnr_db={:.2} paper_adaptive_faces=3943 paper_uniform3_faces=12736",
