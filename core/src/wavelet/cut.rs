@@ -7,7 +7,8 @@
 //! in it leaves when the policy no longer wants it, and a wavelet both of whose parents are in
 //! `U_t` joins when the policy wants it, largest error first, so `U_t` always
 //! meets the closure condition (every ancestor of a member is a member). A frame's work is one
-//! pass over the members and their children, and a split or removal for each change.
+//! pass over the members and their children, and a split or removal for each change; the
+//! triangles are emitted again only when a wavelet came or went or a geomorph ran.
 //!
 //! The triangles are then emitted as §3.6 describes: every base triangle is subdivided
 //! recursively while one of its edge midpoints is in `U_t`; a triangle that is not, but whose
@@ -148,6 +149,10 @@ pub struct WaveletCut<
     /// The previous frame's view (valid with `has_previous`).
     previous: View,
     has_previous: bool,
+    /// Whether the emitted mesh may differ from what the set and the geomorphs make now (a
+    /// wavelet came or went, a geomorph ran or stopped, or the last emission did not fit):
+    /// a frame that changed nothing does not emit again.
+    stale: bool,
 }
 
 /// One running geomorph (Azuma et al. §3.5, equation 6): the wavelet's coefficient is scaled by
@@ -228,6 +233,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
             geomorph_frames: 0,
             previous: View::ZERO,
             has_previous: false,
+            stale: true,
         }
     }
 
@@ -450,6 +456,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
     fn toggle(&mut self, s: &SemiRegularView<'_>, id: u32, p: Point, level: u32) {
         let (around, n) = Self::neighbourhood(s, p, level);
         self.flip(id);
+        self.stale = true;
         for &(vid, q) in around[..n].iter().flatten() {
             let (now, sides) = self.presence(s, q, s.level(q));
             if now == self.is_present(vid) {
@@ -568,6 +575,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
             step,
             leaving,
         };
+        self.stale = true;
         match at {
             Ok(i) => self.morphs.as_mut_slice()[i] = morph,
             Err(_) => {
@@ -588,11 +596,13 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
             self.morphs.as_mut_slice()[i..].rotate_left(1);
             self.morphs.pop();
             self.set_morphing(id, false);
+            self.stale = true;
         }
     }
 
     /// One frame of every geomorph: weights move; joined wavelets stop blending.
     fn advance_morphs(&mut self) {
+        self.stale |= self.morphs.len() > 0;
         let mut i = 0;
         while i < self.morphs.len() {
             let m = &mut self.morphs.as_mut_slice()[i];
@@ -772,7 +782,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         }
         self.heap.clear();
 
-        if !self.emit(s) {
+        if self.stale && !self.emit(s) {
             stats.capacity_limited = true;
         }
         self.previous = *view;
@@ -900,6 +910,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
                 return false;
             }
         }
+        self.stale = false;
         true
     }
 
