@@ -27,9 +27,14 @@
 //!
 //! 7. **Settled vertices** skipped or asked (`Cut::set_settling`), without and with geomorphs.
 //!
+//! 8. **The wavelet engine's coherence**: settled wavelets skipped or asked
+//!    (`WaveletCut::set_settling`) over the wavelet paper's session on the subdivided cow
+//!    (`reproduce fig9`'s, at 90 and at 720 frames, 0.5 / 3.5 px), interleaved frame by frame,
+//!    and a frame whose view has not moved.
+//!
 //! Run: `../shared/peers/run.sh` and `../shared/peers/hoppe/run.sh` once (they build the peers),
-//! then `cargo bench --bench lod` (`-- adaptation`, `-- quality`, `-- policies` or
-//! `-- srmesh`, `-- settling` for one section).
+//! then `cargo bench --bench lod` (`-- adaptation`, `-- quality`, `-- policies`,
+//! `-- srmesh`, `-- settling` or `-- wavelets` for one section).
 
 use std::path::PathBuf;
 use std::process::Command;
@@ -401,6 +406,70 @@ fn settling(h: &HierarchyView<'_>, mesh: &IndexedMesh) {
     }
 }
 
+/// The wavelet cut with settled wavelets skipped or asked, interleaved frame by frame over the
+/// session of `reproduce fig9` on the subdivided cow; then the same view twice in a row.
+fn wavelets() {
+    use vdlod_core::wavelet::SemiRegularView;
+    use vdlod_demo::wavelet::{cow_loop, finest_mesh, session, DemoWaveletCut};
+    println!(
+        "\n## 8. The wavelet engine's coherence, subdivided cow (51,200 faces), 0.5 / 3.5 px\n"
+    );
+    let mesh = cow_loop().expect("the cow subdivides");
+    let bytes = mesh.to_bytes().expect("writes");
+    let s = SemiRegularView::parse(&bytes).expect("valid");
+    let b = finest_mesh(&mesh).bounds();
+    let policy = QRefine {
+        error: ScreenError {
+            silhouette: 0.5,
+            interior: 3.5,
+        },
+    };
+    println!("| session | skipped: median us | asked: median us | ratio | wavelets skipped per frame | the same view again, skipped / asked: median us |");
+    println!("|---|---|---|---|---|---|");
+    for frames in [90u32, 720] {
+        let cameras = session(b.center(), b.radius(), frames, 512, 512);
+        // Each frame's view once, then (other cuts) each view twice in a row.
+        let mut moving = Vec::new();
+        let mut still = Vec::new();
+        for twice in [false, true] {
+            let mut cuts = [DemoWaveletCut::boxed(), DemoWaveletCut::boxed()];
+            for cut in &mut cuts {
+                cut.reset(&s).expect("fits");
+            }
+            cuts[1].set_settling(false);
+            let (mut times, mut skipped) = ([Vec::new(), Vec::new()], 0.0);
+            for _ in 0..2 {
+                for camera in &cameras {
+                    let view = camera.view();
+                    for (k, cut) in cuts.iter_mut().enumerate() {
+                        if twice {
+                            cut.adapt(&s, &view, &policy, &Budget::default());
+                        }
+                        let start = Instant::now();
+                        let stats = cut.adapt(&s, &view, &policy, &Budget::default());
+                        times[k].push(start.elapsed().as_secs_f64() * 1e6);
+                        if k == 0 {
+                            skipped += stats.settled as f64;
+                        }
+                    }
+                }
+            }
+            let [on, off] = times;
+            let row = (median(on), median(off), skipped / (2 * frames) as f64);
+            if twice {
+                still.push(row);
+            } else {
+                moving.push(row);
+            }
+        }
+        let ((on, off, skipped), (still_on, still_off, _)) = (moving[0], still[0]);
+        println!(
+            "| {frames} frames | {on:.0} | {off:.0} | {:.2}x | {skipped:.0} | {still_on:.0} / {still_off:.0} |",
+            on / off,
+        );
+    }
+}
+
 fn policies(h: &HierarchyView<'_>, mesh: &IndexedMesh) {
     println!("\n## 5. Policies, bunny, peer orbit (640x480, 60 deg, 200 frames)\n");
     let screen = QRefine::new(0.3);
@@ -561,6 +630,9 @@ fn main() {
         }
         if wanted("settling") {
             settling(&h, &mesh);
+        }
+        if wanted("wavelets") {
+            wavelets();
         }
     }
 }

@@ -38,9 +38,10 @@
 
 use crate::adapt::{Budget, FrameStats};
 use crate::cut::slot::{Arena, SlotIndex};
+use crate::cut::steady::{Margins, Mode, Steady};
 use crate::cut::NIL;
 use crate::nodemap::NodeMap;
-use crate::policy::{Demand, Policy, View};
+use crate::policy::{Bounds, Demand, Policy, View};
 
 use super::format::SemiRegularView;
 use super::lattice::Point;
@@ -98,6 +99,9 @@ impl core::fmt::Display for WaveletDefect {
 #[derive(Debug)]
 struct Full;
 
+/// Relative slack on the settling proofs' thresholds, far above float rounding.
+const SLACK: f32 = 1.0 + 1e-5;
+
 /// The level given to a piece's edges inside its leaf triangle (never tested for a neighbour).
 const INSIDE: u32 = u32::MAX;
 
@@ -110,6 +114,20 @@ fn has(bits: &[u32], base: u32, wavelets: u32, id: u32) -> bool {
         && bits
             .get((w / 32) as usize)
             .is_some_and(|b| b >> (w % 32) & 1 == 1)
+}
+
+/// Sets or clears wavelet vertex `id`'s bit in `bits` (see [`has`]).
+#[inline]
+fn put(bits: &mut [u32], base: u32, id: u32, on: bool) {
+    let w = id.wrapping_sub(base);
+    if let Some(word) = bits.get_mut((w / 32) as usize) {
+        let bit = 1 << (w % 32);
+        if on {
+            *word |= bit;
+        } else {
+            *word &= !bit;
+        }
+    }
 }
 
 /// The wavelets in a frame's mesh as bits, and the triangles they make, in fixed arenas: up to
@@ -153,6 +171,13 @@ pub struct WaveletCut<
     /// wavelet came or went, a geomorph ran or stopped, or the last emission did not fit):
     /// a frame that changed nothing does not emit again.
     stale: bool,
+    /// Frame-to-frame coherence, as the vertex cut has it (`crate::cut::steady`): the anchor
+    /// frame, and per wavelet whether its answer provably holds while the anchor does
+    /// (`settled`: a member with nothing to do, or a candidate the policy does not want) and,
+    /// for a member, whether none of its children out of the set is wanted (`quiet`).
+    steady: Steady,
+    settled: [u32; WORDS],
+    quiet: [u32; WORDS],
 }
 
 /// One running geomorph (Azuma et al. §3.5, equation 6): the wavelet's coefficient is scaled by
@@ -233,7 +258,10 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
             geomorph_frames: 0,
             previous: View::ZERO,
             has_previous: false,
-            stale: true,
+            stale: false,
+            steady: Steady::ZERO,
+            settled: [0; WORDS],
+            quiet: [0; WORDS],
         }
     }
 
@@ -277,6 +305,9 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         self.included.iter_mut().for_each(|w| *w = 0);
         self.present.iter_mut().for_each(|w| *w = 0);
         self.morphing.iter_mut().for_each(|w| *w = 0);
+        self.settled.iter_mut().for_each(|w| *w = 0);
+        self.quiet.iter_mut().for_each(|w| *w = 0);
+        self.steady.clear();
         self.morphs.clear();
         self.has_previous = false;
         self.base_vertices = c.base_vertices;
@@ -457,6 +488,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         let (around, n) = Self::neighbourhood(s, p, level);
         self.flip(id);
         self.stale = true;
+        self.unsettle(s, id, p, level);
         for &(vid, q) in around[..n].iter().flatten() {
             let (now, sides) = self.presence(s, q, s.level(q));
             if now == self.is_present(vid) {
@@ -547,6 +579,24 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
                 *word &= !(1 << (w % 32));
             }
         }
+    }
+
+    /// Forgets what the anchor frame proved about wavelet `id` (at `p`, `level`) and its
+    /// parents: it came, went or started leaving, which changes what they have to do.
+    fn unsettle(&mut self, s: &SemiRegularView<'_>, id: u32, p: Point, level: u32) {
+        let base = self.base_vertices;
+        for q in core::iter::once(id).chain(s.parents(p, level)) {
+            if q != NIL {
+                put(&mut self.settled, base, q, false);
+                put(&mut self.quiet, base, q, false);
+            }
+        }
+    }
+
+    /// Whether frames skip the wavelets whose answers cannot have changed since an anchor
+    /// frame (on by default). The frames are the same either way; only their time differs.
+    pub fn set_settling(&mut self, on: bool) {
+        self.steady.set_on(on);
     }
 
     /// Starts (or turns around) wavelet `id`'s geomorph towards leaving or towards staying,
@@ -677,6 +727,32 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         self.advance_morphs();
         self.finish_leaving(s);
 
+        // Settled wavelets are skipped while the anchor holds; an anchor frame marks them anew.
+        let envelope = if policy.judges_triangles() {
+            None
+        } else {
+            policy.envelope(view)
+        };
+        let (lo, hi) = s.bounding_box();
+        let half: [f32; 3] = core::array::from_fn(|k| 0.5 * (hi[k] - lo[k]));
+        let model = (
+            core::array::from_fn(|k| lo[k] + half[k]),
+            libm::sqrtf(half[0] * half[0] + half[1] * half[1] + half[2] * half[2]),
+        );
+        let mode = self
+            .steady
+            .begin(view, envelope, t, self.geomorph_frames > 0, model);
+        let skip = mode == Mode::Skip;
+        let anchor = (mode == Mode::Anchor).then(|| {
+            self.settled.iter_mut().for_each(|w| *w = 0);
+            self.quiet.iter_mut().for_each(|w| *w = 0);
+            let upper = envelope.map_or(f32::INFINITY, |e| e.upper);
+            (
+                self.steady.margins(upper, t, SLACK, model),
+                envelope.is_some_and(|e| e.frustum),
+            )
+        });
+
         // Coarsen: a member none of whose children stays leaves when unwanted (blending unless
         // it left the view); its parents may follow in the next pass.
         'coarsen: loop {
@@ -684,14 +760,30 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
             let mut next = 0;
             while let Some(id) = self.member_from(next) {
                 next = id - self.base_vertices + 1;
+                if skip && self.settled_bit(id) {
+                    stats.settled += 1;
+                    continue;
+                }
                 let Some(p) = s.point(id) else { continue };
                 let level = s.level(p);
                 let leaving = self.leaving(id);
                 if !leaving && self.any_child_in(s, p, level, true) {
+                    if anchor.is_some() {
+                        // Stays while that child does (whose coming and going unsettles it).
+                        put(&mut self.settled, self.base_vertices, id, true);
+                    }
                     continue;
                 }
                 let d = Self::demand(s, id, p, view, policy);
                 let wanted = d.visible && d.error > t;
+                if let Some((m, _)) = &anchor {
+                    if wanted
+                        && !leaving
+                        && self.steady.stays_wanted(m, &s.bounds_at(p, id), t, SLACK)
+                    {
+                        put(&mut self.settled, self.base_vertices, id, true);
+                    }
+                }
                 if leaving {
                     if wanted {
                         // Wanted back: it turns around where it is.
@@ -708,6 +800,8 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
                 }
                 let children = self.any_child_in(s, p, level, false);
                 let frames = if d.visible { self.geomorph_frames } else { 0 };
+                // Leaving changes what its parents have to do.
+                self.unsettle(s, id, p, level);
                 if (frames == 0 && !children) || !self.start_morph(id, true, frames) {
                     if children {
                         stats.blend_limited = true;
@@ -736,14 +830,32 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         let n = s.steps() as u32;
         for e in 0..s.counts().base_edges {
             let id = self.base_vertices + e * (n - 1) + n / 2 - 1;
+            if skip && self.settled_bit(id) {
+                stats.settled += 1;
+                continue;
+            }
             if let (false, Some(p)) = (self.includes(id), s.point(id)) {
+                if let Some((m, frustum)) = &anchor {
+                    if self.stays_unwanted(m, *frustum, &s.bounds_at(p, id), view) {
+                        put(&mut self.settled, self.base_vertices, id, true);
+                    }
+                }
                 self.offer(s, (id, p), view, policy, t, &mut stats);
             }
         }
         let mut next = 0;
         while let Some(id) = self.member_from(next) {
             next = id - self.base_vertices + 1;
+            if skip && has(&self.quiet, self.base_vertices, self.wavelets, id) {
+                stats.settled += 1;
+                continue;
+            }
             if !self.leaving(id) {
+                if let Some((m, frustum)) = &anchor {
+                    if self.children_stay_unwanted(s, id, m, *frustum, view) {
+                        put(&mut self.quiet, self.base_vertices, id, true);
+                    }
+                }
                 self.offer_children(s, id, true, view, policy, t, &mut stats);
             }
         }
@@ -785,6 +897,11 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         if self.stale && !self.emit(s) {
             stats.capacity_limited = true;
         }
+        if anchor.is_some() {
+            let settled: u32 = self.settled.iter().map(|w| w.count_ones()).sum();
+            self.steady
+                .anchored(settled as usize, self.included() as usize);
+        }
         self.previous = *view;
         self.has_previous = true;
         self.threshold = budget.regulate(self.threshold, self.triangles);
@@ -794,6 +911,43 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         stats.blending = self.blending();
         stats.over_budget = stats.triangles > budget.max_triangles;
         stats
+    }
+
+    #[inline]
+    fn settled_bit(&self, id: u32) -> bool {
+        has(&self.settled, self.base_vertices, self.wavelets, id)
+    }
+
+    /// Whether a wavelet with bounds `b` provably stays unwanted while the anchor holds: its
+    /// error bound stays under the threshold wherever the eye gets, or (with `frustum`) it
+    /// stays out of the view.
+    fn stays_unwanted(&self, m: &Margins, frustum: bool, b: &Bounds, view: &View) -> bool {
+        let r = [
+            b.center[0] - view.eye[0],
+            b.center[1] - view.eye[1],
+            b.center[2] - view.eye[2],
+        ];
+        let d2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+        self.steady.stays_quiet(m, libm::sqrtf(b.a2.max(b.b2)), d2)
+            || (frustum && self.steady.stays_visible(m, b.center, b.radius) == Some(false))
+    }
+
+    /// Whether every child of member `id` out of the set provably stays unwanted while the
+    /// anchor holds (whether it may join yet or not).
+    fn children_stay_unwanted(
+        &self,
+        s: &SemiRegularView<'_>,
+        id: u32,
+        m: &Margins,
+        frustum: bool,
+        view: &View,
+    ) -> bool {
+        let Some(p) = s.point(id) else { return false };
+        s.children(p, s.level(p)).into_iter().flatten().all(|c| {
+            s.vertex_id(c).is_some_and(|cid| {
+                self.includes(cid) || self.stays_unwanted(m, frustum, &s.bounds_at(c, cid), view)
+            })
+        })
     }
 
     /// Removes members with no member child, smallest error first, until the mesh fits
