@@ -10,6 +10,15 @@
 //! pass over the members and their children, and a split or removal for each change; the
 //! triangles are emitted again only when a wavelet came or went or a geomorph ran.
 //!
+//! Frame-to-frame coherence as the vertex cut has it (`crate::cut::steady`, on unless
+//! [`WaveletCut::set_settling`] turns it off): when the policy describes how its demand moves
+//! with the view, an anchor frame proves, for each wavelet it asks, how far the eye and the
+//! frustum may move before the answer could change; while the camera stays within that, later
+//! frames skip a member that provably stays (wanted, or holding a child that stays) and the
+//! children of a member that provably stay unwanted, with one bit each. A wavelet that comes,
+//! goes or starts leaving clears its own bits and its parents'. The frames are the same as
+//! asking every wavelet (a test flies both side by side).
+//!
 //! The triangles are then emitted as §3.6 describes: every base triangle is subdivided
 //! recursively while one of its edge midpoints is in `U_t`; a triangle that is not, but whose
 //! neighbour across an edge is, is cut at that edge's midpoint, and each half is tested again, so
@@ -29,12 +38,12 @@
 //! number of frames ([`WaveletCut::set_geomorph_frames`]); they overlap in space and time, and a
 //! wavelet turned around mid-way starts from where it is.
 //!
-//! Memory (`Self::BYTES`, asserted in a test): three bits per wavelet (`12 WORDS`: in the set,
-//! a vertex of the emitted mesh, blending), 17 B per vertex slot (id, position, whether it is
-//! moved), 8 B per triangle slot (corners as `u16`, vertex map), 24 B per queue entry (a candidate and a geomorph), and under
-//! 256 B of counts and the previous view. With `V = T / 2` (a closed mesh has about half as many
-//! vertices as triangles) and `Q = T / 8`, that is 19.5 B per triangle of capacity beside the
-//! bits.
+//! Memory (`Self::BYTES`, asserted in a test): five bits per wavelet (`20 WORDS`: in the set,
+//! a vertex of the emitted mesh, blending, settled, children quiet), 17 B per vertex slot (id,
+//! position, whether it is moved), 8 B per triangle slot (corners as `u16`, vertex map), 24 B
+//! per queue entry (a candidate and a geomorph), and under 512 B of counts, the previous view
+//! and the anchor frame. With `V = T / 2` (a closed mesh has about half as many vertices as
+//! triangles) and `Q = T / 8`, that is about 19.6 B per triangle of capacity beside the bits.
 
 use crate::adapt::{Budget, FrameStats};
 use crate::cut::slot::{Arena, SlotIndex};
