@@ -13,7 +13,7 @@
 //! corner's own coordinates, so the texture tears there.
 
 use vdlod_core::wavelet::SemiRegularView;
-use vdlod_raster::{Mesh, MeshSource, Uv, VertexIndex};
+use vdlod_raster::{Mesh, MeshSource, Rgba8, Uv, VertexIndex};
 
 /// A mesh with three vertices of its own per triangle, each with texture coordinates in its
 /// triangle's chart.
@@ -44,6 +44,17 @@ impl CornerMesh {
             ..Mesh::default()
         }
     }
+}
+
+/// The texels of a checker of `cells` x `cells` cells of one texel each, light and dark: drawn
+/// with nearest sampling and repeated, a checker over any chart.
+pub fn checker_texels(cells: usize) -> Vec<Rgba8> {
+    (0..cells * cells)
+        .map(|k| match (k % cells + k / cells) % 2 {
+            0 => Rgba8([236, 232, 220, 255]),
+            _ => Rgba8([60, 70, 110, 255]),
+        })
+        .collect()
 }
 
 /// Texture coordinates of the point at weights `w` (units of `1 / n`) of any base face: the

@@ -87,12 +87,7 @@ pub fn textures(out: &Path, setup: Setup, pictured: u32) -> Result<Vec<String>, 
         .collect();
     let colormap = Texture::new(&texels, side, side, Filter::Bilinear, Wrap::Clamp)
         .map_err(|e| e.to_string())?;
-    let checker_texels: Vec<Rgba8> = (0..CELLS * CELLS)
-        .map(|k| match (k % CELLS + k / CELLS) % 2 {
-            0 => Rgba8([236, 232, 220, 255]),
-            _ => Rgba8([60, 70, 110, 255]),
-        })
-        .collect();
+    let checker_texels = crate::atlas::checker_texels(CELLS);
     let checker = Texture::new(&checker_texels, CELLS, CELLS, Filter::Nearest, Wrap::Repeat)
         .map_err(|e| e.to_string())?;
     let textured = Style {

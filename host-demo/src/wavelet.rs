@@ -912,16 +912,11 @@ fn checker_sheet(
     policy: &impl Policy,
     out: &Path,
 ) -> Result<String, String> {
-    use crate::atlas::corners;
+    use crate::atlas::{checker_texels, corners};
     use crate::importance::{sheet, Panel};
     use vdlod_raster::texture::{Filter, Texture, Wrap};
     let cells = CHECKER_CELLS;
-    let texels: Vec<Rgba8> = (0..cells * cells)
-        .map(|k| match (k % cells + k / cells) % 2 {
-            0 => Rgba8([236, 232, 220, 255]),
-            _ => Rgba8([60, 70, 110, 255]),
-        })
-        .collect();
+    let texels = checker_texels(cells);
     let checker = Texture::new(&texels, cells, cells, Filter::Nearest, Wrap::Repeat)
         .map_err(|e| e.to_string())?;
     let style = Style {
