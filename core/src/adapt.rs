@@ -86,6 +86,13 @@ pub struct Budget {
     pub target_band: f32,
     /// Splits plus collapses per frame at most.
     pub max_ops: u32,
+    /// Regulate the error threshold towards this frame time, in microseconds (0: off): the LOD
+    /// lecture's constant frame rate. The core has no clock; the caller measures its frames and
+    /// gives the last one's time in [`Budget::frame_us`].
+    pub target_frame_us: u32,
+    /// The previous frame's time in microseconds, as the caller measured it (adapting and
+    /// drawing; 0: not measured).
+    pub frame_us: u32,
 }
 
 impl Default for Budget {
@@ -95,6 +102,8 @@ impl Default for Budget {
             target_triangles: 0,
             target_band: 0.05,
             max_ops: u32::MAX,
+            target_frame_us: 0,
+            frame_us: 0,
         }
     }
 }
@@ -146,15 +155,32 @@ impl Budget {
     }
 
     /// The error threshold for the next frame, after a frame of `triangles` at `threshold`:
-    /// scaled by the ratio to [`Budget::target_triangles`] (at most 2x either way) when it is
-    /// outside [`Budget::target_band`] (the LOD lecture's regulation); unchanged without a
-    /// target.
+    /// scaled by the ratio to [`Budget::target_triangles`], or of [`Budget::frame_us`] to
+    /// [`Budget::target_frame_us`] (with both, the larger ratio: the stricter target wins), at
+    /// most 2x either way, when it is outside [`Budget::target_band`] (the LOD lecture's
+    /// regulation); unchanged without a target.
+    ///
+    /// ```
+    /// use vdlod_core::adapt::Budget;
+    /// let budget = Budget { target_frame_us: 10_000, frame_us: 15_000, ..Budget::default() };
+    /// // A frame 1.5x too slow raises the threshold 1.5x: fewer triangles next frame.
+    /// assert_eq!(budget.regulate(1.0, 5_000), 1.5);
+    /// // Within 5% of the target, it stays.
+    /// let close = Budget { frame_us: 10_300, ..budget };
+    /// assert_eq!(close.regulate(1.0, 5_000), 1.0);
+    /// ```
     #[must_use]
     pub fn regulate(&self, threshold: f32, triangles: u32) -> f32 {
-        if self.target_triangles == 0 {
-            return threshold;
-        }
-        let ratio = triangles.max(1) as f32 / self.target_triangles as f32;
+        let ratio = |value: u32, target: u32| {
+            (target > 0 && value > 0).then(|| value as f32 / target as f32)
+        };
+        let by_triangles = ratio(triangles.max(1), self.target_triangles);
+        let by_time = ratio(self.frame_us, self.target_frame_us);
+        let ratio = match (by_triangles, by_time) {
+            (Some(a), Some(b)) => a.max(b),
+            (Some(r), None) | (None, Some(r)) => r,
+            (None, None) => return threshold,
+        };
         if (ratio - 1.0).abs() > self.target_band {
             (threshold * ratio.clamp(0.5, 2.0)).clamp(1e-6, 1e6)
         } else {

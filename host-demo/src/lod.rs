@@ -841,11 +841,17 @@ fn fly_orbit(
         Some(path) if !path.is_empty() => path[i as usize % path.len()],
         _ => orbit.camera(i),
     };
+    // The previous frame's adapt + render time, for a frame-time target.
+    let mut frame_us = 0u32;
     for i in 0..opts.frames {
         let camera = camera_of(i);
         let view = camera.view_scaled(opts.frustum);
+        let budget = Budget {
+            frame_us,
+            ..opts.budget
+        };
         let start = Instant::now();
-        let stats = engine.adapt(&view, &policy, &opts.budget);
+        let stats = engine.adapt(&view, &policy, &budget);
         let base = engine.base_triangles();
         if stats.over_budget && !warned && base > opts.budget.max_triangles {
             eprintln!(
@@ -865,6 +871,7 @@ fn fly_orbit(
             .draw(&mut frame, &camera, &drawn, ground)
             .map_err(|e| e.to_string())?;
         let render_us = start.elapsed().as_secs_f64() * 1e6;
+        frame_us = (adapt_us + render_us).round().min(u32::MAX as f64) as u32;
         let start = Instant::now();
         draw_either(&mut reference, &full_mesh, &camera, &drawn, ground)
             .map_err(|e| e.to_string())?;

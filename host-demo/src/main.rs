@@ -364,6 +364,10 @@ struct FlightArgs {
     /// Regulate the tolerance towards this many triangles (at least 1).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     target: Option<u32>,
+    /// Regulate the tolerance towards this frame time in milliseconds (adapt + render, as
+    /// measured on this machine; with --target, the stricter one wins).
+    #[arg(long, value_parser = positive)]
+    target_ms: Option<f32>,
     /// Splits plus collapses per frame at most (at least 1).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     max_ops: Option<u32>,
@@ -431,6 +435,7 @@ impl Default for FlightArgs {
         FlightArgs {
             budget: None,
             target: None,
+            target_ms: None,
             max_ops: None,
             tolerance: 1.0,
             interior: None,
@@ -472,6 +477,10 @@ impl FlightArgs {
         }
         if let Some(m) = self.max_ops {
             budget.max_ops = m;
+        }
+        if let Some(ms) = self.target_ms {
+            // At least a microsecond (`as` saturates above `u32::MAX`).
+            budget.target_frame_us = ((ms * 1e3).round() as u32).max(1);
         }
         OrbitOptions {
             width: self.width,

@@ -609,6 +609,40 @@ fn subdivide_to_obj_writes_the_loop_subdivided_mesh() {
 }
 
 #[test]
+fn a_frame_time_target_regulates_and_bad_ones_are_refused() {
+    let dir = scratch_dir("cli_target_ms");
+    // A target far below any frame's time: the threshold rises every frame the blends allow.
+    succeed(
+        &[
+            "orbit",
+            "--target-ms",
+            "0.001",
+            "--frames",
+            "12",
+            "-o",
+            "out",
+        ],
+        &dir,
+    );
+    let csv = std::fs::read_to_string(dir.join("out/stats.csv")).unwrap();
+    let thresholds: Vec<f32> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(11).unwrap().parse().unwrap())
+        .collect();
+    assert_eq!(thresholds[0], 1.0);
+    assert!(
+        thresholds.windows(2).all(|w| w[1] >= w[0]),
+        "{thresholds:?}"
+    );
+    assert!(thresholds[11] >= 4.0, "{thresholds:?}");
+    for bad in ["0", "-1", "nan"] {
+        let out = demo(&["orbit", "--target-ms", bad, "-o", "out"], &dir);
+        assert!(!out.status.success(), "{bad}");
+    }
+}
+
+#[test]
 fn near_needs_the_merge_tree_policy() {
     let dir = scratch_dir("cli_near");
     let out = demo(&["orbit", "--near", "2", "-o", "out"], &dir);

@@ -331,6 +331,37 @@ mod adapt {
     }
 
     #[test]
+    fn regulation_reaches_a_frame_time_target() {
+        // A frame that costs 200 us plus 1 us per triangle, against a 600 us target: the cut
+        // settles near 400 triangles, from above (0.25 px) and from below (the base mesh).
+        let bytes = sphere_bytes();
+        let h = HierarchyView::parse(&bytes).unwrap();
+        let policy = (Frustum, ScreenError::new(0.25));
+        for start_fine in [true, false] {
+            let mut cut: Box<Mid> = Cut::boxed();
+            cut.reset(&h).unwrap();
+            let mut frame_us = 0;
+            if start_fine {
+                let s = cut.adapt(&h, &orbit(0, 3.0), &policy, &Budget::default());
+                assert!(s.triangles > 700, "{s:?}");
+                frame_us = 200 + s.triangles;
+            }
+            let mut last = 0;
+            for _ in 0..40 {
+                let budget = Budget {
+                    target_frame_us: 600,
+                    frame_us,
+                    ..Budget::default()
+                };
+                let s = cut.adapt(&h, &orbit(0, 3.0), &policy, &budget);
+                frame_us = 200 + s.triangles;
+                last = s.triangles;
+            }
+            assert!((340..=460).contains(&last), "{start_fine}: {last}");
+        }
+    }
+
+    #[test]
     fn importance_splits_the_corners_of_important_triangles_and_then_holds_still() {
         use crate::policy::{Importance, Policy};
         let (p, t) = grid(32);
