@@ -207,6 +207,28 @@ mod tests {
     }
 
     #[test]
+    fn unfolding_is_what_canonical_undoes() {
+        let bytes = SemiRegular::sphere(3).unwrap().to_bytes().unwrap();
+        let s = SemiRegularView::parse(&bytes).unwrap();
+        let n = s.steps();
+        let mut unfolded = 0;
+        for v in 0..s.vertices() {
+            let Some(p) = s.point(v) else { continue };
+            for f in 0..s.counts().base_faces {
+                let Some(w) = unfolded_weights_in(&s, v, f) else {
+                    continue;
+                };
+                assert_eq!(w.iter().sum::<i32>(), n);
+                let q = vdlod_core::wavelet::Point { face: f, w };
+                assert_eq!(s.canonical(q).and_then(|q| s.vertex_id(q)), Some(v));
+                unfolded += usize::from(f != p.face && w.iter().any(|&x| x < 0));
+            }
+        }
+        // Every inner point of a face unfolds into its three neighbours.
+        assert!(unfolded > 3 * 8 * 20, "{unfolded}");
+    }
+
+    #[test]
     fn the_wavelet_engine_emits_every_triangle_inside_one_base_face() {
         use vdlod::WaveletMesh;
         use vdlod_core::adapt::Budget;
