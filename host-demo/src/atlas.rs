@@ -27,9 +27,10 @@ pub struct CornerMesh {
     pub uvs: Vec<Uv>,
     /// `[3k, 3k + 1, 3k + 2]`.
     pub triangles: Vec<[u32; 3]>,
-    /// Triangles no base face holds (charted by unfolding a neighbour into one's frame).
+    /// Triangles no base face holds (charted by unfolding a neighbour into one's frame, or
+    /// torn).
     pub across: usize,
-    /// Triangles that no chart reaches, not even unfolded: their texture tears.
+    /// Of those, triangles that no chart reaches, not even unfolded: their texture tears.
     pub torn: usize,
 }
 

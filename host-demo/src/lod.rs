@@ -496,6 +496,8 @@ pub struct OrbitSummary {
     pub frames: Vec<OrbitFrame>,
     /// Frame whose comparison went into `side_by_side.png`.
     pub compared: u32,
+    /// Whether the screen-space test was Hoppe's (the file has his bounds).
+    pub hoppe_test: bool,
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -961,7 +963,11 @@ fn fly_orbit(
     file.write_all(csv.as_bytes()).map_err(io)?;
     let png = plot(&frames).map_err(|e| e.to_string())?;
     std::fs::write(out_dir.join("plot.png"), png).map_err(io)?;
-    Ok(OrbitSummary { frames, compared })
+    Ok(OrbitSummary {
+        frames,
+        compared,
+        hoppe_test: matches!(policy, DemoPolicy::Hoppe(_)),
+    })
 }
 
 #[cfg(test)]

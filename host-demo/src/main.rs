@@ -866,24 +866,14 @@ fn fly(
     opts: &OrbitOptions,
     out: &Path,
 ) -> Result<(), String> {
-    let hoppe = matches!(opts.policy, PolicyChoice::Screen { .. })
-        && HierarchyView::parse(bytes).map_or_else(
-            |_| SemiRegularView::parse(bytes).is_ok_and(|s| s.hoppe_bounds()),
-            |h| h.hoppe_bounds(),
-        );
     say!(
-        "{name}: {} vertices, {} triangles at full detail; {} frames at {}x{} into {}{}",
+        "{name}: {} vertices, {} triangles at full detail; {} frames at {}x{} into {}",
         full.positions.len(),
         full.triangles.len(),
         opts.frames,
         opts.width,
         opts.height,
-        out.display(),
-        if hoppe {
-            "; Hoppe's error bounds, tested as he does"
-        } else {
-            ""
-        }
+        out.display()
     );
     let summary = lod::run_orbit(bytes, full, opts, out, |f| {
         let limits = lod::limits(&f.stats);
@@ -924,6 +914,9 @@ fn fly(
         );
     } else {
         say!("one frame only: no figures over the following frames");
+    }
+    if summary.hoppe_test {
+        say!("the file has Hoppe's error bounds: tested as he does");
     }
     let counts = summary.limit_counts();
     if !counts.is_empty() {

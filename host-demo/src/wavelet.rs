@@ -9,7 +9,7 @@ use std::time::Instant;
 use glam::Vec3;
 use vdlod::{Camera, CutMesh, Style, WaveletMesh};
 use vdlod_core::adapt::{Budget, FrameStats};
-use vdlod_core::build::{build, BuildOptions, ErrorBound, InputMesh};
+use vdlod_core::build::{build, BuildOptions, ErrorBound, Hierarchy, InputMesh};
 use vdlod_core::cut::Cut;
 use vdlod_core::format::HierarchyView;
 use vdlod_core::policy::{BackFace, Frustum, HoppeError, Policy, QRefine, ScreenError};
@@ -708,8 +708,8 @@ pub fn fig10(out: &Path) -> Result<Vec<String>, String> {
         .map_err(|e| e.to_string())?;
     let s = flight.view()?;
     let h = SemiRegularView::parse(&hoppe_bytes).map_err(|e| e.to_string())?;
-    let forest = |bound| forest_file(full, bound);
-    let offset = forest(ErrorBound::Offset)?;
+    let file = |bound| forest_file(full, bound);
+    let offset = file(ErrorBound::Offset)?;
     let runs = [
         (
             "wavelet",
@@ -720,12 +720,12 @@ pub fn fig10(out: &Path) -> Result<Vec<String>, String> {
         (
             "forest",
             "spheroid",
-            fly_forest(&forest(ErrorBound::Spheroid)?, full, cameras, &[], spheroid)?,
+            fly_forest(&file(ErrorBound::Spheroid)?, full, cameras, &[], spheroid)?,
         ),
         (
             "forest",
             "hoppe",
-            fly_forest(&forest(ErrorBound::Hoppe)?, full, cameras, &[], hoppe)?,
+            fly_forest(&file(ErrorBound::Hoppe)?, full, cameras, &[], hoppe)?,
         ),
         (
             "forest",
@@ -843,8 +843,8 @@ fn forest_at(
     Ok((frames, hbytes.len()))
 }
 
-/// The vertex-forest file of `source` with error bounds `bound`.
-fn forest_file(source: &IndexedMesh, bound: ErrorBound) -> Result<Vec<u8>, String> {
+/// The vertex forest of `source` with error bounds `bound`.
+fn forest(source: &IndexedMesh, bound: ErrorBound) -> Result<Hierarchy, String> {
     let input = InputMesh {
         positions: &source.positions,
         colors: None,
@@ -854,8 +854,12 @@ fn forest_file(source: &IndexedMesh, bound: ErrorBound) -> Result<Vec<u8>, Strin
         bound,
         ..BuildOptions::default()
     };
-    let hierarchy = build(&input, &options, &mut |_| {}).map_err(|e| e.to_string())?;
-    Ok(hierarchy.to_bytes(false))
+    build(&input, &options, &mut |_| {}).map_err(|e| e.to_string())
+}
+
+/// The vertex-forest file of `source` with error bounds `bound`.
+fn forest_file(source: &IndexedMesh, bound: ErrorBound) -> Result<Vec<u8>, String> {
+    Ok(forest(source, bound)?.to_bytes(false))
 }
 
 /// Flies the vertex forest of the file `hbytes` along `cameras` with `policy` and the triangle
@@ -945,13 +949,7 @@ fn checker_sheet(
     let w_corners = corners(&w_mesh, s, |i| wavelet.vertex_id(i));
     let w_pixels = draw(&w_corners)?;
 
-    let input = InputMesh {
-        positions: &full.positions,
-        colors: None,
-        triangles: &full.triangles,
-    };
-    let hierarchy =
-        build(&input, &BuildOptions::default(), &mut |_| {}).map_err(|e| e.to_string())?;
+    let hierarchy = forest(&full, ErrorBound::default())?;
     let hbytes = hierarchy.to_bytes(false);
     let h = HierarchyView::parse(&hbytes).map_err(|e| e.to_string())?;
     // A node stands for the leaf down its first children: a point of the surface it covers.
@@ -963,15 +961,15 @@ fn checker_sheet(
     for i in (0..h.nodes()).rev().filter(|&i| h.is_parent(i)) {
         leaf_of[i as usize] = leaf_of[h.children(i)[0] as usize];
     }
-    let mut forest = ForestCut::boxed();
-    forest.reset(&h).map_err(|e| e.to_string())?;
+    let mut forest_cut = ForestCut::boxed();
+    forest_cut.reset(&h).map_err(|e| e.to_string())?;
     let budget = Budget {
         max_triangles: w.triangles,
         ..Budget::default()
     };
-    let f = forest.adapt(&h, &camera.view(), &QRefine::new(0.1), &budget);
-    let f_mesh = CutMesh::new(&forest, &h, false);
-    let nodes = forest.nodes();
+    let f = forest_cut.adapt(&h, &camera.view(), &QRefine::new(0.1), &budget);
+    let f_mesh = CutMesh::new(&forest_cut, &h, false);
+    let nodes = forest_cut.nodes();
     let f_corners = corners(&f_mesh, s, |i| leaf_of[nodes[i] as usize]);
     let f_pixels = draw(&f_corners)?;
 

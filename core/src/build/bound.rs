@@ -22,7 +22,8 @@
 /// let [a, b] = equation3(&[(2.0, 0.0), (0.0, 1.0), (1.6, 0.8)]);
 /// assert!((a / b - 2.0).abs() < 1e-6);
 /// for (along, across) in [(2.0f32, 0.0f32), (0.0, 1.0), (1.6, 0.8)] {
-///     assert!((along / a).powi(2) + (across / b).powi(2) <= 1.0 + 1e-6);
+///     let (x, y) = (along / a, across / b);
+///     assert!(x * x + y * y <= 1.0 + 1e-6);
 /// }
 /// ```
 #[must_use]

@@ -50,7 +50,7 @@ use crate::cut::slot::{Arena, SlotIndex};
 use crate::cut::steady::{Margins, Mode, Steady};
 use crate::cut::NIL;
 use crate::nodemap::NodeMap;
-use crate::policy::{Bounds, Demand, Policy, View};
+use crate::policy::{dot, sub, Bounds, Demand, Policy, View};
 
 use super::format::SemiRegularView;
 use super::lattice::Point;
@@ -931,13 +931,9 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
     /// error bound stays under the threshold wherever the eye gets, or (with `frustum`) it
     /// stays out of the view.
     fn stays_unwanted(&self, m: &Margins, frustum: bool, b: &Bounds, view: &View) -> bool {
-        let r = [
-            b.center[0] - view.eye[0],
-            b.center[1] - view.eye[1],
-            b.center[2] - view.eye[2],
-        ];
-        let d2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
-        self.steady.stays_quiet(m, libm::sqrtf(b.a2.max(b.b2)), d2)
+        let r = sub(b.center, view.eye);
+        self.steady
+            .stays_quiet(m, libm::sqrtf(b.a2.max(b.b2)), dot(r, r))
             || (frustum && self.steady.stays_visible(m, b.center, b.radius) == Some(false))
     }
 
