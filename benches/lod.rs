@@ -32,9 +32,15 @@
 //!    (`reproduce fig9`'s, at 90 and at 720 frames, 0.5 / 3.5 px), interleaved frame by frame,
 //!    and a frame whose view has not moved.
 //!
+//! 9. **Amortized traversal** ([`Budget::max_visits`], the LOD lecture's "distribute traversing
+//!    the tree over frames"): the bunny over the peer orbit at 0.5 / 1 / 2 px with all the
+//!    active vertices asked each frame, then a half, a quarter and an eighth of them (of the
+//!    full pass's mean count): median microseconds, vertices asked, triangles, and what the lag
+//!    costs, as the PSNR of each frame against the full pass's frame from the same camera.
+//!
 //! Run: `../shared/peers/run.sh` and `../shared/peers/hoppe/run.sh` once (they build the peers),
 //! then `cargo bench --bench lod` (`-- adaptation`, `-- quality`, `-- policies`,
-//! `-- srmesh`, `-- settling` or `-- wavelets` for one section).
+//! `-- srmesh`, `-- settling`, `-- wavelets` or `-- amortized` for one section).
 
 use std::path::PathBuf;
 use std::process::Command;
@@ -406,6 +412,114 @@ fn settling(h: &HierarchyView<'_>, mesh: &IndexedMesh) {
     }
 }
 
+/// One revolution of the peer orbit with [`Budget::max_visits`] at `visits`.
+struct Window {
+    us: Vec<f64>,
+    visited: Vec<f64>,
+    tris: Vec<f64>,
+    /// Every tenth frame as drawn (from the fifth).
+    frames: Vec<Vec<vdlod_raster::Rgba8>>,
+}
+
+fn window_orbit(
+    h: &HierarchyView<'_>,
+    mesh: &IndexedMesh,
+    policy: &impl Policy,
+    visits: u32,
+    draw: bool,
+) -> Window {
+    let orbit = peer_orbit(&mesh.bounds(), FRAMES, W, H);
+    let mut cut = BunnyCut::boxed();
+    cut.reset(h).expect("base mesh fits");
+    let budget = Budget {
+        max_visits: visits,
+        ..Budget::default()
+    };
+    let mut frame = Frame::new(W, H).expect("frame");
+    let mut out = Window {
+        us: Vec::new(),
+        visited: Vec::new(),
+        tris: Vec::new(),
+        frames: Vec::new(),
+    };
+    for i in 0..FRAMES {
+        let camera = orbit.camera(i);
+        let view = camera.view();
+        let start = Instant::now();
+        let s = cut.adapt(h, &view, policy, &budget);
+        let us = start.elapsed().as_secs_f64() * 1e6;
+        if i > 0 {
+            out.us.push(us);
+            out.visited.push(s.visited as f64);
+            out.tris.push(s.triangles as f64);
+        }
+        if draw && i % 10 == 5 {
+            frame
+                .draw_cut(&cut, h, &camera, &style(Shading::Gouraud, false))
+                .expect("draws");
+            out.frames.push(frame.pixels().to_vec());
+        }
+    }
+    out
+}
+
+/// The traversal spread over frames: windows of a half, a quarter and an eighth of the active
+/// list against the full pass, interleaved (full, windows, full, windows), medians of both runs.
+fn amortized(h: &HierarchyView<'_>, mesh: &IndexedMesh) {
+    println!(
+        "\n## 9. Amortized traversal (Budget::max_visits), bunny, peer orbit (640x480, 60 deg, 200 frames)\n"
+    );
+    println!("| tol px | vertices asked per frame | median us | ratio to full | mean tris | PSNR against the full pass dB |");
+    println!("|---|---|---|---|---|---|");
+    for t in [0.5f32, 1.0, 2.0] {
+        let policy = QRefine::new(t);
+        let full = window_orbit(h, mesh, &policy, u32::MAX, true);
+        let active = full.tris.iter().sum::<f64>() / full.tris.len() as f64 / 2.0;
+        let windows = [u32::MAX, 2, 4, 8].map(|d| {
+            if d == u32::MAX {
+                d
+            } else {
+                (active / d as f64).round() as u32
+            }
+        });
+        let mut us: Vec<Vec<f64>> = vec![Vec::new(); windows.len()];
+        let mut runs: Vec<Option<Window>> = (0..windows.len()).map(|_| None).collect();
+        for _ in 0..2 {
+            for (k, &w) in windows.iter().enumerate() {
+                let run = window_orbit(h, mesh, &policy, w, runs[k].is_none());
+                us[k].extend(run.us.iter().copied());
+                runs[k].get_or_insert(run);
+            }
+        }
+        let full_us = median(us[0].clone());
+        for (k, run) in runs.iter().enumerate() {
+            let run = run.as_ref().expect("ran");
+            let quality: Vec<f64> = run
+                .frames
+                .iter()
+                .zip(&full.frames)
+                .map(|(a, b)| psnr(a, b))
+                .collect();
+            let m = median(us[k].clone());
+            let shown = if k == 0 {
+                "all".to_string()
+            } else {
+                format!("{:.0} (1/{})", mean(&run.visited), [1, 2, 4, 8][k])
+            };
+            let psnr_cell = if k == 0 {
+                "-".to_string()
+            } else {
+                format!("{:.2}", mean(&quality))
+            };
+            println!(
+                "| {t} | {shown} | {m:.1} | {:.2}x | {:.0} | {psnr_cell} |",
+                m / full_us,
+                mean(&run.tris)
+            );
+        }
+    }
+}
+
 /// The wavelet cut with settled wavelets skipped or asked, interleaved frame by frame over the
 /// session of `reproduce fig9` on the subdivided cow; then the same view twice in a row.
 fn wavelets() {
@@ -633,6 +747,9 @@ fn main() {
         }
         if wanted("wavelets") {
             wavelets();
+        }
+        if wanted("amortized") {
+            amortized(&h, &mesh);
         }
     }
 }

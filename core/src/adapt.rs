@@ -93,6 +93,12 @@ pub struct Budget {
     /// The previous frame's time in microseconds, as the caller measured it (adapting and
     /// drawing; 0: not measured).
     pub frame_us: u32,
+    /// Active vertices asked per frame at most: the LOD lecture's amortization, the traversal
+    /// spread over frames. Each frame asks the next `max_visits` vertices of the active list,
+    /// going on where the previous frame stopped and wrapping round; vertices in a geomorph are
+    /// asked every frame besides (their blends advance). Below the active count, frames do not
+    /// skip settled vertices (the window is the saving instead). The vertex cut only.
+    pub max_visits: u32,
 }
 
 impl Default for Budget {
@@ -104,6 +110,7 @@ impl Default for Budget {
             max_ops: u32::MAX,
             target_frame_us: 0,
             frame_us: 0,
+            max_visits: u32::MAX,
         }
     }
 }
@@ -129,6 +136,9 @@ pub struct FrameStats {
     /// Vertices skipped because their answers could not have changed since an anchor frame
     /// (see [`Cut::adapt`]; the frame is the same as if they had been asked).
     pub settled: u32,
+    /// Vertices asked this frame (all active ones but the settled, unless
+    /// [`Budget::max_visits`] binds; 0 from the wavelet cut, which asks wavelets).
+    pub visited: u32,
     /// The error threshold used (1 unless regulated).
     pub threshold: f32,
     /// Splits were refused by [`Budget::max_triangles`].
@@ -272,7 +282,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             threshold: self.threshold,
             ops: 0,
         };
-        self.evaluate(h, view, policy, &mut frame);
+        self.evaluate(h, view, policy, budget.max_visits, &mut frame);
         self.coarsen(h, view, policy, budget, &mut frame);
         self.refine(h, view, policy, budget, &mut frame);
         self.enforce_max(h, view, policy, budget, &mut frame.stats);
@@ -313,6 +323,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         h: &HierarchyView<'_>,
         view: &View,
         policy: &P,
+        max_visits: u32,
         frame: &mut Frame,
     ) {
         self.candidates.clear();
@@ -343,7 +354,28 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         // Settled vertices are skipped while the anchor holds; otherwise an anchor frame marks
         // them anew (see `crate::cut::steady`).
         let model = h.bounding_sphere();
-        let mode = self.steady.begin(view, envelope, t, blends, model);
+        // The walk: positions 0..len of the active list from slot `start`, wrapping round; the
+        // first `visits` are the window, past it only vertices in a geomorph are asked.
+        let len = self.v.len();
+        let visits = (max_visits as usize).min(len);
+        let windowed = visits < len;
+        let start = if windowed {
+            self.walk as usize % len
+        } else {
+            0
+        };
+        self.walk = if windowed {
+            ((start + visits) % len) as u32
+        } else {
+            0
+        };
+        let end = if windowed && self.blends.len() == 0 {
+            visits
+        } else {
+            len
+        };
+        let steady_envelope = if windowed { None } else { envelope };
+        let mode = self.steady.begin(view, steady_envelope, t, blends, model);
         let skip = mode == Mode::Skip;
         // On an anchor frame, the margins its settled vertices must have.
         let anchor = (mode == Mode::Anchor).then(|| self.steady.margins(upper, t, SLACK, model));
@@ -360,20 +392,29 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         let mut records = [Record::default(); BATCH];
         let mut parent_bounds = [Bounds::default(); BATCH];
         let mut next = 0;
-        while next < self.v.len() {
+        while next < end {
             // 1. The digests, until the batch holds `BATCH` vertices still to decide. A vertex
             // the bound decides that has no pair to judge and no geomorph is done with here:
             // only its visibility flag moves (computed only with geomorphs, the one use of it).
             let mut n = 0;
             let mut ns = 0;
-            while n < BATCH && next < self.v.len() {
-                let i = next;
+            while n < BATCH && next < end {
+                let place = next;
                 next += 1;
+                let i = if start + place < len {
+                    start + place
+                } else {
+                    start + place - len
+                };
                 let flags = self.v.flags[i];
+                if place >= visits && flags & (BLENDING | COLLAPSING) == 0 {
+                    continue;
+                }
                 if skip && flags & SETTLED != 0 {
                     frame.stats.settled += 1;
                     continue;
                 }
+                frame.stats.visited += 1;
                 let digest = &self.v.digest[i];
                 let center = h.digest_center(digest);
                 let s = h.length(digest.spheroid);

@@ -578,6 +578,9 @@ pub fn run_orbit(
         if opts.depth_colors {
             return Err("--depth-colors needs the vertex forest (a .vdh file or a mesh)".into());
         }
+        if opts.budget.max_visits != u32::MAX {
+            return Err("--max-visits needs the vertex forest (a .vdh file or a mesh)".into());
+        }
         let triangles = s
             .counts()
             .finest_faces()
@@ -833,7 +836,7 @@ fn fly_orbit(
     let full_mesh = full.as_raster_mesh();
     let ground = opts.ground.as_ref();
     let mut csv = String::from(
-        "frame,triangles,vsplits,ecols,adapt_us,render_us,full_render_us,psnr_db,vertices,forced,blending,threshold,budget_limited,ops_limited,capacity_limited,queue_overflow,blend_limited,over_budget,new_triangles\n",
+        "frame,triangles,vsplits,ecols,adapt_us,render_us,full_render_us,psnr_db,vertices,forced,blending,threshold,budget_limited,ops_limited,capacity_limited,queue_overflow,blend_limited,over_budget,new_triangles,visited\n",
     );
     let mut frames = Vec::with_capacity(opts.frames as usize);
     let mut before = Vec::new();
@@ -935,7 +938,7 @@ fn fly_orbit(
         }
         let _ = writeln!(
             csv,
-            "{},{},{},{},{:.1},{:.1},{:.1},{:.3},{},{},{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{:.1},{:.1},{:.1},{:.3},{},{},{},{},{},{},{},{},{},{},{},{}",
             i,
             stats.triangles,
             stats.vsplits,
@@ -955,6 +958,7 @@ fn fly_orbit(
             stats.blend_limited as u8,
             stats.over_budget as u8,
             f.new_triangles,
+            stats.visited,
         );
         report(&f);
         frames.push(f);

@@ -371,6 +371,10 @@ struct FlightArgs {
     /// Splits plus collapses per frame at most (at least 1).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     max_ops: Option<u32>,
+    /// Active vertices asked per frame at most (at least 1): the traversal spread over frames,
+    /// each frame going on where the last stopped (vertex forest only).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    max_visits: Option<u32>,
     /// Screen-space tolerance in pixels (at the silhouette, and inside unless --interior); 0
     /// asks for full detail.
     #[arg(long, default_value_t = 1.0, allow_negative_numbers = true, value_parser = non_negative)]
@@ -437,6 +441,7 @@ impl Default for FlightArgs {
             target: None,
             target_ms: None,
             max_ops: None,
+            max_visits: None,
             tolerance: 1.0,
             interior: None,
             policy: PolicyArg::Screen,
@@ -477,6 +482,9 @@ impl FlightArgs {
         }
         if let Some(m) = self.max_ops {
             budget.max_ops = m;
+        }
+        if let Some(v) = self.max_visits {
+            budget.max_visits = v;
         }
         if let Some(ms) = self.target_ms {
             // At least a microsecond (`as` saturates above `u32::MAX`).

@@ -166,6 +166,7 @@ fn bad_flag_values_are_refused_with_their_range() {
         (&["orbit", "--budget", "0"][..], "1.."),
         (&["orbit", "--target", "0"][..], "1.."),
         (&["orbit", "--max-ops", "0"][..], "1.."),
+        (&["orbit", "--max-visits", "0"][..], "1.."),
     ] {
         let out = demo(args, &dir);
         assert_eq!(out.status.code(), Some(2), "{args:?}");
@@ -639,6 +640,29 @@ fn a_frame_time_target_regulates_and_bad_ones_are_refused() {
     for bad in ["0", "-1", "nan"] {
         let out = demo(&["orbit", "--target-ms", bad, "-o", "out"], &dir);
         assert!(!out.status.success(), "{bad}");
+    }
+}
+
+#[test]
+fn a_visit_window_asks_at_most_that_many_vertices() {
+    let dir = scratch_dir("cli_max_visits");
+    succeed(
+        &["orbit", "--max-visits", "100", "--frames", "6", "-o", "out"],
+        &dir,
+    );
+    let csv = std::fs::read_to_string(dir.join("out/stats.csv")).unwrap();
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let column = |name: &str| header.iter().position(|&c| c == name).unwrap();
+    let (visited, blending, vertices) = (column("visited"), column("blending"), column("vertices"));
+    for line in csv.lines().skip(1) {
+        let row: Vec<u32> = line
+            .split(',')
+            .map(|c| c.parse::<f32>().unwrap() as u32)
+            .collect();
+        // The window, plus the vertices of the running geomorphs (two per split or collapse).
+        assert!(row[visited] >= 1, "{line}");
+        assert!(row[visited] <= 100 + 2 * row[blending] + 2, "{line}");
+        assert!(row[vertices] > 100, "{line}");
     }
 }
 

@@ -33,10 +33,11 @@
 //! | triangle slot | `6i + 4 + i` (18 with `u16`) | corners, neighbours, id; one node-map entry |
 //! | queue entry | `4 + 8 + 12 + 28 = 52` | forcing stack, split heap, collapse pairs, blend arena |
 //!
-//! plus 164 bytes of lengths, settings and the anchor frame of the settled vertices (`steady`).
+//! plus 168 bytes of lengths, settings, the walk's position and the anchor frame of the settled
+//! vertices (`steady`).
 //! With the recommended `F = 2 V` and `Q = V / 8` that is 21 + 36 + 6.5 = 63.5 bytes per vertex
 //! slot, **31.75 bytes per triangle of capacity** with `u16` (48.75 with `u32`), 31.89 for a
-//! 1,000-triangle cut. A cut for a 10,000-triangle budget, `Cut<5000, 10000, 625>`, is 317,664
+//! 1,000-triangle cut. A cut for a 10,000-triangle budget, `Cut<5000, 10000, 625>`, is 317,668
 //! bytes. The queues only bound how much one frame can do: when one overflows, the rest
 //! waits for the next frame and [`crate::adapt::FrameStats`] says so.
 //!
@@ -100,8 +101,8 @@ use store::{Triangles, Vertices};
 
 // The documented figure, checked when the crate is compiled for any target (CI builds it for
 // x86_64 and a 32-bit Cortex-M): a cut of 10,240 triangle slots with the recommended
-// capacities is 325,284 bytes, at most 32 bytes per triangle of capacity.
-const _: () = assert!(Cut::<5120, 10240, 640>::BYTES == 325_284);
+// capacities is 325,288 bytes, at most 32 bytes per triangle of capacity.
+const _: () = assert!(Cut::<5120, 10240, 640>::BYTES == 325_288);
 const _: () = assert!(Cut::<5120, 10240, 640>::BYTES <= 32 * 10240);
 
 /// A slot that holds nothing (no neighbour across a border edge, no incident triangle).
@@ -226,6 +227,8 @@ pub struct Cut<const V: usize, const F: usize, const Q: usize, I: SlotIndex = u1
     pub(crate) threshold: f32,
     /// The anchor frame of the vertices marked `SETTLED`.
     pub(crate) steady: Steady,
+    /// Where the next frame's walk starts when [`crate::adapt::Budget::max_visits`] binds.
+    pub(crate) walk: u32,
 }
 
 impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> fmt::Debug for Cut<V, F, Q, I> {
@@ -326,6 +329,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             raise_wait: 0,
             threshold: 0.0,
             steady: Steady::ZERO,
+            walk: 0,
         }
     }
 
@@ -421,6 +425,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         self.blends.clear();
         self.threshold = 1.0;
         self.steady.clear();
+        self.walk = 0;
     }
 
     /// Active vertices.
