@@ -19,7 +19,8 @@
 //!    parent's error is below the next split's are collapsed to make room, so the cut is the best
 //!    the budget allows. [`Budget::target_triangles`] regulates the error threshold from frame to
 //!    frame (the LOD lecture's regulation), [`Budget::max_ops`] caps the splits and collapses of
-//!    one frame (its amortization).
+//!    one frame and [`Budget::max_visits`] the vertices the pass asks, each frame asking the
+//!    next window of the active list (its amortization).
 //!
 //! Geomorphs ([`Cut::set_geomorph_frames`]): a split's children start at the parent's current
 //! position, normal and colour and blend to their own; a collapse first blends both children to
