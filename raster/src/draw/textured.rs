@@ -5,7 +5,7 @@
 //! texture is mapped perspective-correctly), with a fill that colours each fragment with the texel
 //! at its `(u, v)` modulated by its lit colour (so a white mesh shows the texture as it is, lit).
 
-use super::{DrawError, DrawStats, ShadedMesh};
+use super::{DrawError, DrawStats, Fill, ShadedMesh};
 use crate::edge::{scan_textured, Fragment, ScreenVertex};
 use crate::mesh::MeshSource;
 use crate::target::{Depth, Pixel, Target};
@@ -52,6 +52,27 @@ impl<M: MeshSource> ShadedMesh<'_, M> {
         if !self.mesh.has_uvs() {
             return Err(DrawError::MissingUvs);
         }
+        Ok(self.draw_triangles::<P, D, false, _>(target, &[], &Textured(texture)))
+    }
+}
+
+/// The textured fill: each fragment that passes the strict-less depth test takes the texel at
+/// its `(u, v)` times its lit colour.
+struct Textured<'a, 't, T: Pixel>(&'a Texture<'t, T>);
+
+impl<P: Pixel, D: Depth, T: Pixel> Fill<P, D> for Textured<'_, '_, T> {
+    const TEXTURED: bool = true;
+
+    #[inline(always)]
+    fn fill(
+        &self,
+        target: &mut Target<'_, P, D>,
+        s: &[ScreenVertex; 3],
+        q: &[[f32; 3]; 3],
+        area: i64,
+        bounds: [i64; 4],
+    ) {
+        let texture = self.0;
         let plot = |c: &mut P, d: &mut D, f: Fragment<'_>, uv: [f32; 2]| {
             let z = D::from_depth(f.z);
             if z < *d {
@@ -64,12 +85,6 @@ impl<M: MeshSource> ShadedMesh<'_, M> {
                 );
             }
         };
-        let fill =
-            |target: &mut Target<'_, P, D>,
-             s: &[ScreenVertex; 3],
-             q: &[[f32; 3]; 3],
-             area: i64,
-             bounds: [i64; 4]| { scan_textured(target, s, q, area, bounds, plot) };
-        Ok(self.draw_triangles::<P, D, false, true, _>(target, &[], fill))
+        scan_textured(target, s, q, area, bounds, plot);
     }
 }
