@@ -198,6 +198,16 @@ fn validate<M: MeshSource>(mesh: &M, params: &DrawParams, scratch: usize) -> Res
     if params.shading == Shading::Gouraud && !mesh.has_normals() {
         return Err(DrawError::MissingNormals);
     }
+    // The largest index first, without a branch per index (the reduction runs in SIMD
+    // registers); the offender is searched for only when there is one.
+    let largest = mesh
+        .triangles()
+        .as_flattened()
+        .iter()
+        .fold(0u32, |m, &i| m.max(i.to_u32()));
+    if (largest as usize) < n || mesh.triangles().is_empty() {
+        return Ok(());
+    }
     for (triangle, tri) in mesh.triangles().iter().enumerate() {
         if let Some(index) = tri
             .map(VertexIndex::to_u32)

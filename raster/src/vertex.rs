@@ -213,16 +213,51 @@ impl PreparedLighting {
     /// Intensity at a vertex with object-space normal `n`.
     #[inline(always)]
     pub fn intensity(&self, n: Vec3) -> f32 {
-        // Object-space lighting, the common case, skips the identity product.
-        let n = match &self.columns {
-            None => n,
-            Some(m) => Vec3::new(
+        match (self.columns.is_some(), self.unit_normals) {
+            (false, false) => self.lane::<false, false>(n),
+            (false, true) => self.lane::<false, true>(n),
+            (true, false) => self.lane::<true, false>(n),
+            (true, true) => self.lane::<true, true>(n),
+        }
+    }
+
+    /// [`PreparedLighting::intensity`] of a batch of normals, attribute by attribute: the choice
+    /// of formula made once for the batch, so that the lanes run straight (and in SIMD registers).
+    #[inline(always)]
+    fn intensities(&self, n: &[[f32; BATCH]; 3], out: &mut [f32; BATCH]) {
+        match (self.columns.is_some(), self.unit_normals) {
+            (false, false) => self.lanes::<false, false>(n, out),
+            (false, true) => self.lanes::<false, true>(n, out),
+            (true, false) => self.lanes::<true, false>(n, out),
+            (true, true) => self.lanes::<true, true>(n, out),
+        }
+    }
+
+    #[inline(always)]
+    fn lanes<const ROTATE: bool, const UNIT: bool>(
+        &self,
+        n: &[[f32; BATCH]; 3],
+        out: &mut [f32; BATCH],
+    ) {
+        for (k, l) in out.iter_mut().enumerate() {
+            *l = self.lane::<ROTATE, UNIT>(Vec3::new(n[0][k], n[1][k], n[2][k]));
+        }
+    }
+
+    /// One normal's intensity: rotated by the normal matrix when `ROTATE` (object-space
+    /// lighting, the common case, skips the identity product), then lit as a unit normal when
+    /// `UNIT`.
+    #[inline(always)]
+    fn lane<const ROTATE: bool, const UNIT: bool>(&self, n: Vec3) -> f32 {
+        let n = match (ROTATE, &self.columns) {
+            (true, Some(m)) => Vec3::new(
                 m[0][0] * n.x + m[1][0] * n.y + m[2][0] * n.z,
                 m[0][1] * n.x + m[1][1] * n.y + m[2][1] * n.z,
                 m[0][2] * n.x + m[1][2] * n.y + m[2][2] * n.z,
             ),
+            _ => n,
         };
-        if self.unit_normals {
+        if UNIT {
             self.light.intensity_unit(n, self.unit_direction)
         } else {
             self.light.intensity(n)
@@ -276,9 +311,7 @@ pub fn shade_vertices<M: MeshSource>(
         }
         let mut light = [1.0f32; BATCH];
         if let Some(p) = lighting {
-            for (k, l) in light.iter_mut().enumerate() {
-                *l = p.intensity(Vec3::new(n[0][k], n[1][k], n[2][k]));
-            }
+            p.intensities(&n, &mut light);
         }
         let mut screen = [(0, 0, 0.0f32); BATCH];
         for (k, s) in screen.iter_mut().enumerate() {
