@@ -371,8 +371,14 @@ fn settled_vertices_change_no_frame() {
             let s = skipping.adapt(&h, view, &policy, &budget);
             let a = asked.adapt(&h, view, &policy, &budget);
             assert_eq!(a.settled, 0);
+            // A skipped vertex is one not asked.
+            assert_eq!(s.visited + s.settled, a.visited, "{name}, frame {i}");
             assert_eq!(
-                FrameStats { settled: 0, ..s },
+                FrameStats {
+                    settled: 0,
+                    visited: a.visited,
+                    ..s
+                },
                 a,
                 "{name}, frame {i}: the stats differ"
             );
