@@ -70,11 +70,6 @@ pub(crate) struct Engine<'o> {
     /// squared edges`, 1 for equilateral), unless the region already had one as bad: 0 for the
     /// hierarchy builder, where shape does not matter; the remesher's base faces need it.
     pub min_shape: f64,
-    /// The smallest angle sum at a border vertex (radians) that may not become the corner of a
-    /// triangle with two border edges: such a triangle spans the border's turn at that corner,
-    /// so a corner turning the other way (a notch in a hole's rim) would fold it over. Infinite
-    /// for the hierarchy builder; the remesher's base faces need it.
-    pub max_ear_angle: f64,
 }
 
 /// `4 sqrt(3) area / (sum of squared edge lengths)`: 1 for an equilateral triangle, 0 for a
@@ -158,7 +153,6 @@ impl<'o> Engine<'o> {
                 .then(|| Surface::new(mesh.positions, mesh.triangles)),
             planar: None,
             min_shape: 0.0,
-            max_ear_angle: f64::INFINITY,
         };
         e.alive_count = e.alive.iter().filter(|&&a| a).count();
         // Boundary quadrics keep open borders in place.
@@ -339,9 +333,6 @@ impl<'o> Engine<'o> {
                 return Ok(false);
             }
         }
-        if (ba || bb) && self.max_ear_angle.is_finite() && self.makes_blunt_ear(a, b) {
-            return Ok(false);
-        }
         // No flipped or collapsed triangle, and none worse shaped than `min_shape` allows.
         let mut worst_before = f64::INFINITY;
         let mut worst_after = f64::INFINITY;
@@ -366,104 +357,6 @@ impl<'o> Engine<'o> {
             }
         }
         Ok(self.min_shape <= 0.0 || worst_after >= self.min_shape.min(worst_before))
-    }
-
-    /// The sum of the corner angles at `v` over its faces: 2 pi inside a flat region, pi along a
-    /// straight border, less at a convex border corner, more at a notch.
-    fn angle_sum(&self, v: u32) -> f64 {
-        self.vfaces[v as usize]
-            .iter()
-            .map(|&f| self.corner_angle(f, v))
-            .sum()
-    }
-
-    /// The angle of face `f` at its corner `v`.
-    fn corner_angle(&self, f: u32, v: u32) -> f64 {
-        let t = self.faces[f as usize];
-        let k = t.iter().position(|&x| x == v).unwrap_or(0);
-        let p = self.pos[t[k] as usize];
-        let (u, w) = (
-            sub(self.pos[t[(k + 1) % 3] as usize], p),
-            sub(self.pos[t[(k + 2) % 3] as usize], p),
-        );
-        libm::atan2(len(cross(u, w)), dot(u, w))
-    }
-
-    /// Whether collapsing `a-b` makes a triangle with two border edges (where none was) whose
-    /// shared corner has an angle sum of at least [`Engine::max_ear_angle`] now (for the merged
-    /// vertex, the angle its border corner will have).
-    fn makes_blunt_ear(&self, a: u32, b: u32) -> bool {
-        const MERGED: u32 = NONE - 1;
-        let removed = |f: u32| {
-            let t = self.faces[f as usize];
-            t.contains(&a) && t.contains(&b)
-        };
-        let rename = |x: u32| if x == a || x == b { MERGED } else { x };
-        // Whether a face left after the collapse has the directed edge `p -> q` (renamed).
-        let has_edge = |p: u32, q: u32| {
-            let any = |p: u32, q: u32| {
-                let f = self.face_with_edge(p, q);
-                f != NONE && !removed(f)
-            };
-            match (p == MERGED, q == MERGED) {
-                (false, false) => any(p, q),
-                (true, false) => any(a, q) || any(b, q),
-                (false, true) => any(p, a) || any(p, b),
-                (true, true) => false,
-            }
-        };
-        let merged_angle = || {
-            let (ea, eb) = (self.angle_sum(a), self.angle_sum(b));
-            match self.edge_faces(a, b) {
-                (_, 1) => {
-                    let f = self.face_with_edge(a, b);
-                    let f = if f == NONE {
-                        self.face_with_edge(b, a)
-                    } else {
-                        f
-                    };
-                    ea + eb - self.corner_angle(f, a) - self.corner_angle(f, b)
-                }
-                _ if self.vfaces[a as usize].len() < self.neighbours(a).len() => ea,
-                _ => eb,
-            }
-        };
-        let mut faces: Vec<u32> = self.vfaces[a as usize]
-            .iter()
-            .chain(&self.vfaces[b as usize])
-            .copied()
-            .filter(|&f| !removed(f))
-            .collect();
-        faces.sort_unstable();
-        faces.dedup();
-        for f in faces {
-            let t = self.faces[f as usize];
-            let r = t.map(rename);
-            let after: [bool; 3] = core::array::from_fn(|k| !has_edge(r[(k + 1) % 3], r[k]));
-            if after.iter().filter(|&&x| x).count() < 2 {
-                continue;
-            }
-            let before = (0..3)
-                .filter(|&k| self.face_with_edge(t[(k + 1) % 3], t[k]) == NONE)
-                .count();
-            if before >= 2 {
-                continue;
-            }
-            // The corner between two border edges: edges k - 1 and k meet at corner k.
-            for k in 0..3 {
-                if after[k] && after[(k + 2) % 3] {
-                    let angle = if r[k] == MERGED {
-                        merged_angle()
-                    } else {
-                        self.angle_sum(r[k])
-                    };
-                    if angle >= self.max_ear_angle {
-                        return true;
-                    }
-                }
-            }
-        }
-        false
     }
 
     /// Collapses the cheapest legal edge; `false` when none is left.

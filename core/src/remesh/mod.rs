@@ -6,9 +6,8 @@
 //! is ours, after Liu, Kim, Chen, Jacobson, Sharp and Aigerman's successive self-parameterization
 //! ("Neural subdivision", 2020), itself a descendant of Lee et al.'s MAPS (1998):
 //!
-//! 1. The vertex forest's own edge collapses (quadric costs, the same legality tests, a floor on
-//!    the base faces' shape, no base face spanning a blunt rim corner) simplify the input to the
-//!    chosen base size; each collapse also maps its region into the plane
+//! 1. The vertex forest's own edge collapses (quadric costs, the same legality tests) simplify
+//!    the input to the chosen base size; each collapse also maps its region into the plane
 //!    before and after ([`crate::build`]'s `flatten`), and an edge whose region cannot be mapped
 //!    without a fold is not collapsed.
 //! 2. The base mesh is subdivided `J` times; every vertex of every level is a point of a base
@@ -71,13 +70,6 @@ pub use quality::{distances, Distances, Quality};
 
 /// The worst base triangle shape a collapse may make (unless its region had one as bad).
 const MIN_SHAPE: f64 = 0.3;
-
-/// The bluntest border corner (angle sum, radians: 99 degrees) a base face with two border
-/// edges may sit on. Such a face spans the border's whole turn there, and at a blunter corner the
-/// subdivided face folds over wherever the input's rim turns the other way (the head's holes
-/// had two such folds); a square's corner (90 degrees) must stay allowed, since one triangle is
-/// all it can have.
-const MAX_EAR_ANGLE: f64 = 0.55 * core::f64::consts::PI;
 
 /// Settings of [`remesh`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -223,7 +215,6 @@ pub fn remesh(
     let mut engine = Engine::new(input, &build_options);
     engine.planar = Some(Vec::new());
     engine.min_shape = MIN_SHAPE;
-    engine.max_ear_angle = MAX_EAR_ANGLE;
     let (faces, collapses) = simplify(&mut engine, options.base_faces, input_faces, progress);
     if faces > options.base_faces.saturating_mul(2) {
         return Err(RemeshError::NotReached {
