@@ -19,8 +19,9 @@
 //!    parent's error is below the next split's are collapsed to make room, so the cut is the best
 //!    the budget allows. [`Budget::target_triangles`] regulates the error threshold from frame to
 //!    frame (the LOD lecture's regulation), [`Budget::max_ops`] caps the splits and collapses of
-//!    one frame and [`Budget::max_visits`] the vertices the pass asks, each frame asking the
-//!    next window of the active list (its amortization).
+//!    one frame (least needed pairs first, up to half the cap kept for the largest errors'
+//!    splits) and [`Budget::max_visits`] the vertices the pass asks, each frame asking the next
+//!    window of the active list (its amortization).
 //!
 //! Geomorphs ([`Cut::set_geomorph_frames`]): a split's children start at the parent's current
 //! position, normal and colour and blend to their own; a collapse first blends both children to
@@ -85,7 +86,8 @@ pub struct Budget {
     pub target_triangles: u32,
     /// Relative band around the target inside which the threshold is left alone.
     pub target_band: f32,
-    /// Splits plus collapses per frame at most.
+    /// Splits plus collapses per frame at most: the least needed pairs collapse first, and up
+    /// to half of it stays for the waiting splits, largest error first.
     pub max_ops: u32,
     /// Regulate the error threshold towards this frame time, in microseconds (0: off): the LOD
     /// lecture's constant frame rate. The core has no clock; the caller measures its frames and
@@ -654,6 +656,15 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         if self.pairs.len() == 0 {
             return;
         }
+        // Under an operation cap, the least needed pairs go first (culled ones before all), and
+        // up to half the cap stays for the splits waiting in the heap, which refinement spends
+        // largest error first: a cap that binds is spent where the errors are.
+        let cap = if budget.max_ops == u32::MAX {
+            u32::MAX
+        } else {
+            sort_pairs(self.pairs.as_mut_slice());
+            budget.max_ops - (self.candidates.len() as u32).min(budget.max_ops / 2)
+        };
         // Scratch for the fans of every collapse tried (made once: making one costs a memset).
         let mut fans = PairFans::default();
         // One pass over a list that grows: a collapse lists the pair it makes and the pairs
@@ -680,7 +691,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             };
             let b = self.v.mate(a as usize);
             let (a, b) = (a as usize, b as usize);
-            if frame.ops >= budget.max_ops {
+            if frame.ops >= cap {
                 frame.stats.ops_limited = true;
                 return;
             }

@@ -1,8 +1,8 @@
 //! Random camera paths over a cut, checked after every frame.
 //!
 //! Each path mixes close-ups (the eye near or inside the bounding box), far views, views from
-//! inside the frustum and looking away from the mesh, changing tolerances, budgets and
-//! geomorphs. After every frame the cut must be an oriented manifold without cracks with the
+//! inside the frustum and looking away from the mesh, changing tolerances, budgets, operation
+//! caps, visit windows and geomorphs. After every frame the cut must be an oriented manifold without cracks with the
 //! input's Euler characteristic and border loops, within the triangle budget.
 
 use super::{sorted, topology};
@@ -120,6 +120,7 @@ pub fn fly<const V: usize, const F: usize, const Q: usize, I: SlotIndex>(
         let budget = Budget {
             max_triangles: max.max(h.base_triangles() + 2),
             max_ops: if i % 7 == 0 { 50 } else { u32::MAX },
+            max_visits: if i % 150 < 40 { 150 } else { u32::MAX },
             ..Budget::default()
         };
         cut.set_geomorph_frames(((i / 50) % 3) as u16 * 2);

@@ -452,6 +452,59 @@ mod adapt {
     }
 
     #[test]
+    fn an_operation_cap_is_spent_where_the_errors_are() {
+        use crate::policy::Policy;
+        let bytes = sphere_bytes();
+        let h = HierarchyView::parse(&bytes).unwrap();
+        let policy = ScreenError::new(0.5);
+        // Refined close to one side; then the eye moves round to the other side: the first
+        // side's detail is no longer needed, the second side's is.
+        let (before, after) = (orbit(0, 1.6), orbit(45, 1.6));
+        let mut cut: Box<Mid> = Cut::boxed();
+        cut.reset(&h).unwrap();
+        while {
+            let s = cut.adapt(&h, &before, &policy, &Budget::default());
+            s.vsplits + s.ecols > 0
+        } {}
+        let budget = Budget {
+            max_ops: 8,
+            ..Budget::default()
+        };
+        // The pairs that could collapse, with their parents' errors, before the frame.
+        let collapsible = |cut: &Mid| -> Vec<(u32, f32)> {
+            (0..cut.vertex_count())
+                .filter_map(|i| cut.pair_parent(&h, i))
+                .filter(|&p| cut.collapse_legal(&h, p, &mut Default::default()).is_ok())
+                .map(|p| (p, policy.demand(&h.bounds(p), &after).error))
+                .filter(|&(_, e)| e <= 1.0)
+                .collect()
+        };
+        let pairs = collapsible(&cut);
+        let s = cut.adapt(&h, &after, &policy, &budget);
+        assert!(s.ops_limited && s.vsplits + s.ecols <= 8, "{s:?}");
+        // Splits got their half of the cap, and collapses the rest.
+        assert!(s.vsplits >= 4 && s.ecols >= 3, "{s:?}");
+        // The pairs collapsed were the least needed of those that could.
+        let collapsed: Vec<f32> = pairs
+            .iter()
+            .filter(|&&(p, _)| cut.is_active(p))
+            .map(|&(_, e)| e)
+            .collect();
+        let left = pairs
+            .iter()
+            .filter(|&&(p, _)| !cut.is_active(p))
+            .map(|&(_, e)| e)
+            .fold(f32::INFINITY, f32::min);
+        let most = collapsed.iter().copied().fold(0.0, f32::max);
+        assert!(
+            collapsed.len() >= 2 && collapsed.len() < pairs.len() && most <= left,
+            "{most} > {left}, {} of {}",
+            collapsed.len(),
+            pairs.len()
+        );
+    }
+
+    #[test]
     fn importance_splits_the_corners_of_important_triangles_and_then_holds_still() {
         use crate::policy::{Importance, Policy};
         let (p, t) = grid(32);
