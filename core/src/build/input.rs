@@ -6,6 +6,7 @@
 //! is reported as a [`BuildError`] naming the first offender. Vertices used by no triangle are
 //! accepted (documented repair): they become roots of their own and never collapse.
 
+use alloc::vec;
 use alloc::vec::Vec;
 use core::fmt;
 
@@ -160,7 +161,7 @@ pub fn validate(mesh: &InputMesh<'_>) -> Result<(), BuildError> {
     }
 
     // Duplicates: sort triangles by their sorted corners.
-    let mut keyed: Vec<([u32; 3], u32)> = mesh
+    let keyed: Vec<([u32; 3], u32)> = mesh
         .triangles
         .iter()
         .enumerate()
@@ -170,7 +171,7 @@ pub fn validate(mesh: &InputMesh<'_>) -> Result<(), BuildError> {
             (k, t as u32)
         })
         .collect();
-    keyed.sort_unstable();
+    let keyed = sorted_by_vertex(n, &keyed, |k| k.0[0]);
     for w in keyed.windows(2) {
         if w[0].0 == w[1].0 {
             return Err(BuildError::DuplicateTriangle {
@@ -188,7 +189,7 @@ pub fn validate(mesh: &InputMesh<'_>) -> Result<(), BuildError> {
             edges.push((a.min(b), a.max(b), a < b));
         }
     }
-    edges.sort_unstable();
+    let edges = sorted_by_vertex(n, &edges, |e| e.0);
     let mut i = 0;
     while i < edges.len() {
         let mut j = i + 1;
@@ -212,7 +213,7 @@ pub fn validate(mesh: &InputMesh<'_>) -> Result<(), BuildError> {
             around.push((tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3]));
         }
     }
-    around.sort_unstable();
+    let around = sorted_by_vertex(n, &around, |a| a.0);
     let mut i = 0;
     while i < around.len() {
         let v = around[i].0;
@@ -226,6 +227,34 @@ pub fn validate(mesh: &InputMesh<'_>) -> Result<(), BuildError> {
         i = j;
     }
     Ok(())
+}
+
+/// `items` in the order `sort_unstable` gives them, where each item's order starts with
+/// `vertex(item)`, a vertex below `n`: a counting sort on the vertex, then a sort of each
+/// vertex's few items (a handful per vertex, where one sort of them all compared across the
+/// whole mesh: several times faster on large meshes).
+fn sorted_by_vertex<T: Copy + Ord>(n: usize, items: &[T], vertex: impl Fn(&T) -> u32) -> Vec<T> {
+    let Some(&first) = items.first() else {
+        return Vec::new();
+    };
+    let mut start = vec![0u32; n + 1];
+    for item in items {
+        start[vertex(item) as usize + 1] += 1;
+    }
+    for v in 0..n {
+        start[v + 1] += start[v];
+    }
+    let mut next = start.clone();
+    let mut out = vec![first; items.len()];
+    for item in items {
+        let v = vertex(item) as usize;
+        out[next[v] as usize] = *item;
+        next[v] += 1;
+    }
+    for v in 0..n {
+        out[start[v] as usize..start[v + 1] as usize].sort_unstable();
+    }
+    out
 }
 
 /// Whether the link edges `x -> y` (sorted by `x`) of one vertex form a single path or cycle.
@@ -275,6 +304,27 @@ mod tests {
         [-1.0, 0.0, 0.0],
         [0.0, -1.0, 0.0],
     ];
+
+    #[test]
+    fn grouping_by_vertex_sorts_as_a_full_sort_does() {
+        // A small generator (xorshift), so the test needs no dependency.
+        let mut x = 0x9E37_79B9u32;
+        let mut next = |m: u32| {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            x % m
+        };
+        for n in [1usize, 2, 7, 50] {
+            let items: Vec<(u32, u32, bool)> = (0..300)
+                .map(|_| (next(n as u32), next(9), next(2) == 1))
+                .collect();
+            let mut full = items.clone();
+            full.sort_unstable();
+            assert_eq!(sorted_by_vertex(n, &items, |e| e.0), full, "{n}");
+        }
+        assert!(sorted_by_vertex(3, &[] as &[(u32, u32, bool)], |e| e.0).is_empty());
+    }
 
     #[test]
     fn accepts_open_and_closed_surfaces() {
