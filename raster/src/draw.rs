@@ -495,12 +495,18 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
             if misses(t) {
                 continue;
             }
-            let tri = &tri.map(VertexIndex::to_u32);
-            // References, not copies: a culled triangle reads only positions and outcodes.
-            let v = tri.map(|i| &scratch[i as usize]);
+            // Indices as scalars and references, not copies: a culled triangle reads only
+            // positions and outcodes (an index array here went through the stack, and reading
+            // one index back from the wider store stalled every triangle).
+            let [i0, i1, i2] = tri.map(VertexIndex::to_u32);
+            let v = [
+                &scratch[i0 as usize],
+                &scratch[i1 as usize],
+                &scratch[i2 as usize],
+            ];
             let union = v[0].outcode | v[1].outcode | v[2].outcode;
             let uvs = |mesh: &M| match F::TEXTURED {
-                true => tri.map(|i| mesh.uv(i as usize)),
+                true => [i0, i1, i2].map(|i| mesh.uv(i as usize)),
                 false => [[0.0; 2]; 3],
             };
             if union == 0 {
@@ -511,6 +517,7 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
                     stats.culled += 1;
                     continue;
                 }
+                let tri = &[i0, i1, i2];
                 stats.rasterized += 1;
                 // Smaller than a pixel and between pixel centres: nothing to draw, no set-up to pay.
                 let Some(bounds) = pixel_bounds(xy, &target.window) else {
@@ -541,6 +548,7 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
                     bounds,
                 );
             } else if needs_clipping(&v, union, &mut stats) {
+                let tri = &[i0, i1, i2];
                 let colors = triangle_colors(mesh, params, prepared, t, tri, &v);
                 let uv = uvs(mesh);
                 for_each_clipped(viewport, params, mesh, tri, colors, uv, union, |s, q| {
