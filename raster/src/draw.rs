@@ -396,8 +396,13 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
             ..DrawStats::default()
         };
         for (tri, row) in triangles.iter().zip(rows.iter_mut()) {
-            let tri = &tri.map(VertexIndex::to_u32);
-            let v = tri.map(|i| &scratch[i as usize]);
+            // Scalars until needed, as in the triangle loop.
+            let [i0, i1, i2] = tri.map(VertexIndex::to_u32);
+            let v = [
+                &scratch[i0 as usize],
+                &scratch[i1 as usize],
+                &scratch[i2 as usize],
+            ];
             let union = v[0].outcode | v[1].outcode | v[2].outcode;
             *row = EMPTY;
             if union == 0 {
@@ -422,7 +427,7 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
                     &self.viewport,
                     params,
                     self.mesh,
-                    tri,
+                    &[i0, i1, i2],
                     [[0.0; 3]; 3],
                     [[0.0; 2]; 3],
                     union,
