@@ -229,6 +229,22 @@ mod adapt {
 
     type Mid = Cut<4096, 8192, 2048>;
 
+    /// Adapts `cut` to `view` without limits until a frame changes nothing (within ten).
+    fn settle(
+        cut: &mut Mid,
+        h: &HierarchyView<'_>,
+        view: &View,
+        policy: &impl crate::policy::Policy,
+    ) {
+        for _ in 0..10 {
+            let s = cut.adapt(h, view, policy, &Budget::default());
+            if s.vsplits + s.ecols == 0 {
+                return;
+            }
+        }
+        panic!("the cut does not settle");
+    }
+
     #[test]
     fn frames_keep_the_mesh_valid_within_budget_and_repeat_exactly() {
         let bytes = sphere_bytes();
@@ -368,20 +384,14 @@ mod adapt {
         let policy = (Frustum, (BackFace, ScreenError::new(0.5)));
         // Both cuts start from the one a close view asks for; then the camera moves to the
         // other side, where a split's recursion cannot reach what must collapse.
-        let settle = |cut: &mut Mid, view: &View| {
-            while {
-                let s = cut.adapt(&h, view, &policy, &Budget::default());
-                s.vsplits + s.ecols > 0
-            } {}
-        };
         let (before, view) = (orbit(0, 1.5), orbit(45, 2.5));
         let mut full: Box<Mid> = Cut::boxed();
         full.reset(&h).unwrap();
-        settle(&mut full, &before);
+        settle(&mut full, &h, &before, &policy);
         let mut cut: Box<Mid> = Cut::boxed();
         cut.reset(&h).unwrap();
-        settle(&mut cut, &before);
-        settle(&mut full, &view);
+        settle(&mut cut, &h, &before, &policy);
+        settle(&mut full, &h, &view, &policy);
         let budget = Budget {
             max_visits: 64,
             ..Budget::default()
@@ -462,10 +472,7 @@ mod adapt {
         let (before, after) = (orbit(0, 1.6), orbit(45, 1.6));
         let mut cut: Box<Mid> = Cut::boxed();
         cut.reset(&h).unwrap();
-        while {
-            let s = cut.adapt(&h, &before, &policy, &Budget::default());
-            s.vsplits + s.ecols > 0
-        } {}
+        settle(&mut cut, &h, &before, &policy);
         let budget = Budget {
             max_ops: 8,
             ..Budget::default()
@@ -523,14 +530,7 @@ mod adapt {
         let policy = (Frustum, importance);
         let mut cut: Box<Mid> = Cut::boxed();
         cut.reset(&h).unwrap();
-        let mut rounds = 0;
-        while {
-            let s = cut.adapt(&h, &view, &policy, &Budget::default());
-            s.vsplits + s.ecols > 0
-        } {
-            rounds += 1;
-            assert!(rounds < 10, "the cut does not settle");
-        }
+        settle(&mut cut, &h, &view, &policy);
         cut.check(&h).unwrap();
         // Every triangle over the threshold has no corner left that could split (the paper's
         // rule), and the cut is neither the base nor full detail.
