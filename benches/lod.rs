@@ -475,18 +475,19 @@ fn amortized(h: &HierarchyView<'_>, mesh: &IndexedMesh) {
         let policy = QRefine::new(t);
         let full = window_orbit(h, mesh, &policy, u32::MAX, true);
         let active = full.tris.iter().sum::<f64>() / full.tris.len() as f64 / 2.0;
-        let windows = [u32::MAX, 2, 4, 8].map(|d| {
-            if d == u32::MAX {
-                d
-            } else {
-                (active / d as f64).round() as u32
-            }
+        // All, a half, a quarter and an eighth of the full pass's mean active count.
+        const SHARES: [u32; 4] = [1, 2, 4, 8];
+        let windows = SHARES.map(|d| match d {
+            1 => u32::MAX,
+            d => (active / d as f64).round() as u32,
         });
         let mut us: Vec<Vec<f64>> = vec![Vec::new(); windows.len()];
         let mut runs: Vec<Option<Window>> = (0..windows.len()).map(|_| None).collect();
         for _ in 0..2 {
             for (k, &w) in windows.iter().enumerate() {
-                let run = window_orbit(h, mesh, &policy, w, runs[k].is_none());
+                // The full pass's frames are `full`'s: only the windows' first runs draw.
+                let draw = k > 0 && runs[k].is_none();
+                let run = window_orbit(h, mesh, &policy, w, draw);
                 us[k].extend(run.us.iter().copied());
                 runs[k].get_or_insert(run);
             }
@@ -504,7 +505,7 @@ fn amortized(h: &HierarchyView<'_>, mesh: &IndexedMesh) {
             let shown = if k == 0 {
                 "all".to_string()
             } else {
-                format!("{:.0} (1/{})", mean(&run.visited), [1, 2, 4, 8][k])
+                format!("{:.0} (1/{})", mean(&run.visited), SHARES[k])
             };
             let psnr_cell = if k == 0 {
                 "-".to_string()

@@ -205,7 +205,7 @@ fn validate<M: MeshSource>(mesh: &M, params: &DrawParams, scratch: usize) -> Res
         .as_flattened()
         .iter()
         .fold(0u32, |m, &i| m.max(i.to_u32()));
-    if (largest as usize) < n || mesh.triangles().is_empty() {
+    if (largest as usize) < n {
         return Ok(());
     }
     for (triangle, tri) in mesh.triangles().iter().enumerate() {
@@ -480,7 +480,6 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
         rows: &[[u16; 2]],
         fill: &F,
     ) -> DrawStats {
-        const { assert!(!(BINNED && F::TEXTURED), "no binned textured draw") };
         let (mesh, params, scratch) = (self.mesh, self.params, self.vertices);
         let viewport = &self.viewport;
         let prepared = self.lighting.as_ref();
