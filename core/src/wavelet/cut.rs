@@ -55,6 +55,8 @@ use crate::policy::{dot, sub, Bounds, Demand, Policy, View};
 use super::format::SemiRegularView;
 use super::lattice::Point;
 
+mod emit;
+
 /// Why a cut cannot hold a semi-regular mesh.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum WaveletCutError {
@@ -160,9 +162,32 @@ pub struct WaveletCut<
     /// The emitted mesh's counts, kept as wavelets come and go.
     triangles: u32,
     vertices: u32,
+    /// Per vertex slot: its vertex id (`NIL` when freed), position, uses by triangles (with
+    /// [`emit::PENDING`]) and link in the pending or free list (see [`emit`]).
     ids: Arena<u32, V>,
     positions: [[f32; 3]; V],
+    uses: [u16; V],
+    link: [I; V],
+    free: u32,
+    freed: u32,
+    pending: u32,
+    /// Per triangle slot: its corners, its tile, and its neighbours in the tile's list.
     tris: Arena<[I; 3], T>,
+    owner: [I; T],
+    prev: [I; T],
+    next: [I; T],
+    spare: u32,
+    /// Per tile, its first triangle; the tiles' level and count (see [`emit`]).
+    head: [I; T],
+    tile_level: u32,
+    tiles: u32,
+    /// Runs of tiles to emit again (first tile, tiles), and whether the mesh emitted is the
+    /// set's apart from them (`false`: emit it all).
+    dirty: Arena<(u32, u32), Q>,
+    built: bool,
+    /// Whether a frame that changes anything emits the whole mesh (see
+    /// [`WaveletCut::set_partial_emission`]).
+    whole: bool,
     map: NodeMap<T, I>,
     heap: Arena<(u32, u32), Q>,
     threshold: f32,
@@ -176,10 +201,6 @@ pub struct WaveletCut<
     /// The previous frame's view (valid with `has_previous`).
     previous: View,
     has_previous: bool,
-    /// Whether the emitted mesh may differ from what the set and the geomorphs make now (a
-    /// wavelet came or went, a geomorph ran or stopped, or the last emission did not fit):
-    /// a frame that changed nothing does not emit again.
-    stale: bool,
     /// Frame-to-frame coherence, as the vertex cut has it (`crate::cut::steady`): the anchor
     /// frame, and per wavelet whether its answer provably holds while the anchor does
     /// (`settled`: a member with nothing to do, or a candidate the policy does not want) and,
@@ -257,7 +278,22 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
             vertices: 0,
             ids: Arena::new(0),
             positions: [[0.0; 3]; V],
+            uses: [0; V],
+            link: [I::ZERO; V],
+            free: 0,
+            freed: 0,
+            pending: 0,
             tris: Arena::new([I::ZERO; 3]),
+            owner: [I::ZERO; T],
+            prev: [I::ZERO; T],
+            next: [I::ZERO; T],
+            spare: 0,
+            head: [I::ZERO; T],
+            tile_level: 0,
+            tiles: 0,
+            dirty: Arena::new((0, 0)),
+            built: false,
+            whole: false,
             map: NodeMap::new(),
             heap: Arena::new((0, 0)),
             threshold: 0.0,
@@ -267,7 +303,6 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
             geomorph_frames: 0,
             previous: View::ZERO,
             has_previous: false,
-            stale: false,
             steady: Steady::ZERO,
             settled: [0; WORDS],
             quiet: [0; WORDS],
@@ -326,6 +361,9 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         self.triangles = c.base_faces;
         self.vertices = c.base_vertices;
         self.threshold = 1.0;
+        self.tile_level = Self::tile_level_for(c.base_faces, c.levels);
+        self.tiles = c.base_faces << (2 * self.tile_level);
+        self.built = false;
         // The base mesh fits, so emitting it cannot fail.
         let _complete = self.emit(s);
         debug_assert!(_complete);
@@ -380,13 +418,22 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         self.tris.as_slice()
     }
 
-    /// Emitted vertices.
+    /// Vertex slots in use or freed: the triangles index below this. A freed slot (a hole
+    /// left for a later vertex, so that the others keep their slots) has id `u32::MAX`; holes
+    /// stay fewer than half the live vertices.
     #[must_use]
     pub fn vertex_count(&self) -> usize {
         self.ids.len()
     }
 
-    /// The mesh vertex id of vertex slot `i` (see [`super::format`]; `u32::MAX` out of range).
+    /// Vertex slots the triangles use (the mesh's vertices).
+    #[must_use]
+    pub fn live_vertices(&self) -> usize {
+        self.ids.len() - self.freed as usize
+    }
+
+    /// The mesh vertex id of vertex slot `i` (see [`super::format`]; `u32::MAX` out of range
+    /// and for a freed slot).
     #[must_use]
     pub fn vertex_id(&self, i: usize) -> u32 {
         self.ids.as_slice().get(i).copied().unwrap_or(NIL)
@@ -470,39 +517,26 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         has(&self.present, self.base_vertices, self.wavelets, id)
     }
 
-    /// The points whose presence can change when wavelet `p` (at `level`) comes or goes: the
-    /// edge midpoints of the two triangles around its parent edge (`p` among them), each once.
-    fn neighbourhood(
-        s: &SemiRegularView<'_>,
-        p: Point,
-        level: u32,
-    ) -> ([Option<(u32, Point)>; 5], usize) {
+    /// Adds or removes wavelet `p` (vertex `id`, at `level`), updates the counts and marks
+    /// what the emitted mesh must change. The points whose presence can change are the edge
+    /// midpoints of the two triangles around its parent edge (`p` first).
+    fn toggle(&mut self, s: &SemiRegularView<'_>, id: u32, p: Point, level: u32) {
         let [x, y] = s.parent_edge(p, level);
         let (l, r) = (x.left_of(y), x.right_of(y));
-        let mut out = [None; 5];
-        let mut n = 0;
-        for m in [p, y.mid(l), l.mid(x), x.mid(r), r.mid(y)] {
-            let Some(q) = s.canonical(m) else { continue };
-            let Some(id) = s.vertex_id(q) else { continue };
-            if out[..n].iter().all(|o| o.is_none_or(|(k, _)| k != id)) {
-                out[n] = Some((id, q));
-                n += 1;
-            }
-        }
-        (out, n)
-    }
-
-    /// Adds or removes wavelet `p` (vertex `id`, at `level`) and updates the counts.
-    fn toggle(&mut self, s: &SemiRegularView<'_>, id: u32, p: Point, level: u32) {
-        let (around, n) = Self::neighbourhood(s, p, level);
         self.flip(id);
-        self.stale = true;
         self.unsettle(s, id, p, level);
-        for &(vid, q) in around[..n].iter().flatten() {
+        let mut changed = [NIL; 5];
+        for (k, m) in [p, y.mid(l), l.mid(x), x.mid(r), r.mid(y)]
+            .into_iter()
+            .enumerate()
+        {
+            let Some(q) = s.canonical(m) else { continue };
+            let Some(vid) = s.vertex_id(q) else { continue };
             let (now, sides) = self.presence(s, q, s.level(q));
             if now == self.is_present(vid) {
                 continue;
             }
+            changed[k] = vid;
             let w = vid.wrapping_sub(self.base_vertices) as usize;
             if let Some(word) = self.present.get_mut(w / 32) {
                 *word ^= 1 << (w % 32);
@@ -515,6 +549,8 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
                 self.triangles = self.triangles.saturating_sub(sides);
             }
         }
+        // An edge whose midpoint appeared or vanished changes the triangle across it.
+        self.mark_wavelet(s, p, level, &changed);
     }
 
     /// Whether any child of wavelet `p` (at `level`) is in the mesh (with `staying`, only
@@ -608,10 +644,23 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         self.steady.set_on(on);
     }
 
+    /// Whether a frame emits again only the tiles its changes touch (on by default) or, in
+    /// any frame that changes anything, the whole mesh. The triangles and positions are the
+    /// same either way, in another order; only the time differs.
+    pub fn set_partial_emission(&mut self, on: bool) {
+        self.whole = !on;
+    }
+
     /// Starts (or turns around) wavelet `id`'s geomorph towards leaving or towards staying,
     /// from where it is, over the set number of frames (`frames` 0: at once); `false` when the
     /// arena is full.
-    fn start_morph(&mut self, id: u32, leaving: bool, frames: u16) -> bool {
+    fn start_morph(
+        &mut self,
+        s: &SemiRegularView<'_>,
+        id: u32,
+        leaving: bool,
+        frames: u16,
+    ) -> bool {
         let n = frames.max(1) as f32;
         let at = self.morph_at(id);
         let mut weight = match at {
@@ -634,7 +683,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
             step,
             leaving,
         };
-        self.stale = true;
+        self.mark_blend(s, id);
         match at {
             Ok(i) => self.morphs.as_mut_slice()[i] = morph,
             Err(_) => {
@@ -650,26 +699,29 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
     }
 
     /// Ends wavelet `id`'s geomorph, if any.
-    fn end_morph(&mut self, id: u32) {
+    fn end_morph(&mut self, s: &SemiRegularView<'_>, id: u32) {
         if let Ok(i) = self.morph_at(id) {
             self.morphs.as_mut_slice()[i..].rotate_left(1);
             self.morphs.pop();
             self.set_morphing(id, false);
-            self.stale = true;
+            self.mark_blend(s, id);
         }
     }
 
     /// One frame of every geomorph: weights move; joined wavelets stop blending.
-    fn advance_morphs(&mut self) {
-        self.stale |= self.morphs.len() > 0;
+    fn advance_morphs(&mut self, s: &SemiRegularView<'_>) {
         let mut i = 0;
         while i < self.morphs.len() {
             let m = &mut self.morphs.as_mut_slice()[i];
+            let was = m.weight;
             m.weight = (m.weight + m.step).clamp(0.0, 1.0);
+            let (id, moved) = (m.id, m.weight != was);
             if !m.leaving && m.weight >= 1.0 {
-                let id = m.id;
-                self.end_morph(id);
+                self.end_morph(s, id);
             } else {
+                if moved {
+                    self.mark_blend(s, id);
+                }
                 i += 1;
             }
         }
@@ -693,7 +745,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
                     if let Some(p) = s.point(m.id) {
                         self.toggle(s, m.id, p, s.level(p));
                     }
-                    self.end_morph(m.id);
+                    self.end_morph(s, m.id);
                     done = true;
                 } else {
                     i += 1;
@@ -733,7 +785,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         let max_triangles = budget.max_triangles.min(T as u32);
         let max_vertices = (V.min(self.map.capacity()) as u32).max(self.base_vertices);
         let mut ops = 0u32;
-        self.advance_morphs();
+        self.advance_morphs(s);
         self.finish_leaving(s);
 
         // Settled wavelets are skipped while the anchor holds; an anchor frame marks them anew.
@@ -796,7 +848,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
                 if leaving {
                     if wanted {
                         // Wanted back: it turns around where it is.
-                        self.start_morph(id, false, self.geomorph_frames);
+                        self.start_morph(s, id, false, self.geomorph_frames);
                     }
                     continue;
                 }
@@ -811,12 +863,12 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
                 let frames = if d.visible { self.geomorph_frames } else { 0 };
                 // Leaving changes what its parents have to do.
                 self.unsettle(s, id, p, level);
-                if (frames == 0 && !children) || !self.start_morph(id, true, frames) {
+                if (frames == 0 && !children) || !self.start_morph(s, id, true, frames) {
                     if children {
                         stats.blend_limited = true;
                         continue;
                     }
-                    self.end_morph(id);
+                    self.end_morph(s, id);
                     self.toggle(s, id, p, level);
                 }
                 ops += 1;
@@ -893,7 +945,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
             if self.geomorph_frames > 0
                 && self.has_previous
                 && policy.demand(&s.bounds_at(p, id), &self.previous).visible
-                && !self.start_morph(id, false, self.geomorph_frames)
+                && !self.start_morph(s, id, false, self.geomorph_frames)
             {
                 stats.blend_limited = true;
             }
@@ -903,7 +955,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         }
         self.heap.clear();
 
-        if self.stale && !self.emit(s) {
+        if !self.emit(s) {
             stats.capacity_limited = true;
         }
         if anchor.is_some() {
@@ -915,7 +967,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         self.has_previous = true;
         self.threshold = budget.regulate(self.threshold, self.triangles);
         stats.triangles = self.tris.len() as u32;
-        stats.vertices = self.ids.len() as u32;
+        stats.vertices = self.live_vertices() as u32;
         stats.threshold = t;
         stats.blending = self.blending();
         stats.over_budget = stats.triangles > budget.max_triangles;
@@ -991,7 +1043,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
             if !self.includes(id) || self.any_child_in(s, p, level, false) {
                 continue;
             }
-            self.end_morph(id);
+            self.end_morph(s, id);
             self.toggle(s, id, p, level);
             stats.ecols += 1;
             stats.budget_ecols += 1;
@@ -1048,167 +1100,42 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         }
     }
 
-    /// Emits the triangles of the current set; `false` when an arena filled up (the mesh is
-    /// then incomplete, which the budget's admission prevents).
-    fn emit(&mut self, s: &SemiRegularView<'_>) -> bool {
-        self.ids.clear();
-        self.tris.clear();
-        self.map
-            .reset(NodeMap::<T, I>::span_for(self.vertices as usize));
-        let n = s.steps();
-        for f in 0..self.base_faces {
-            let p = [[n, 0, 0], [0, n, 0], [0, 0, n]].map(|w| Point { face: f, w });
-            let mut v = [0u32; 3];
-            for k in 0..3 {
-                match self.slot(s, p[k], [NIL; 2]) {
-                    Ok(x) => v[k] = x,
-                    Err(Full) => return false,
+    /// Whether each tile's list runs both ways through exactly the triangles of that tile, all
+    /// triangles are in one, and the lists of spare and pending slots are empty.
+    fn check_lists(&self) -> Result<(), WaveletDefect> {
+        let bad = |what| Err(WaveletDefect(what));
+        if self.spare != NIL || self.pending != NIL || self.tiles as usize > T {
+            return bad("a spare or pending list is left, or too many tiles");
+        }
+        let mut seen = 0usize;
+        for tile in 0..self.tiles as usize {
+            let mut x = self.head[tile].load();
+            let mut before = NIL;
+            while x != NIL {
+                let i = x as usize;
+                if i >= self.tris.len() || seen >= self.tris.len() {
+                    return bad("a tile's list leaves the triangles or runs in a loop");
                 }
-            }
-            if self.emit_triangle(s, p, v, 0).is_err() {
-                return false;
-            }
-        }
-        self.stale = false;
-        true
-    }
-
-    /// The vertex slot of point `p`, added if new: at its own position when it is a base vertex
-    /// or a member, else at the midpoint of the slots `ends` (its parent edge).
-    fn slot(&mut self, s: &SemiRegularView<'_>, p: Point, ends: [u32; 2]) -> Result<u32, Full> {
-        let id = s.canonical(p).and_then(|q| s.vertex_id(q)).ok_or(Full)?;
-        self.slot_of(s, (id, p), ends)
-    }
-
-    /// [`WaveletCut::slot`] of vertex `id` at point `p` (in any frame holding it).
-    fn slot_of(
-        &mut self,
-        s: &SemiRegularView<'_>,
-        (id, p): (u32, Point),
-        ends: [u32; 2],
-    ) -> Result<u32, Full> {
-        if let Some(slot) = self.map.get(id, self.ids.as_slice()) {
-            return Ok(slot);
-        }
-        let end = |k: usize| ends[k] as usize;
-        let ends_moved = ends[0] != NIL && (self.moved[end(0)] || self.moved[end(1)]);
-        let at_own =
-            id < self.base_vertices || (self.includes(id) && !ends_moved && !self.morphing_bit(id));
-        let (position, moved) = if at_own {
-            (s.position_at(p, id), false)
-        } else {
-            // rho_t at this vertex: the midpoint of its parent edge as drawn, plus its
-            // coefficient (its own position minus its parent edge's midpoint) scaled by its
-            // weight (0 when it is not in the mesh).
-            let a = self.position(end(0));
-            let b = self.position(end(1));
-            let w = if self.includes(id) {
-                self.weight(id)
-            } else {
-                0.0
-            };
-            let mut at = [0, 1, 2].map(|k| (a[k] + b[k]) * 0.5);
-            if w > 0.0 {
-                let (own, x, y) = (
-                    s.position_at(p, id),
-                    s.position(self.vertex_id(end(0))),
-                    s.position(self.vertex_id(end(1))),
-                );
-                for k in 0..3 {
-                    at[k] += w * (own[k] - (x[k] + y[k]) * 0.5);
+                if self.owner[i].index() != tile || self.prev[i].load() != before {
+                    return bad("a tile's list holds a triangle of another tile or runs wrong");
                 }
+                seen += 1;
+                before = x;
+                x = self.next[i].load();
             }
-            (at, true)
-        };
-        let slot = self.ids.push(id).map_err(|_| Full)?;
-        self.positions[slot as usize] = position;
-        self.moved[slot as usize] = moved;
-        if !self.map.insert(slot, self.ids.as_slice()) {
-            return Err(Full);
         }
-        Ok(slot)
-    }
-
-    /// Emits the triangle `p` (vertex slots `v`) of level `level`: its four children when it
-    /// is subdivided, else itself, cut where its neighbours are finer.
-    fn emit_triangle(
-        &mut self,
-        s: &SemiRegularView<'_>,
-        p: [Point; 3],
-        v: [u32; 3],
-        level: u32,
-    ) -> Result<(), Full> {
-        if level >= self.levels {
-            return self.emit_piece(s, p, v, [level; 3]);
+        if seen != self.tris.len() {
+            return bad("a triangle is in no tile's list");
         }
-        // The midpoints are inside this triangle's face: their ids need no unfolding.
-        let m = [p[0].mid(p[1]), p[1].mid(p[2]), p[2].mid(p[0])];
-        let ids = m.map(|q| s.vertex_id(q));
-        if !ids.iter().any(|&id| id.is_some_and(|id| self.includes(id))) {
-            return self.emit_piece(s, p, v, [level; 3]);
-        }
-        let mut mv = [0; 3];
-        for k in 0..3 {
-            let id = ids[k].ok_or(Full)?;
-            mv[k] = self.slot_of(s, (id, m[k]), [v[k], v[(k + 1) % 3]])?;
-        }
-        let next = level + 1;
-        self.emit_triangle(s, [p[0], m[0], m[2]], [v[0], mv[0], mv[2]], next)?;
-        self.emit_triangle(s, [m[0], p[1], m[1]], [mv[0], v[1], mv[1]], next)?;
-        self.emit_triangle(s, [m[2], m[1], p[2]], [mv[2], mv[1], v[2]], next)?;
-        self.emit_triangle(s, [m[0], m[1], m[2]], mv, next)
-    }
-
-    /// Emits a piece of a leaf triangle whose edges are at `levels` (edge `k` from corner `k`;
-    /// [`INSIDE`] for a cut inside the leaf): halved at the midpoint of the first edge whose
-    /// neighbour across is subdivided (the paper's T-vertex removal, Fig. 7), else as it is.
-    fn emit_piece(
-        &mut self,
-        s: &SemiRegularView<'_>,
-        p: [Point; 3],
-        v: [u32; 3],
-        levels: [u32; 3],
-    ) -> Result<(), Full> {
-        for i in 0..3 {
-            let (j, k) = ((i + 1) % 3, (i + 2) % 3);
-            if levels[i] >= self.levels {
-                continue;
-            }
-            let (a, b) = (p[i], p[j]);
-            // The leaf is not subdivided, so the midpoint of this edge is a vertex of the mesh
-            // exactly when the triangle across is subdivided.
-            let m = a.mid(b);
-            let Some(mid) = s.canonical(m).and_then(|q| s.vertex_id(q)) else {
-                continue;
-            };
-            if !self.is_present(mid) {
-                continue;
-            }
-            let mv = self.slot_of(s, (mid, m), [v[i], v[j]])?;
-            let finer = levels[i] + 1;
-            self.emit_piece(
-                s,
-                [a, m, p[k]],
-                [v[i], mv, v[k]],
-                [finer, INSIDE, levels[k]],
-            )?;
-            return self.emit_piece(
-                s,
-                [m, b, p[k]],
-                [mv, v[j], v[k]],
-                [finer, levels[j], INSIDE],
-            );
-        }
-        self.tris
-            .push([I::store(v[0]), I::store(v[1]), I::store(v[2])])
-            .map_err(|_| Full)?;
         Ok(())
     }
 
     /// Checks the invariants: every member's parents are members, the kept counts are the
-    /// emitted ones, no triangle repeats a vertex, no edge is run the same way twice or shared
-    /// by more than two triangles, and on a mesh without border (`closed`) every edge is shared
-    /// by exactly two. `scratch` needs three entries per triangle.
+    /// emitted ones, every tile lists exactly its triangles, every vertex slot's use count is
+    /// the number of triangle corners in it (none in a freed slot, and no live slot unused),
+    /// no triangle repeats a vertex, no edge is run the same way twice or shared by more than
+    /// two triangles, and on a mesh without border (`closed`) every edge is shared by exactly
+    /// two. `scratch` needs three entries per triangle.
     pub fn check(
         &self,
         s: &SemiRegularView<'_>,
@@ -1234,13 +1161,39 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
                 return Err(WaveletDefect("a kept presence bit is wrong"));
             }
         }
-        if self.tris.len() as u32 != self.triangles || self.ids.len() as u32 != self.vertices {
+        if self.tris.len() as u32 != self.triangles || self.live_vertices() as u32 != self.vertices
+        {
             return Err(WaveletDefect("the kept counts are not the emitted mesh's"));
         }
+        self.check_lists()?;
         let tris = self.tris.as_slice();
         let edges = scratch
             .get_mut(..3 * tris.len())
             .ok_or(WaveletDefect("scratch too small"))?;
+        // Corners sorted by slot: each slot's run is its uses.
+        for (t, e) in tris.iter().zip(edges.chunks_exact_mut(3)) {
+            for k in 0..3 {
+                e[k] = [t[k].load(), 0];
+            }
+        }
+        edges.sort_unstable();
+        let mut run = 0;
+        for slot in 0..self.ids.len() {
+            let mut count = 0u32;
+            while run < edges.len() && edges[run][0] as usize == slot {
+                count += 1;
+                run += 1;
+            }
+            let freed = self.ids.as_slice()[slot] == NIL;
+            if u32::from(self.uses[slot]) != count || (freed != (count == 0)) {
+                return Err(WaveletDefect(
+                    "a vertex slot's use count is not its triangles'",
+                ));
+            }
+        }
+        if run != edges.len() {
+            return Err(WaveletDefect("a triangle's corner is not a vertex slot"));
+        }
         for (t, e) in tris.iter().zip(edges.chunks_exact_mut(3)) {
             let v = t.map(|x| x.load());
             if v[0] == v[1] || v[1] == v[2] || v[0] == v[2] {

@@ -130,8 +130,16 @@ impl SemiRegularView<'_> {
     #[inline]
     #[must_use]
     pub fn canonical(&self, p: Point) -> Option<Point> {
+        self.canonical_scaled(p, self.n)
+    }
+
+    /// [`SemiRegularView::canonical`] of weights that sum to `total` rather than `N` (the
+    /// unfolding is linear): three times a triangle's centroid names the triangle.
+    #[inline]
+    #[must_use]
+    pub(super) fn canonical_scaled(&self, p: Point, total: i32) -> Option<Point> {
         let w = p.w;
-        if w[0].checked_add(w[1])?.checked_add(w[2])? != self.n {
+        if w[0].checked_add(w[1])?.checked_add(w[2])? != total {
             return None;
         }
         if w[0] >= 0 && w[1] >= 0 && w[2] >= 0 {
