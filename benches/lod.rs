@@ -27,10 +27,11 @@
 //!
 //! 7. **Settled vertices** skipped or asked (`Cut::set_settling`), without and with geomorphs.
 //!
-//! 8. **The wavelet engine's coherence**: settled wavelets skipped or asked
-//!    (`WaveletCut::set_settling`) over the wavelet paper's session on the subdivided cow
-//!    (`reproduce fig9`'s, at 90 and at 720 frames, 0.5 / 3.5 px), interleaved frame by frame,
-//!    and a frame whose view has not moved.
+//! 8. **The wavelet engine's coherence**: the cut as it is against one that asks settled
+//!    wavelets (`WaveletCut::set_settling`) and one that emits the whole mesh in every frame
+//!    that changes (`WaveletCut::set_partial_emission`), over the wavelet paper's session on the
+//!    subdivided cow (`reproduce fig9`'s, at 90 and at 720 frames, 0.5 / 3.5 px, without and
+//!    with geomorphs), interleaved frame by frame, and a frame whose view has not moved.
 //!
 //! 9. **Amortized traversal** ([`Budget::max_visits`], the LOD lecture's "distribute traversing
 //!    the tree over frames"): the bunny over the peer orbit at 0.5 / 1 / 2 px with all the
@@ -521,8 +522,9 @@ fn amortized(h: &HierarchyView<'_>, mesh: &IndexedMesh) {
     }
 }
 
-/// The wavelet cut with settled wavelets skipped or asked, interleaved frame by frame over the
-/// session of `reproduce fig9` on the subdivided cow; then the same view twice in a row.
+/// The wavelet cut as it is, with settled wavelets asked, and with the whole mesh emitted in
+/// every frame that changes, interleaved frame by frame over the session of `reproduce fig9` on
+/// the subdivided cow (without and with geomorphs); then the same view twice in a row.
 fn wavelets() {
     use vdlod_core::wavelet::SemiRegularView;
     use vdlod_demo::wavelet::{cow_loop, finest_mesh, session, DemoWaveletCut};
@@ -539,20 +541,25 @@ fn wavelets() {
             interior: 3.5,
         },
     };
-    println!("| session | skipped: median us | asked: median us | ratio | wavelets skipped per frame | the same view again, skipped / asked: median us |");
-    println!("|---|---|---|---|---|---|");
-    for frames in [90u32, 720] {
+    println!("| session | geomorph frames | as it is: median us | settled asked | ratio | whole mesh emitted | ratio | wavelets skipped per frame | the same view again, as it is / settled asked: median us |");
+    println!("|---|---|---|---|---|---|---|---|---|");
+    for (frames, morphs) in [(90u32, 0u16), (720, 0), (90, 8), (720, 8)] {
         let cameras = session(b.center(), b.radius(), frames, 512, 512);
         // Each frame's view once, then (other cuts) each view twice in a row.
-        let mut moving = Vec::new();
-        let mut still = Vec::new();
+        let mut rows = Vec::new();
         for twice in [false, true] {
-            let mut cuts = [DemoWaveletCut::boxed(), DemoWaveletCut::boxed()];
+            let mut cuts = [
+                DemoWaveletCut::boxed(),
+                DemoWaveletCut::boxed(),
+                DemoWaveletCut::boxed(),
+            ];
             for cut in &mut cuts {
                 cut.reset(&s).expect("fits");
+                cut.set_geomorph_frames(morphs);
             }
             cuts[1].set_settling(false);
-            let (mut times, mut skipped) = ([Vec::new(), Vec::new()], 0.0);
+            cuts[2].set_partial_emission(false);
+            let (mut times, mut skipped) = ([Vec::new(), Vec::new(), Vec::new()], 0.0);
             for _ in 0..2 {
                 for camera in &cameras {
                     let view = camera.view();
@@ -569,18 +576,14 @@ fn wavelets() {
                     }
                 }
             }
-            let [on, off] = times;
-            let row = (median(on), median(off), skipped / (2 * frames) as f64);
-            if twice {
-                still.push(row);
-            } else {
-                moving.push(row);
-            }
+            let [us, asked, whole] = times.map(median);
+            rows.push((us, asked, whole, skipped / (2 * frames) as f64));
         }
-        let ((on, off, skipped), (still_on, still_off, _)) = (moving[0], still[0]);
+        let ((us, asked, whole, skipped), (still, still_asked, _, _)) = (rows[0], rows[1]);
         println!(
-            "| {frames} frames | {on:.0} | {off:.0} | {:.2}x | {skipped:.0} | {still_on:.0} / {still_off:.0} |",
-            on / off,
+            "| {frames} frames | {morphs} | {us:.0} | {asked:.0} | {:.2}x | {whole:.0} | {:.2}x | {skipped:.0} | {still:.0} / {still_asked:.0} |",
+            us / asked,
+            us / whole,
         );
     }
 }

@@ -53,7 +53,7 @@ use crate::nodemap::NodeMap;
 use crate::policy::{dot, sub, Bounds, Demand, Policy, View};
 
 use super::format::SemiRegularView;
-use super::lattice::Point;
+use super::lattice::{Point, DIRECTIONS};
 
 mod emit;
 
@@ -560,23 +560,6 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
             s.vertex_id(c)
                 .is_some_and(|id| self.includes(id) && !(staying && self.leaving(id)))
         })
-    }
-
-    /// Whether every parent of wavelet `p` (at `level`) is in the mesh and not leaving, and
-    /// `from` (when not [`NIL`]) is the one with the smallest id (so that a sweep over the
-    /// members looks at a wavelet with two parents once).
-    fn joinable_from(&self, s: &SemiRegularView<'_>, p: Point, level: u32, from: u32) -> bool {
-        let parents = s.parents(p, level);
-        let mut first = NIL;
-        for q in parents {
-            if q != NIL {
-                if !self.includes(q) || self.leaving(q) {
-                    return false;
-                }
-                first = first.min(q);
-            }
-        }
-        from == NIL || first == from
     }
 
     /// Geomorphs last `frames` frames (0, the default: none). Wavelets that join or leave
@@ -1091,12 +1074,31 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
     ) {
         let Some(p) = s.point(id) else { return };
         let level = s.level(p);
-        for c in s.children(p, level).into_iter().flatten() {
+        if level >= self.levels || self.leaving(id) {
+            return;
+        }
+        // Child `p + h d` has the parent edge from `p` to `q = p + 2h d`: its parents are `p`
+        // and `q` when `q` is of `p`'s level (as `joinable_from` finds, without unfolding the
+        // child's frame again).
+        let h = s.step_of(level + 1);
+        for d in DIRECTIONS {
+            let Some(c) = s.canonical(p.offset(d, h)) else {
+                continue;
+            };
             let Some(cid) = s.vertex_id(c) else { continue };
-            let from = if sweep { id } else { NIL };
-            if !self.includes(cid) && self.joinable_from(s, c, level + 1, from) {
-                self.offer(s, (cid, c), view, policy, t, stats);
+            if self.includes(cid) {
+                continue;
             }
+            let Some(q) = s.canonical(p.offset(d, 2 * h)) else {
+                continue;
+            };
+            if s.level(q) == level {
+                let Some(qid) = s.vertex_id(q) else { continue };
+                if !self.includes(qid) || self.leaving(qid) || (sweep && qid < id) {
+                    continue;
+                }
+            }
+            self.offer(s, (cid, c), view, policy, t, stats);
         }
     }
 

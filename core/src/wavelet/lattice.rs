@@ -139,11 +139,20 @@ impl SemiRegularView<'_> {
     #[must_use]
     pub(super) fn canonical_scaled(&self, p: Point, total: i32) -> Option<Point> {
         let w = p.w;
+        let sum = i64::from(w[0]) + i64::from(w[1]) + i64::from(w[2]);
+        if w[0] >= 0 && w[1] >= 0 && w[2] >= 0 && sum == i64::from(total) {
+            return Some(p);
+        }
+        self.unfold(p, total)
+    }
+
+    /// [`SemiRegularView::canonical_scaled`] of a point outside its face's frame.
+    #[cold]
+    #[inline(never)]
+    fn unfold(&self, p: Point, total: i32) -> Option<Point> {
+        let w = p.w;
         if w[0].checked_add(w[1])?.checked_add(w[2])? != total {
             return None;
-        }
-        if w[0] >= 0 && w[1] >= 0 && w[2] >= 0 {
-            return Some(p);
         }
         for k in 0..3 {
             let opp = (k + 2) % 3;
