@@ -7,8 +7,9 @@
 //! in it leaves when the policy no longer wants it, and a wavelet both of whose parents are in
 //! `U_t` joins when the policy wants it, largest error first, so `U_t` always
 //! meets the closure condition (every ancestor of a member is a member). A frame's work is one
-//! pass over the members and their children, and a split or removal for each change; the
-//! triangles are emitted again only when a wavelet came or went or a geomorph ran.
+//! pass over the members and their children that the anchor below has not settled, a split or
+//! removal for each change, and the emission again of the tiles those changes touch (see
+//! the `emit` module: the mesh, its vertex slots and the triangles' order outlive the frame).
 //!
 //! Frame-to-frame coherence as the vertex cut has it (`crate::cut::steady`, on unless
 //! [`WaveletCut::set_settling`] turns it off): when the policy describes how its demand moves
@@ -19,7 +20,7 @@
 //! goes or starts leaving clears its own bits and its parents'. The frames are the same as
 //! asking every wavelet (a test flies both side by side).
 //!
-//! The triangles are then emitted as §3.6 describes: every base triangle is subdivided
+//! The triangles are emitted as §3.6 describes: every base triangle is subdivided
 //! recursively while one of its edge midpoints is in `U_t`; a triangle that is not, but whose
 //! neighbour across an edge is, is cut at that edge's midpoint, and each half is tested again, so
 //! no T-vertex is left and the mesh has no crack: for a closed input every edge is shared by two
@@ -39,11 +40,12 @@
 //! wavelet turned around mid-way starts from where it is.
 //!
 //! Memory (`Self::BYTES`, asserted in a test): five bits per wavelet (`20 WORDS`: in the set,
-//! a vertex of the emitted mesh, blending, settled, children quiet), 17 B per vertex slot (id,
-//! position, whether it is moved), 8 B per triangle slot (corners as `u16`, vertex map), 24 B
-//! per queue entry (a candidate and a geomorph), and under 512 B of counts, the previous view
-//! and the anchor frame. With `V = T / 2` (a closed mesh has about half as many vertices as
-//! triangles) and `Q = T / 8`, that is about 19.6 B per triangle of capacity beside the bits.
+//! a vertex of the emitted mesh, blending, settled, children quiet), 20 B per vertex slot (id,
+//! position, uses with two flags, a list link), 14 B per triangle slot (corners as `u16`, vertex
+//! map, tile, next in the tile's list, a tile's head), 28 B per queue entry (a candidate, a
+//! geomorph and a dirty run), and under 512 B of counts, list heads, the previous view and the
+//! anchor frame. With `V = T / 2` (a closed mesh has about half as many vertices as triangles)
+//! and `Q = T / 8`, that is about 27.6 B per triangle of capacity beside the bits.
 
 use crate::adapt::{Budget, FrameStats};
 use crate::cut::slot::{Arena, SlotIndex};
@@ -162,8 +164,9 @@ pub struct WaveletCut<
     /// The emitted mesh's counts, kept as wavelets come and go.
     triangles: u32,
     vertices: u32,
-    /// Per vertex slot: its vertex id (`NIL` when freed), position, uses by triangles (with
-    /// [`emit::PENDING`]) and link in the pending or free list (see [`emit`]).
+    /// Per vertex slot: its vertex id (`NIL` when freed), position, uses by triangles (with the
+    /// flags [`emit::PENDING`] and [`emit::MOVED`]) and link in the pending or free list (see
+    /// [`emit`]).
     ids: Arena<u32, V>,
     positions: [[f32; 3]; V],
     uses: [u16; V],
@@ -171,10 +174,9 @@ pub struct WaveletCut<
     free: u32,
     freed: u32,
     pending: u32,
-    /// Per triangle slot: its corners, its tile, and its neighbours in the tile's list.
+    /// Per triangle slot: its corners, its tile, and the next triangle in the tile's list.
     tris: Arena<[I; 3], T>,
     owner: [I; T],
-    prev: [I; T],
     next: [I; T],
     spare: u32,
     /// Per tile, its first triangle; the tiles' level and count (see [`emit`]).
@@ -183,7 +185,7 @@ pub struct WaveletCut<
     tiles: u32,
     /// Runs of tiles to emit again (first tile, tiles), and whether the mesh emitted is the
     /// set's apart from them (`false`: emit it all).
-    dirty: Arena<(u32, u32), Q>,
+    dirty: Arena<u32, Q>,
     built: bool,
     /// Whether a frame that changes anything emits the whole mesh (see
     /// [`WaveletCut::set_partial_emission`]).
@@ -194,9 +196,6 @@ pub struct WaveletCut<
     /// Running geomorphs, sorted by wavelet vertex id, and their wavelets as bits.
     morphs: Arena<Morph, Q>,
     morphing: [u32; WORDS],
-    /// Whether a vertex slot sits elsewhere than its own position because a geomorph moves it or
-    /// an end of its parent edge.
-    moved: [bool; V],
     geomorph_frames: u16,
     /// The previous frame's view (valid with `has_previous`).
     previous: View,
@@ -285,13 +284,12 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
             pending: 0,
             tris: Arena::new([I::ZERO; 3]),
             owner: [I::ZERO; T],
-            prev: [I::ZERO; T],
             next: [I::ZERO; T],
             spare: 0,
             head: [I::ZERO; T],
             tile_level: 0,
             tiles: 0,
-            dirty: Arena::new((0, 0)),
+            dirty: Arena::new(0),
             built: false,
             whole: false,
             map: NodeMap::new(),
@@ -299,7 +297,6 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
             threshold: 0.0,
             morphs: Arena::new(Morph::ZERO),
             morphing: [0; WORDS],
-            moved: [false; V],
             geomorph_frames: 0,
             previous: View::ZERO,
             has_previous: false,
@@ -1102,8 +1099,8 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         }
     }
 
-    /// Whether each tile's list runs both ways through exactly the triangles of that tile, all
-    /// triangles are in one, and the lists of spare and pending slots are empty.
+    /// Whether each tile's list runs through exactly the triangles of that tile, all triangles
+    /// are in one, and the lists of spare and pending slots are empty.
     fn check_lists(&self) -> Result<(), WaveletDefect> {
         let bad = |what| Err(WaveletDefect(what));
         if self.spare != NIL || self.pending != NIL || self.tiles as usize > T {
@@ -1112,17 +1109,15 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         let mut seen = 0usize;
         for tile in 0..self.tiles as usize {
             let mut x = self.head[tile].load();
-            let mut before = NIL;
             while x != NIL {
                 let i = x as usize;
                 if i >= self.tris.len() || seen >= self.tris.len() {
                     return bad("a tile's list leaves the triangles or runs in a loop");
                 }
-                if self.owner[i].index() != tile || self.prev[i].load() != before {
-                    return bad("a tile's list holds a triangle of another tile or runs wrong");
+                if self.owner[i].index() != tile {
+                    return bad("a tile's list holds a triangle of another tile");
                 }
                 seen += 1;
-                before = x;
                 x = self.next[i].load();
             }
         }
@@ -1187,7 +1182,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
                 run += 1;
             }
             let freed = self.ids.as_slice()[slot] == NIL;
-            if u32::from(self.uses[slot]) != count || (freed != (count == 0)) {
+            if u32::from(self.uses[slot] & emit::USES) != count || (freed != (count == 0)) {
                 return Err(WaveletDefect(
                     "a vertex slot's use count is not its triangles'",
                 ));

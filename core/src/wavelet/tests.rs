@@ -289,20 +289,24 @@ fn geomorphs_blend_and_settle() {
 
 #[test]
 fn the_cut_costs_under_32_bytes_per_triangle_beside_its_bits() {
-    // With V = T / 2 and Q = T / 8: 16 B per triangle slot (corners, vertex map, tile and
-    // tile-list links, a tile's head), 21 per vertex slot (id, position, moved, uses, link),
-    // 32 per queue entry (candidate, geomorph, dirty run), 20 per word of bits (included,
-    // present, blending, settled, quiet), and under 512 B of counts, list heads, the previous
-    // view and the anchor frame.
+    // With V = T / 2 and Q = T / 8: 14 B per triangle slot (corners, vertex map, tile, next in
+    // the tile's list, a tile's head), 20 per vertex slot (id, position, uses and flags, list
+    // link), 28 per queue entry (candidate, geomorph, dirty run), 20 per word of bits
+    // (included, present, blending, settled, quiet), and under 512 B of counts, list heads, the
+    // previous view and the anchor frame.
     type C = WaveletCut<128, 5000, 2500, 625>;
-    let arenas = 5000 * 16 + 2500 * 21 + 625 * 32 + 128 * 20;
+    let arenas = 5000 * 14 + 2500 * 20 + 625 * 28 + 128 * 20;
     assert!(
         C::BYTES >= arenas && C::BYTES <= arenas + 512,
         "{}",
         C::BYTES
     );
     let per_triangle = (C::BYTES - 128 * 20) as f64 / 5000.0;
-    assert!(per_triangle <= 31.0, "{per_triangle}");
+    assert!(per_triangle <= 28.0, "{per_triangle}");
+    // With the bits of 32,768 wavelets (the engines experiment's cut), under 32 B in all.
+    type Engines = WaveletCut<1024, 5000, 2500, 625>;
+    let in_all = Engines::BYTES as f64 / 5000.0;
+    assert!(in_all <= 32.0, "{in_all}");
 }
 
 /// A bumpy open grid: 4 x 4 squares of two triangles, subdivided four times.

@@ -44,6 +44,17 @@ use super::{Full, WaveletCut, INSIDE};
 /// A slot's use count's flag: the slot is on the list of slots to free if still unused.
 pub(super) const PENDING: u16 = 0x8000;
 
+/// A slot's use count's flag: its position is not its own (a geomorph moves it or an end of its
+/// parent edge).
+pub(super) const MOVED: u16 = 0x4000;
+
+/// The use count under the flags.
+pub(super) const USES: u16 = MOVED - 1;
+
+/// The most tiles: a dirty run is its first tile and the base-4 logarithm of its length in one
+/// `u32`, four bits for the logarithm.
+const MAX_TILES: u64 = 1 << 28;
+
 /// `4^k` tiles under a lattice triangle `k` levels above the tiles.
 #[inline]
 fn tiles_under(k: u32) -> u32 {
@@ -112,7 +123,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
     /// finest, or coarser until the tiles fit the triangle arena.
     pub(super) fn tile_level_for(faces: u32, levels: u32) -> u32 {
         let mut d = levels.saturating_sub(2);
-        while d > 0 && u64::from(faces) << (2 * d) > T as u64 {
+        while d > 0 && u64::from(faces) << (2 * d) > (T as u64).min(MAX_TILES) {
             d -= 1;
         }
         d
@@ -140,23 +151,25 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
                 .iter()
                 .any(|&x| s.vertex_id(x).is_some_and(|id| self.includes(id)))
             {
-                return self.mark_run(at, 1);
+                return self.mark_run(at, 0);
             }
             let Some(c) = children(t, m).iter().position(|c| holds(c, q)) else {
-                return self.mark_run(at, 1);
+                return self.mark_run(at, 0);
             };
             at += c as u32 * tiles_under(d - l - 1);
             t = children(t, m)[c];
         }
-        self.mark_run(at, tiles_under(d.saturating_sub(level)));
+        self.mark_run(at, d.saturating_sub(level));
     }
 
-    /// Adds the run of `len` tiles from `first` to the dirty list (the whole mesh when full).
-    fn mark_run(&mut self, first: u32, len: u32) {
-        if self.dirty.last() == Some(&(first, len)) {
+    /// Adds the run of `4^up` tiles from `first` to the dirty list (the whole mesh when full),
+    /// as one number that sorts by first tile, then longest first.
+    fn mark_run(&mut self, first: u32, up: u32) {
+        let run = first << 4 | (15 - up.min(15));
+        if self.dirty.last() == Some(&run) {
             return;
         }
-        if self.dirty.push((first, len)).is_err() {
+        if self.dirty.push(run).is_err() {
             self.built = false;
         }
     }
@@ -219,11 +232,12 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         }
         // Runs are aligned subtrees: sorted by start, longest first, each is inside the one
         // kept before it or apart from it.
-        let dirty = self.dirty.as_mut_slice();
-        dirty.sort_unstable_by_key(|&(first, len)| (first, u32::MAX - len));
+        let run = |x: u32| (x >> 4, tiles_under(15 - (x & 15)));
+        self.dirty.as_mut_slice().sort_unstable();
         let mut covered = 0u64;
         let mut end = 0u32;
-        for &(first, len) in dirty.iter() {
+        for &x in self.dirty.as_slice() {
+            let (first, len) = run(x);
             if first >= end {
                 covered += u64::from(len);
                 end = first.saturating_add(len);
@@ -234,7 +248,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         }
         let mut end = 0u32;
         for i in 0..self.dirty.len() {
-            let (first, len) = self.dirty.as_slice()[i];
+            let (first, len) = run(self.dirty.as_slice()[i]);
             if first < end {
                 continue;
             }
@@ -340,10 +354,10 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
     /// One use fewer of vertex slot `v`; unused, it goes on the list of slots to free.
     fn unuse(&mut self, v: u32) {
         let i = v as usize;
-        let u = self.uses[i].saturating_sub(1);
-        self.uses[i] = u;
-        if u == 0 {
-            self.uses[i] = PENDING;
+        let u = self.uses[i];
+        self.uses[i] = if u & USES > 0 { u - 1 } else { u };
+        if u & (PENDING | USES) == 1 {
+            self.uses[i] |= PENDING;
             self.link[i] = I::store(self.pending);
             self.pending = v;
         }
@@ -357,7 +371,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
             let i = x as usize;
             let next = self.link[i].load();
             self.uses[i] &= !PENDING;
-            if self.uses[i] == 0 {
+            if self.uses[i] & USES == 0 {
                 let id = self.ids.as_slice()[i];
                 self.map.remove(id, self.ids.as_slice());
                 self.ids.as_mut_slice()[i] = NIL;
@@ -369,7 +383,8 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         }
     }
 
-    /// Closes the holes the spare triangle slots left by moving the last triangles into them.
+    /// Closes the holes the spare triangle slots left by moving the last triangles into them
+    /// (a moved triangle's tile list is walked to its predecessor: tiles are small).
     fn drop_spares(&mut self) {
         let mut x = self.spare;
         self.spare = NIL;
@@ -393,15 +408,21 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
     fn move_triangle(&mut self, from: usize, to: usize) {
         let t = self.tris.as_slice()[from];
         self.tris.as_mut_slice()[to] = t;
-        let (prev, next, owner) = (self.prev[from], self.next[from], self.owner[from]);
-        (self.prev[to], self.next[to], self.owner[to]) = (prev, next, owner);
+        let (next, owner) = (self.next[from], self.owner[from]);
+        (self.next[to], self.owner[to]) = (next, owner);
         let to_i = I::store(to as u32);
-        match prev.load() {
-            NIL => self.head[owner.index()] = to_i,
-            p => self.next[p as usize] = to_i,
-        }
-        if next.load() != NIL {
-            self.prev[next.index()] = to_i;
+        if let Some(h) = self.head.get_mut(owner.index()) {
+            if h.index() == from {
+                *h = to_i;
+            } else {
+                let mut x = h.index();
+                while x < self.tris.len() && self.next[x].index() != from {
+                    x = self.next[x].index();
+                }
+                if x < self.tris.len() {
+                    self.next[x] = to_i;
+                }
+            }
         }
         self.tris.pop();
     }
@@ -409,9 +430,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
     /// Adds triangle `v` to tile `tile`'s list.
     fn push_triangle(&mut self, v: [u32; 3], tile: u32) -> Result<(), Full> {
         let h = self.head.get(tile as usize).ok_or(Full)?.load();
-        if v.iter()
-            .any(|&c| self.uses[c as usize] & !PENDING >= PENDING - 1)
-        {
+        if v.iter().any(|&c| self.uses[c as usize] & USES == USES) {
             return Err(Full);
         }
         let t = [I::store(v[0]), I::store(v[1]), I::store(v[2])];
@@ -427,10 +446,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
             self.uses[c as usize] += 1;
         }
         let i = slot as usize;
-        (self.owner[i], self.prev[i], self.next[i]) = (I::store(tile), I::store(NIL), I::store(h));
-        if h != NIL {
-            self.prev[h as usize] = I::store(slot);
-        }
+        (self.owner[i], self.next[i]) = (I::store(tile), I::store(h));
         self.head[tile as usize] = I::store(slot);
         Ok(())
     }
@@ -451,7 +467,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         ends: [u32; 2],
     ) -> Result<u32, Full> {
         let end = |k: usize| ends[k] as usize;
-        let ends_moved = ends[0] != NIL && (self.moved[end(0)] || self.moved[end(1)]);
+        let ends_moved = ends[0] != NIL && (self.uses[end(0)] | self.uses[end(1)]) & MOVED != 0;
         let at_own =
             id < self.base_vertices || (self.includes(id) && !ends_moved && !self.morphing_bit(id));
         let (position, moved) = if at_own {
@@ -484,8 +500,9 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
             Some(slot) => slot,
             None => self.new_slot(id)?,
         };
-        self.positions[slot as usize] = position;
-        self.moved[slot as usize] = moved;
+        let i = slot as usize;
+        self.positions[i] = position;
+        self.uses[i] = self.uses[i] & !MOVED | if moved { MOVED } else { 0 };
         Ok(slot)
     }
 
