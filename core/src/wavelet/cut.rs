@@ -41,11 +41,12 @@
 //!
 //! Memory (`Self::BYTES`, asserted in a test): five bits per wavelet (`20 WORDS`: in the set,
 //! a vertex of the emitted mesh, blending, settled, children quiet), 20 B per vertex slot (id,
-//! position, uses with two flags, a list link), 14 B per triangle slot (corners as `u16`, vertex
-//! map, tile, next in the tile's list, a tile's head), 28 B per queue entry (a candidate, a
-//! geomorph and a dirty run), and under 512 B of counts, list heads, the previous view and the
-//! anchor frame. With `V = T / 2` (a closed mesh has about half as many vertices as triangles)
-//! and `Q = T / 8`, that is about 27.6 B per triangle of capacity beside the bits.
+//! position, uses with two flags, a list link), 12 B per triangle slot (corners as `u16`, vertex
+//! map, tile, next in the tile's list), 30 B per queue entry (a candidate, a geomorph, a dirty
+//! run and a tile's head: a tile per queue entry at most), and under 512 B of counts, list
+//! heads, the previous view and the anchor frame. With `V = T / 2` (a closed mesh has about
+//! half as many vertices as triangles) and `Q = T / 8`, that is about 25.8 B per triangle of
+//! capacity beside the bits.
 
 use crate::adapt::{Budget, FrameStats};
 use crate::cut::slot::{Arena, SlotIndex};
@@ -69,6 +70,14 @@ pub enum WaveletCutError {
         /// Bits of the cut.
         bits: u32,
     },
+    /// The base mesh has more faces than the cut has tiles (one per queue entry: at least
+    /// one per base face).
+    Tiles {
+        /// Base triangles.
+        faces: u32,
+        /// Tiles of the cut.
+        tiles: u32,
+    },
     /// The base mesh alone does not fit the arenas.
     Capacity {
         /// Base vertices.
@@ -84,6 +93,10 @@ impl core::fmt::Display for WaveletCutError {
             Self::Bits { wavelets, bits } => write!(
                 f,
                 "the mesh has {wavelets} wavelets, the cut holds {bits} bits (raise WORDS)"
+            ),
+            Self::Tiles { faces, tiles } => write!(
+                f,
+                "the base mesh has {faces} faces, the cut {tiles} tiles (one per queue entry: raise Q)"
             ),
             Self::Capacity {
                 vertices,
@@ -176,11 +189,11 @@ pub struct WaveletCut<
     pending: u32,
     /// Per triangle slot: its corners, its tile, and the next triangle in the tile's list.
     tris: Arena<[I; 3], T>,
-    owner: [I; T],
+    owner: [u16; T],
     next: [I; T],
     spare: u32,
     /// Per tile, its first triangle; the tiles' level and count (see [`emit`]).
-    head: [I; T],
+    head: [I; Q],
     tile_level: u32,
     tiles: u32,
     /// Runs of tiles to emit again (first tile, tiles), and whether the mesh emitted is the
@@ -283,10 +296,10 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
             freed: 0,
             pending: 0,
             tris: Arena::new([I::ZERO; 3]),
-            owner: [I::ZERO; T],
+            owner: [0; T],
             next: [I::ZERO; T],
             spare: 0,
-            head: [I::ZERO; T],
+            head: [I::ZERO; Q],
             tile_level: 0,
             tiles: 0,
             dirty: Arena::new(0),
@@ -343,6 +356,11 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
                 triangles: c.base_faces,
             });
         }
+        let tile_level =
+            Self::tile_level_for(c.base_faces, c.levels).ok_or(WaveletCutError::Tiles {
+                faces: c.base_faces,
+                tiles: Self::TILES,
+            })?;
         self.included.iter_mut().for_each(|w| *w = 0);
         self.present.iter_mut().for_each(|w| *w = 0);
         self.morphing.iter_mut().for_each(|w| *w = 0);
@@ -358,7 +376,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         self.triangles = c.base_faces;
         self.vertices = c.base_vertices;
         self.threshold = 1.0;
-        self.tile_level = Self::tile_level_for(c.base_faces, c.levels);
+        self.tile_level = tile_level;
         self.tiles = c.base_faces << (2 * self.tile_level);
         self.built = false;
         // The base mesh fits, so emitting it cannot fail.
@@ -1103,7 +1121,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
     /// are in one, and the lists of spare and pending slots are empty.
     fn check_lists(&self) -> Result<(), WaveletDefect> {
         let bad = |what| Err(WaveletDefect(what));
-        if self.spare != NIL || self.pending != NIL || self.tiles as usize > T {
+        if self.spare != NIL || self.pending != NIL || self.tiles > Self::TILES {
             return bad("a spare or pending list is left, or too many tiles");
         }
         let mut seen = 0usize;
@@ -1114,7 +1132,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
                 if i >= self.tris.len() || seen >= self.tris.len() {
                     return bad("a tile's list leaves the triangles or runs in a loop");
                 }
-                if self.owner[i].index() != tile {
+                if usize::from(self.owner[i]) != tile {
                     return bad("a tile's list holds a triangle of another tile");
                 }
                 seen += 1;

@@ -289,24 +289,37 @@ fn geomorphs_blend_and_settle() {
 
 #[test]
 fn the_cut_costs_under_32_bytes_per_triangle_beside_its_bits() {
-    // With V = T / 2 and Q = T / 8: 14 B per triangle slot (corners, vertex map, tile, next in
-    // the tile's list, a tile's head), 20 per vertex slot (id, position, uses and flags, list
-    // link), 28 per queue entry (candidate, geomorph, dirty run), 20 per word of bits
+    // With V = T / 2 and Q = T / 8: 12 B per triangle slot (corners, vertex map, tile, next in
+    // the tile's list), 20 per vertex slot (id, position, uses and flags, list link), 30 per
+    // queue entry (candidate, geomorph, dirty run, a tile's head), 20 per word of bits
     // (included, present, blending, settled, quiet), and under 512 B of counts, list heads, the
     // previous view and the anchor frame.
     type C = WaveletCut<128, 5000, 2500, 625>;
-    let arenas = 5000 * 14 + 2500 * 20 + 625 * 28 + 128 * 20;
+    let arenas = 5000 * 12 + 2500 * 20 + 625 * 30 + 128 * 20;
     assert!(
         C::BYTES >= arenas && C::BYTES <= arenas + 512,
         "{}",
         C::BYTES
     );
     let per_triangle = (C::BYTES - 128 * 20) as f64 / 5000.0;
-    assert!(per_triangle <= 28.0, "{per_triangle}");
+    assert!(per_triangle <= 26.0, "{per_triangle}");
     // With the bits of 32,768 wavelets (the engines experiment's cut), under 32 B in all.
     type Engines = WaveletCut<1024, 5000, 2500, 625>;
     let in_all = Engines::BYTES as f64 / 5000.0;
     assert!(in_all <= 32.0, "{in_all}");
+}
+
+#[test]
+fn a_cut_needs_a_tile_per_base_face() {
+    let bytes = sphere(2);
+    let s = SemiRegularView::parse(&bytes).unwrap();
+    let mut small = WaveletCut::<16, 1024, 600, 4>::boxed();
+    let err = small.reset(&s).unwrap_err();
+    assert_eq!(err, super::WaveletCutError::Tiles { faces: 8, tiles: 4 });
+    assert!(alloc::format!("{err}").contains("raise Q"), "{err}");
+    let mut enough = WaveletCut::<16, 1024, 600, 8>::boxed();
+    enough.reset(&s).unwrap();
+    assert_eq!(enough.triangles().len(), 8);
 }
 
 /// A bumpy open grid: 4 x 4 squares of two triangles, subdivided four times.

@@ -51,9 +51,12 @@ pub(super) const MOVED: u16 = 0x4000;
 /// The use count under the flags.
 pub(super) const USES: u16 = MOVED - 1;
 
-/// The most tiles: a dirty run is its first tile and the base-4 logarithm of its length in one
-/// `u32`, four bits for the logarithm.
-const MAX_TILES: u64 = 1 << 28;
+/// A triangle slot's tile when it is spare.
+const SPARE: u16 = u16::MAX;
+
+/// The most tiles: a triangle's tile is a `u16` ([`SPARE`] aside), and a dirty run is its first
+/// tile and the base-4 logarithm of its length in one `u32`.
+const MAX_TILES: u32 = SPARE as u32;
 
 /// `4^k` tiles under a lattice triangle `k` levels above the tiles.
 #[inline]
@@ -119,14 +122,26 @@ fn holds(t: &[Point; 3], q: Point) -> bool {
 impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: SlotIndex>
     WaveletCut<WORDS, T, V, Q, I>
 {
+    /// The most tiles this cut holds: one per queue entry (so at least eight triangles of
+    /// capacity per tile with `Q = T / 8`), at most [`MAX_TILES`].
+    pub(super) const TILES: u32 = if Q < MAX_TILES as usize {
+        Q as u32
+    } else {
+        MAX_TILES
+    };
+
     /// The tile level for a mesh of `faces` base faces and `levels` levels: two above the
-    /// finest, or coarser until the tiles fit the triangle arena.
-    pub(super) fn tile_level_for(faces: u32, levels: u32) -> u32 {
+    /// finest, or coarser until the tiles fit [`Self::TILES`] (`None` when the base faces
+    /// alone do not).
+    pub(super) fn tile_level_for(faces: u32, levels: u32) -> Option<u32> {
+        if faces > Self::TILES {
+            return None;
+        }
         let mut d = levels.saturating_sub(2);
-        while d > 0 && u64::from(faces) << (2 * d) > (T as u64).min(MAX_TILES) {
+        while d > 0 && u64::from(faces) << (2 * d) > u64::from(Self::TILES) {
             d -= 1;
         }
-        d
+        Some(d)
     }
 
     /// Marks the lattice triangle whose weights sum to `sum` (three times its centroid, in a
@@ -344,7 +359,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
             for c in self.tris.as_slice()[i] {
                 self.unuse(c.load());
             }
-            self.owner[i] = I::store(NIL);
+            self.owner[i] = SPARE;
             self.next[i] = I::store(self.spare);
             self.spare = x;
             x = next;
@@ -391,7 +406,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         while x != NIL {
             let next = self.next[x as usize].load();
             while let Some(last) = self.tris.len().checked_sub(1) {
-                if self.owner[last].load() != NIL {
+                if self.owner[last] != SPARE {
                     break;
                 }
                 self.tris.pop();
@@ -411,7 +426,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         let (next, owner) = (self.next[from], self.owner[from]);
         (self.next[to], self.owner[to]) = (next, owner);
         let to_i = I::store(to as u32);
-        if let Some(h) = self.head.get_mut(owner.index()) {
+        if let Some(h) = self.head.get_mut(usize::from(owner)) {
             if h.index() == from {
                 *h = to_i;
             } else {
@@ -446,7 +461,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
             self.uses[c as usize] += 1;
         }
         let i = slot as usize;
-        (self.owner[i], self.next[i]) = (I::store(tile), I::store(h));
+        (self.owner[i], self.next[i]) = (tile as u16, I::store(h));
         self.head[tile as usize] = I::store(slot);
         Ok(())
     }
