@@ -203,6 +203,8 @@ pub struct WaveletCut<
     /// Whether a frame that changes anything emits the whole mesh (see
     /// [`WaveletCut::set_partial_emission`]).
     whole: bool,
+    /// Whether the whole mesh is being emitted now (every slot placed in this pass).
+    all: bool,
     map: NodeMap<T, I>,
     heap: Arena<(u32, u32), Q>,
     threshold: f32,
@@ -305,6 +307,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
             dirty: Arena::new(0),
             built: false,
             whole: false,
+            all: false,
             map: NodeMap::new(),
             heap: Arena::new((0, 0)),
             threshold: 0.0,

@@ -293,12 +293,15 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         self.map
             .reset(NodeMap::<T, I>::span_for(self.vertices as usize));
         let per_face = tiles_under(self.tile_level);
+        self.all = true;
         for f in 0..self.base_faces {
             if self.emit_run(s, f * per_face, per_face).is_err() {
+                self.all = false;
                 self.built = false;
                 return false;
             }
         }
+        self.all = false;
         self.free_unused();
         self.built = true;
         true
@@ -474,13 +477,19 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
     }
 
     /// [`Self::slot`] of vertex `id` at point `p` (in any frame holding it); an existing slot
-    /// has its position computed again.
+    /// has its position computed again, unless the whole mesh is being emitted (then it was
+    /// placed in this pass).
     fn slot_of(
         &mut self,
         s: &SemiRegularView<'_>,
         (id, p): (u32, Point),
         ends: [u32; 2],
     ) -> Result<u32, Full> {
+        let found = self.map.get(id, self.ids.as_slice());
+        if let (Some(slot), true) = (found, self.all) {
+            // Emitting everything, every slot is new and placed once.
+            return Ok(slot);
+        }
         let end = |k: usize| ends[k] as usize;
         let ends_moved = ends[0] != NIL && (self.uses[end(0)] | self.uses[end(1)]) & MOVED != 0;
         let at_own =
@@ -511,7 +520,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
             }
             (at, true)
         };
-        let slot = match self.map.get(id, self.ids.as_slice()) {
+        let slot = match found {
             Some(slot) => slot,
             None => self.new_slot(id)?,
         };
@@ -521,7 +530,8 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         Ok(slot)
     }
 
-    /// A slot for vertex `id`: a freed one or a new one, unused (so on the pending list).
+    /// A slot for vertex `id`: a freed one or a new one, unused (so on the pending list, unless
+    /// the whole mesh is being emitted).
     fn new_slot(&mut self, id: u32) -> Result<u32, Full> {
         let slot = if self.free != NIL {
             let x = self.free;
@@ -533,9 +543,14 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
             self.ids.push(id).map_err(|_| Full)?
         };
         let i = slot as usize;
-        self.uses[i] = PENDING;
-        self.link[i] = I::store(self.pending);
-        self.pending = slot;
+        if self.all {
+            // Emitting everything, every slot made is used.
+            self.uses[i] = 0;
+        } else {
+            self.uses[i] = PENDING;
+            self.link[i] = I::store(self.pending);
+            self.pending = slot;
+        }
         if !self.map.insert(slot, self.ids.as_slice()) {
             return Err(Full);
         }
