@@ -47,6 +47,33 @@
 //! heads, the previous view and the anchor frame. With `V = T / 2` (a closed mesh has about
 //! half as many vertices as triangles) and `Q = T / 8`, that is about 25.8 B per triangle of
 //! capacity beside the bits.
+//!
+//! ```
+//! # #[cfg(feature = "build")] {
+//! use vdlod_core::adapt::Budget;
+//! use vdlod_core::policy::{QRefine, View};
+//! use vdlod_core::wavelet::{SemiRegular, SemiRegularView, WaveletCut};
+//! let bytes = SemiRegular::sphere(4).unwrap().to_bytes().unwrap(); // 2,048 faces at full detail
+//! let s = SemiRegularView::parse(&bytes).unwrap();
+//! type Cut = WaveletCut<64, 4096, 2100, 512>;
+//! let (mut cut, mut whole) = (Cut::boxed(), Cut::boxed());
+//! cut.reset(&s).unwrap();
+//! whole.reset(&s).unwrap();
+//! whole.set_partial_emission(false); // every frame that changes emits the whole mesh
+//! let mut scratch = vec![[0u32; 2]; 3 * 4096];
+//! for step in 0..20 {
+//!     let a = step as f32 * 0.1;
+//!     let eye = [3.0 * libm::cosf(a), 0.5, 3.0 * libm::sinf(a)];
+//!     let view = View::look_at(eye, [0.0; 3], [0.0, 1.0, 0.0], 0.9, 1.0, 512.0);
+//!     let stats = cut.adapt(&s, &view, &QRefine::new(1.0), &Budget::default());
+//!     whole.adapt(&s, &view, &QRefine::new(1.0), &Budget::default());
+//!     assert!(stats.triangles > 8 && stats.triangles < 2048);
+//!     // The same mesh either way, without a crack.
+//!     assert_eq!(cut.triangles().len(), whole.triangles().len());
+//!     assert!(cut.check(&s, true, &mut scratch).is_ok());
+//! }
+//! # }
+//! ```
 
 use crate::adapt::{Budget, FrameStats};
 use crate::cut::slot::{Arena, SlotIndex};

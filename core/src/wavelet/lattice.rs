@@ -147,8 +147,7 @@ impl SemiRegularView<'_> {
     }
 
     /// [`SemiRegularView::canonical_scaled`] of a point outside its face's frame.
-    #[cold]
-    #[inline(never)]
+    #[inline]
     fn unfold(&self, p: Point, total: i32) -> Option<Point> {
         let w = p.w;
         if w[0].checked_add(w[1])?.checked_add(w[2])? != total {

@@ -184,7 +184,8 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         if self.dirty.last() == Some(&run) {
             return;
         }
-        if self.dirty.push(run).is_err() {
+        // A full list, or more runs than half the tiles: the frame emits the whole mesh.
+        if self.dirty.push(run).is_err() || self.dirty.len() as u32 > self.tiles / 2 {
             self.built = false;
         }
     }
@@ -199,8 +200,8 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         level: u32,
         changed: &[u32],
     ) {
-        if level == 0 {
-            return;
+        if level == 0 || !self.built {
+            return; // the whole mesh is emitted this frame anyway
         }
         let [x, y] = s.parent_edge(p, level);
         let up = level - 1;
