@@ -223,8 +223,9 @@ pub struct WaveletCut<
     head: [I; Q],
     tile_level: u32,
     tiles: u32,
-    /// Runs of tiles to emit again (first tile, tiles), and whether the mesh emitted is the
-    /// set's apart from them (`false`: emit it all).
+    /// Runs of tiles to emit again (the first tile shifted by four bits over 15 less the
+    /// base-4 logarithm of the run's length), and whether the mesh emitted is the set's apart
+    /// from them (`false`: emit it all).
     dirty: Arena<u32, Q>,
     built: bool,
     /// Whether a frame that changes anything emits the whole mesh (see

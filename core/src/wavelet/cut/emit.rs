@@ -6,20 +6,21 @@
 //! for the whole mesh in every frame that changes makes a frame's work follow the mesh's size,
 //! not the change. So the mesh is kept between frames:
 //!
-//! - **Tiles.** The triangles of the lattice level `d` (about two levels above the finest, as
-//!   many as the triangle arena allows) are tiles, numbered base face by base face in the order
-//!   of the recursion's children, so the tiles under any coarser lattice triangle are one run of
-//!   numbers. Each emitted triangle belongs to one tile: the one it lies in, or, for a leaf
-//!   coarser than the tiles, its first tile (the leaf's first child's first child...). A tile
-//!   lists its triangles (linked through the triangle slots, both ways, so a triangle leaves its
-//!   list at once).
+//! - **Tiles.** The triangles of the lattice level `d` (two levels above the finest, or coarser
+//!   so that there are at most as many as queue entries) are tiles, numbered base face by base
+//!   face in the order of the recursion's children, so the tiles under any coarser lattice
+//!   triangle are one run of numbers. Each emitted triangle belongs to one tile: the one it lies
+//!   in, or, for a leaf coarser than the tiles, its first tile (the leaf's first child's first
+//!   child...). A tile lists its triangles, linked through the triangle slots; a triangle moved
+//!   into a freed slot finds its predecessor by walking its tile, which is small.
 //! - **Dirty runs.** When a wavelet comes, goes or blends, the lattice triangles whose emission
 //!   or vertex positions can change are the two around its parent edge (their subdivision, and
 //!   the wavelet's position and its dependents' inside them) and the neighbours across an edge
 //!   whose midpoint appeared or vanished (their T-vertex cuts). Each is marked as a run of
 //!   tiles: all tiles under it when it is in the recursion, else the first tile of the coarser
 //!   leaf that holds it. Only those runs are released and emitted again, and a frame that
-//!   changed nothing emits nothing.
+//!   changed nothing emits nothing. A frame with more runs than half the tiles emits the whole
+//!   mesh and stops marking.
 //! - **Vertex slots that outlive a frame.** A slot counts the triangles that use it; one that
 //!   drops to none is freed at the end of the frame (it may be taken up again first) and its
 //!   slot reused, so a clean tile's triangles keep pointing at their vertices. A slot freed is a
