@@ -39,14 +39,14 @@
 //! number of frames ([`WaveletCut::set_geomorph_frames`]); they overlap in space and time, and a
 //! wavelet turned around mid-way starts from where it is.
 //!
-//! Memory (`Self::BYTES`, asserted in a test): five bits per wavelet (`20 WORDS`: in the set,
-//! a vertex of the emitted mesh, blending, settled, children quiet), 20 B per vertex slot (id,
-//! position, uses with two flags, a list link), 12 B per triangle slot (corners as `u16`, vertex
-//! map, tile, next in the tile's list), 30 B per queue entry (a candidate, a geomorph, a dirty
-//! run and a tile's head: a tile per queue entry at most), and under 512 B of counts, list
-//! heads, the previous view and the anchor frame. With `V = T / 2` (a closed mesh has about
-//! half as many vertices as triangles) and `Q = T / 8`, that is about 25.8 B per triangle of
-//! capacity beside the bits.
+//! Memory (`Self::BYTES`, asserted in a test): six bits per wavelet (`24 WORDS`: in the set,
+//! holding a member child, a vertex of the emitted mesh, blending, settled, children quiet),
+//! 20 B per vertex slot (id, position, uses with two flags, a list link), 12 B per triangle slot
+//! (corners as `u16`, vertex map, tile, next in the tile's list), 30 B per queue entry (a
+//! candidate, a geomorph, a dirty run and a tile's head: a tile per queue entry at most), and
+//! under 512 B of counts, list heads, the previous view and the anchor frame. With `V = T / 2`
+//! (a closed mesh has about half as many vertices as triangles) and `Q = T / 8`, that is about
+//! 25.8 B per triangle of capacity beside the bits.
 //!
 //! ```
 //! # #[cfg(feature = "build")] {
@@ -194,6 +194,8 @@ pub struct WaveletCut<
     I: SlotIndex = u16,
 > {
     included: [u32; WORDS],
+    /// The wavelets with a child in the set, kept as wavelets come and go.
+    holding: [u32; WORDS],
     /// The wavelets whose vertex is in the emitted mesh (in, or a T-vertex or corner of a
     /// subdivided triangle), kept as wavelets come and go.
     present: [u32; WORDS],
@@ -311,6 +313,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         let () = Self::CAPACITY_FITS;
         WaveletCut {
             included: [0; WORDS],
+            holding: [0; WORDS],
             present: [0; WORDS],
             base_vertices: 0,
             base_faces: 0,
@@ -393,6 +396,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
                 tiles: Self::TILES,
             })?;
         self.included.iter_mut().for_each(|w| *w = 0);
+        self.holding.iter_mut().for_each(|w| *w = 0);
         self.present.iter_mut().for_each(|w| *w = 0);
         self.morphing.iter_mut().for_each(|w| *w = 0);
         self.settled.iter_mut().for_each(|w| *w = 0);
@@ -571,6 +575,12 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         let (l, r) = (x.left_of(y), x.right_of(y));
         self.flip(id);
         self.unsettle(s, id, p, level);
+        let now_in = self.includes(id);
+        for q in s.parents(p, level) {
+            let Some(pq) = s.point(q) else { continue };
+            let holds = now_in || self.scan_children(s, pq, s.level(pq), false);
+            put(&mut self.holding, self.base_vertices, q, holds);
+        }
         let mut changed = [NIL; 5];
         for (k, m) in [p, y.mid(l), l.mid(x), x.mid(r), r.mid(y)]
             .into_iter()
@@ -599,9 +609,23 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         self.mark_wavelet(s, p, level, &changed);
     }
 
-    /// Whether any child of wavelet `p` (at `level`) is in the mesh (with `staying`, only
-    /// children that are not leaving count).
-    fn any_child_in(&self, s: &SemiRegularView<'_>, p: Point, level: u32, staying: bool) -> bool {
+    /// Whether any child of wavelet `id` (at `p`, `level`) is in the mesh (with `staying`, only
+    /// children that are not leaving count): its kept bit, and the children themselves only
+    /// when some may be leaving.
+    #[inline]
+    fn any_child_in(
+        &self,
+        s: &SemiRegularView<'_>,
+        (id, p): (u32, Point),
+        level: u32,
+        staying: bool,
+    ) -> bool {
+        has(&self.holding, self.base_vertices, self.wavelets, id)
+            && (!staying || self.morphs.len() == 0 || self.scan_children(s, p, level, true))
+    }
+
+    /// [`Self::any_child_in`] from the children themselves.
+    fn scan_children(&self, s: &SemiRegularView<'_>, p: Point, level: u32, staying: bool) -> bool {
         s.children(p, level).iter().flatten().any(|&c| {
             s.vertex_id(c)
                 .is_some_and(|id| self.includes(id) && !(staying && self.leaving(id)))
@@ -768,7 +792,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
                     && m.weight <= 0.0
                     && s.point(m.id).is_some_and(|p| {
                         let level = s.level(p);
-                        !self.any_child_in(s, p, level, false)
+                        !self.any_child_in(s, (m.id, p), level, false)
                     });
                 if gone {
                     if let Some(p) = s.point(m.id) {
@@ -857,7 +881,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
                 let Some(p) = s.point(id) else { continue };
                 let level = s.level(p);
                 let leaving = self.leaving(id);
-                if !leaving && self.any_child_in(s, p, level, true) {
+                if !leaving && self.any_child_in(s, (id, p), level, true) {
                     if anchor.is_some() {
                         // Stays while that child does (whose coming and going unsettles it).
                         put(&mut self.settled, self.base_vertices, id, true);
@@ -888,7 +912,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
                     stats.ops_limited = true;
                     break 'coarsen;
                 }
-                let children = self.any_child_in(s, p, level, false);
+                let children = self.any_child_in(s, (id, p), level, false);
                 let frames = if d.visible { self.geomorph_frames } else { 0 };
                 // Leaving changes what its parents have to do.
                 self.unsettle(s, id, p, level);
@@ -1057,7 +1081,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         while let Some(id) = self.member_from(next) {
             next = id - self.base_vertices + 1;
             let Some(p) = s.point(id) else { continue };
-            if !self.any_child_in(s, p, s.level(p), false)
+            if !self.any_child_in(s, (id, p), s.level(p), false)
                 && self.heap.heap_push((priority(id, p), id)).is_err()
             {
                 stats.queue_overflow = true;
@@ -1069,7 +1093,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
             };
             let Some(p) = s.point(id) else { continue };
             let level = s.level(p);
-            if !self.includes(id) || self.any_child_in(s, p, level, false) {
+            if !self.includes(id) || self.any_child_in(s, (id, p), level, false) {
                 continue;
             }
             self.end_morph(s, id);
@@ -1079,7 +1103,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
             for q in s.parents(p, level) {
                 let Some(pq) = s.point(q) else { continue };
                 if self.includes(q)
-                    && !self.any_child_in(s, pq, s.level(pq), false)
+                    && !self.any_child_in(s, (q, pq), s.level(pq), false)
                     && self.heap.heap_push((priority(q, pq), q)).is_err()
                 {
                     stats.queue_overflow = true;
@@ -1205,6 +1229,10 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
                 .ok_or(WaveletDefect("a wavelet has no lattice point"))?;
             if self.presence(s, p, s.level(p)).0 != self.is_present(id) {
                 return Err(WaveletDefect("a kept presence bit is wrong"));
+            }
+            let holding = has(&self.holding, self.base_vertices, self.wavelets, id);
+            if holding != self.scan_children(s, p, s.level(p), false) {
+                return Err(WaveletDefect("a kept has-a-member-child bit is wrong"));
             }
         }
         if self.tris.len() as u32 != self.triangles || self.live_vertices() as u32 != self.vertices
