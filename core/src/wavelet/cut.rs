@@ -575,10 +575,12 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         let (l, r) = (x.left_of(y), x.right_of(y));
         self.flip(id);
         self.unsettle(s, id, p, level);
-        let now_in = self.includes(id);
+        // A parent holds a member child now if this one joined, else only if another is in.
+        let joined = self.includes(id);
         for q in s.parents(p, level) {
-            let Some(pq) = s.point(q) else { continue };
-            let holds = now_in || self.scan_children(s, pq, s.level(pq), false);
+            let holds = joined
+                || s.point(q)
+                    .is_some_and(|pq| self.scan_children(s, pq, s.level(pq), false));
             put(&mut self.holding, self.base_vertices, q, holds);
         }
         let mut changed = [NIL; 5];

@@ -74,10 +74,10 @@ fn sum3(a: Point, b: Point, c: Point) -> Point {
     }
 }
 
-/// The four children of the lattice triangle `p` in the recursion's order, with midpoints `m`
-/// (of edges `p0 p1`, `p1 p2`, `p2 p0`).
+/// The four child triangles of the lattice triangle `p` in the recursion's order, with
+/// midpoints `m` (of edges `p0 p1`, `p1 p2`, `p2 p0`).
 #[inline]
-fn children<X: Copy>(p: [X; 3], m: [X; 3]) -> [[X; 3]; 4] {
+fn quarters<X: Copy>(p: [X; 3], m: [X; 3]) -> [[X; 3]; 4] {
     [
         [p[0], m[0], m[2]],
         [m[0], p[1], m[1]],
@@ -162,6 +162,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         let mut t = [[n, 0, 0], [0, n, 0], [0, 0, n]].map(|w| Point { face: q.face, w });
         let mut at = q.face.saturating_mul(tiles_under(d));
         for l in 0..level.min(d) {
+            // Subdivided when a midpoint is in (ids read lazily: the descent needs no slots).
             let m = [t[0].mid(t[1]), t[1].mid(t[2]), t[2].mid(t[0])];
             if !m
                 .iter()
@@ -169,11 +170,11 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
             {
                 return self.mark_run(at, 0);
             }
-            let Some(c) = children(t, m).iter().position(|c| holds(c, q)) else {
+            let Some(c) = quarters(t, m).iter().position(|c| holds(c, q)) else {
                 return self.mark_run(at, 0);
             };
             at += c as u32 * tiles_under(d - l - 1);
-            t = children(t, m)[c];
+            t = quarters(t, m)[c];
         }
         self.mark_run(at, d.saturating_sub(level));
     }
@@ -325,26 +326,20 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         let mut at = face * per_face;
         let mut level = 0;
         while tiles_under(d - level) > len {
-            let m = [p[0].mid(p[1]), p[1].mid(p[2]), p[2].mid(p[0])];
-            let ids = m.map(|q| s.vertex_id(q));
-            if !ids.iter().any(|&id| id.is_some_and(|id| self.includes(id))) {
+            let Some((m, ids)) = self.subdivision(s, &p) else {
                 // A leaf coarser than the run: its pieces belong to its first tile.
                 return if at == first {
                     self.emit_piece(s, p, v, [level; 3], at)
                 } else {
                     Ok(())
                 };
-            }
-            let mut mv = [0; 3];
-            for k in 0..3 {
-                let id = ids[k].ok_or(Full)?;
-                mv[k] = self.slot_of(s, (id, m[k]), [v[k], v[(k + 1) % 3]])?;
-            }
+            };
+            let mv = self.midpoint_slots(s, m, ids, v)?;
             let below = tiles_under(d - level - 1);
             let c = ((first - at) / below).min(3) as usize;
             at += c as u32 * below;
-            p = children(p, m)[c];
-            v = children(v, mv)[c];
+            p = quarters(p, m)[c];
+            v = quarters(v, mv)[c];
             level += 1;
         }
         self.emit_triangle(s, p, v, level, first)
@@ -559,6 +554,40 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         Ok(slot)
     }
 
+    /// The edge midpoints of lattice triangle `p` (of `p0 p1`, `p1 p2`, `p2 p0`: inside its
+    /// face, so their ids need no unfolding) and their vertex ids, when one of them is in the
+    /// set (the triangle is subdivided); `None` for a leaf.
+    #[inline(always)]
+    fn subdivision(
+        &self,
+        s: &SemiRegularView<'_>,
+        p: &[Point; 3],
+    ) -> Option<([Point; 3], [Option<u32>; 3])> {
+        let m = [p[0].mid(p[1]), p[1].mid(p[2]), p[2].mid(p[0])];
+        let ids = m.map(|q| s.vertex_id(q));
+        ids.iter()
+            .any(|&id| id.is_some_and(|id| self.includes(id)))
+            .then_some((m, ids))
+    }
+
+    /// The vertex slots of a subdivided triangle's midpoints `m` (ids `ids`, from
+    /// [`Self::subdivision`]), each placed on its edge between the corner slots `v`.
+    #[inline]
+    fn midpoint_slots(
+        &mut self,
+        s: &SemiRegularView<'_>,
+        m: [Point; 3],
+        ids: [Option<u32>; 3],
+        v: [u32; 3],
+    ) -> Result<[u32; 3], Full> {
+        let mut mv = [0; 3];
+        for k in 0..3 {
+            let id = ids[k].ok_or(Full)?;
+            mv[k] = self.slot_of(s, (id, m[k]), [v[k], v[(k + 1) % 3]])?;
+        }
+        Ok(mv)
+    }
+
     /// Emits the triangle `p` (vertex slots `v`) of level `level`, whose first tile is `tile`:
     /// its four children when it is subdivided, else itself, cut where its neighbours are
     /// finer.
@@ -570,26 +599,19 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         level: u32,
         tile: u32,
     ) -> Result<(), Full> {
-        if level >= self.levels {
+        let split = (level < self.levels)
+            .then(|| self.subdivision(s, &p))
+            .flatten();
+        let Some((m, ids)) = split else {
             return self.emit_piece(s, p, v, [level; 3], tile);
-        }
-        // The midpoints are inside this triangle's face: their ids need no unfolding.
-        let m = [p[0].mid(p[1]), p[1].mid(p[2]), p[2].mid(p[0])];
-        let ids = m.map(|q| s.vertex_id(q));
-        if !ids.iter().any(|&id| id.is_some_and(|id| self.includes(id))) {
-            return self.emit_piece(s, p, v, [level; 3], tile);
-        }
-        let mut mv = [0; 3];
-        for k in 0..3 {
-            let id = ids[k].ok_or(Full)?;
-            mv[k] = self.slot_of(s, (id, m[k]), [v[k], v[(k + 1) % 3]])?;
-        }
+        };
+        let mv = self.midpoint_slots(s, m, ids, v)?;
         let below = if level < self.tile_level {
             tiles_under(self.tile_level - level - 1)
         } else {
             0
         };
-        let (ps, vs) = (children(p, m), children(v, mv));
+        let (ps, vs) = (quarters(p, m), quarters(v, mv));
         for c in 0..4 {
             self.emit_triangle(s, ps[c], vs[c], level + 1, tile + c as u32 * below)?;
         }
