@@ -376,6 +376,29 @@ pub fn triangle_set(triangles: impl Iterator<Item = [u32; 3]>) -> Vec<[u32; 3]> 
     v
 }
 
+/// Each node's vertex, as [`triangle_set`] names it: the node itself, or, for a parent that
+/// repeats a child's vertex bit for bit (position, normal and colour, as a hierarchy built with
+/// `--placement endpoint` does), that child's name. A split then leaves the triangles around the
+/// child that stays where its parent was as they were, and they do not count as new.
+pub fn vertex_names(h: &HierarchyView<'_>) -> Vec<u32> {
+    let key = |i: u32| {
+        let (p, n, c) = h.vertex(i);
+        (p.map(f32::to_bits), n.map(f32::to_bits), c)
+    };
+    (0..h.nodes())
+        .map(|mut n| {
+            while h.is_parent(n) {
+                let k = key(n);
+                match h.children(n).into_iter().find(|&c| key(c) == k) {
+                    Some(c) => n = c,
+                    None => break,
+                }
+            }
+            n
+        })
+        .collect()
+}
+
 /// How many of `now` are not in `before` (both from [`triangle_set`]): ROAM's measure of how
 /// much a frame changed.
 pub fn new_triangles(before: &[[u32; 3]], now: &[[u32; 3]]) -> u32 {
@@ -650,6 +673,8 @@ fn draw_either<M: vdlod_raster::MeshSource>(
 struct Forest<'a, 'h, const V: usize, const F: usize, const Q: usize, I: SlotIndex> {
     h: HierarchyView<'h>,
     cut: &'a mut Cut<V, F, Q, I>,
+    /// [`vertex_names`] of `h`.
+    names: Vec<u32>,
 }
 
 impl<'a, 'h, const V: usize, const F: usize, const Q: usize, I: SlotIndex>
@@ -667,7 +692,8 @@ impl<'a, 'h, const V: usize, const F: usize, const Q: usize, I: SlotIndex>
         });
         cut.reset(&h).map_err(|e| e.to_string())?;
         cut.set_geomorph_frames(opts.geomorph_frames);
-        Ok(Forest { h, cut })
+        let names = vertex_names(&h);
+        Ok(Forest { h, cut, names })
     }
 }
 
@@ -715,7 +741,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex + VertexIndex>
             self.cut
                 .triangles()
                 .iter()
-                .map(|t| t.map(|i| nodes[i.index()])),
+                .map(|t| t.map(|i| self.names[nodes[i.index()] as usize])),
         )
     }
 }
@@ -985,5 +1011,39 @@ mod tests {
         // Every channel off by one: MSE 1, PSNR 20 log10(255) = 48.13 dB.
         let b = vec![Rgba8([11, 21, 31, 255]); 100];
         assert!((psnr(&a, &b) - 48.1308).abs() < 1e-3);
+    }
+
+    #[test]
+    fn vertex_names_follow_a_vertex_that_stays() {
+        use vdlod_core::build::{BuildOptions, Placement};
+        let mesh = crate::terrain::Terrain::procedural(17, 1, 0.1).mesh();
+        let named = |placement| {
+            let opts = BuildOptions {
+                placement,
+                ..BuildOptions::default()
+            };
+            let bytes = crate::hierarchy::build_with_progress(&mesh, &opts, false)
+                .unwrap()
+                .1;
+            let h = HierarchyView::parse(&bytes).unwrap();
+            let names = vertex_names(&h);
+            // A name is the node itself or a node below it with the same vertex.
+            for (n, &m) in names.iter().enumerate() {
+                assert!(m == n as u32 || h.is_below(m, n as u32));
+                assert_eq!(h.vertex(m), h.vertex(n as u32));
+            }
+            let parents = h.parent_nodes().count();
+            let renamed = h.parent_nodes().filter(|&p| names[p as usize] != p).count();
+            (parents, renamed)
+        };
+        // On endpoints every parent is an input vertex: each is named by a leaf.
+        let (parents, renamed) = named(Placement::Endpoint);
+        assert!(
+            parents > 200 && renamed == parents,
+            "{renamed} of {parents}"
+        );
+        // Placed by the quadrics, a parent is a vertex of its own.
+        let (parents, renamed) = named(Placement::Cost);
+        assert!(renamed * 10 < parents, "{renamed} of {parents}");
     }
 }

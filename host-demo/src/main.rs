@@ -8,7 +8,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand, ValueEnum};
 use vdlod_core::adapt::Budget;
-use vdlod_core::build::{BuildOptions, Cost, ErrorBound};
+use vdlod_core::build::{BuildOptions, Cost, ErrorBound, Placement};
 use vdlod_core::format::HierarchyView;
 use vdlod_core::policy::Importance;
 use vdlod_core::wavelet::build::{Scheme, SemiRegular};
@@ -320,6 +320,9 @@ struct BuildArgs {
     /// The error bound each vertex carries.
     #[arg(long, value_enum, default_value = "offset")]
     bound: BoundArg,
+    /// Where a collapse puts the vertex it makes.
+    #[arg(long, value_enum, default_value = "cost")]
+    placement: PlacementArg,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -340,6 +343,24 @@ impl From<BoundArg> for ErrorBound {
             BoundArg::Offset => ErrorBound::Offset,
             BoundArg::Spheroid => ErrorBound::Spheroid,
             BoundArg::Hoppe => ErrorBound::Hoppe,
+        }
+    }
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum PlacementArg {
+    /// Where the cost puts it: the quadrics' minimiser (qem), else the edge's midpoint.
+    Cost,
+    /// On one of the two endpoints, with its normal and colour (a half-edge collapse): fewer
+    /// triangles change per frame, at some cost in fidelity.
+    Endpoint,
+}
+
+impl From<PlacementArg> for Placement {
+    fn from(p: PlacementArg) -> Placement {
+        match p {
+            PlacementArg::Cost => Placement::Cost,
+            PlacementArg::Endpoint => Placement::Endpoint,
         }
     }
 }
@@ -600,6 +621,9 @@ struct TerrainArgs {
     /// The vertex forest's error bound (as `build --bound`).
     #[arg(long, value_enum, default_value = "offset")]
     bound: BoundArg,
+    /// Where the vertex forest's collapses put their vertices (as `build --placement`).
+    #[arg(long, value_enum, default_value = "cost")]
+    placement: PlacementArg,
     /// Draw the colours as a texture over the ground (one texel per sample; the full-detail
     /// frames too), not as a colour per vertex: they keep their detail where the mesh is coarse.
     #[arg(long)]
@@ -819,6 +843,7 @@ fn terrain_command(args: TerrainArgs) -> Result<(), String> {
             let show = std::io::IsTerminal::is_terminal(&std::io::stderr());
             let opts = BuildOptions {
                 bound: args.bound.into(),
+                placement: args.placement.into(),
                 ..BuildOptions::default()
             };
             hierarchy::build_with_progress(&full, &opts, show)
@@ -949,6 +974,7 @@ fn build_command(args: BuildArgs) -> Result<(), String> {
         balanced: args.balanced,
         base_vertices: args.base,
         bound: args.bound.into(),
+        placement: args.placement.into(),
     };
     let show = std::io::IsTerminal::is_terminal(&std::io::stderr());
     let (_, bytes, seconds) = hierarchy::build_with_progress(&mesh, &opts, show)

@@ -7,7 +7,11 @@
 //! a 1 px tolerance, the forest at 0.1 px under a budget of the wavelet engine's triangle count in
 //! each frame, so they are compared at equal triangles: PSNR against full detail, the share of
 //! triangles that are new in a frame (ROAM's measure of frame-to-frame coherence), adaptation
-//! time, file bytes per height sample and cut bytes per triangle of capacity.
+//! time, file bytes per height sample and cut bytes per triangle of capacity. The forest flies
+//! twice: built with the default placement (each collapse's vertex where its quadrics put it),
+//! and on endpoints ([`Placement::Endpoint`], a half-edge hierarchy whose vertices are all
+//! samples, as the wavelet engine's are), where a split leaves the triangles round the staying
+//! child as they were ([`vertex_names`] names a vertex by what it is, not by its node).
 //!
 //! The frames are coloured per vertex (one colour per sample); `reproduce textures` draws the
 //! same flight with the colours as a texture.
@@ -24,18 +28,18 @@ use std::time::Instant;
 
 use vdlod::{Camera, CutMesh, Style, WaveletMesh};
 use vdlod_core::adapt::{Budget, FrameStats};
-use vdlod_core::build::BuildOptions;
+use vdlod_core::build::{BuildOptions, Placement};
 use vdlod_core::cut::Cut;
 use vdlod_core::format::HierarchyView;
 use vdlod_core::policy::QRefine;
 use vdlod_core::wavelet::{SemiRegularView, WaveletCut};
 use vdlod_raster::{MeshSource, Rgba8, Shading};
 
-use crate::chart::{self, Panel, BLUE, ORANGE};
+use crate::chart::{self, Panel, BLUE, GREEN, ORANGE};
 use crate::frame::Frame;
 use crate::ground::{draw_on_ground, GroundTexture};
 use crate::hierarchy::build_with_progress;
-use crate::lod::{new_triangles, psnr, triangle_set};
+use crate::lod::{new_triangles, psnr, triangle_set, vertex_names};
 use crate::mesh::IndexedMesh;
 use crate::render::style;
 use crate::terrain::{FlyOver, Terrain, DEFAULT_VERTICAL_SCALE, UP_AXIS};
@@ -105,13 +109,34 @@ impl Engines {
         camera: &Camera,
         triangles: u32,
     ) -> Result<FrameStats, String> {
-        let budget = Budget {
-            max_triangles: triangles,
-            ..Budget::default()
-        };
-        vdlod::adapt(&mut self.forest, h, camera, &QRefine::new(0.1), &budget)
-            .map_err(|e| e.to_string())
+        adapt_forest(&mut self.forest, h, camera, triangles)
     }
+}
+
+/// `forest` to `camera` at 0.1 px, at most `triangles`.
+fn adapt_forest(
+    forest: &mut ForestCut,
+    h: &HierarchyView<'_>,
+    camera: &Camera,
+    triangles: u32,
+) -> Result<FrameStats, String> {
+    let budget = Budget {
+        max_triangles: triangles,
+        ..Budget::default()
+    };
+    vdlod::adapt(forest, h, camera, &QRefine::new(0.1), &budget).map_err(|e| e.to_string())
+}
+
+/// A forest built with [`Placement::Endpoint`] from the flight's terrain: its file, the file's
+/// size without colours, and the build's seconds.
+fn endpoint_forest(land: &Terrain) -> Result<(Vec<u8>, usize, f64), String> {
+    let opts = BuildOptions {
+        placement: Placement::Endpoint,
+        ..BuildOptions::default()
+    };
+    let (hierarchy, bytes, seconds) =
+        build_with_progress(&land.mesh(), &opts, false).map_err(|e| format!("terrain: {e}"))?;
+    Ok((bytes, hierarchy.to_bytes(false).len(), seconds))
 }
 
 /// What both engines fly: the procedural terrain of `side` samples a side as a semi-regular file
@@ -214,10 +239,15 @@ pub fn terrain_engines(out: &Path, setup: Setup) -> Result<Vec<String>, String> 
         forest_build_s,
         ..
     } = &flight;
+    let (ebytes, endpoint_shape_bytes, endpoint_build_s) = endpoint_forest(&flight.land)?;
+    let e = HierarchyView::parse(&ebytes).map_err(|e| e.to_string())?;
     let mut frame = Frame::new(WIDTH, HEIGHT).map_err(|e| e.to_string())?;
     let mut engines = Engines::new(&s, &h)?;
-    let mut frames: Vec<[EngineFrame; 2]> = Vec::with_capacity(cameras.len());
-    let (mut wavelet_before, mut forest_before) = (Vec::new(), Vec::new());
+    let mut endpoint = ForestCut::boxed();
+    endpoint.reset(&e).map_err(|e| e.to_string())?;
+    let names = [vertex_names(&h), vertex_names(&e)];
+    let mut frames: Vec<[EngineFrame; 3]> = Vec::with_capacity(cameras.len());
+    let mut before: [Vec<[u32; 3]>; 3] = Default::default();
     for camera in cameras {
         frame
             .draw(&full.as_raster_mesh(), &drawn.params(camera))
@@ -239,41 +269,56 @@ pub fn terrain_engines(out: &Path, setup: Setup) -> Result<Vec<String>, String> 
         );
         let w = EngineFrame {
             triangles: stats.triangles,
-            new: new_triangles(&wavelet_before, &now),
+            new: new_triangles(&before[0], &now),
             adapt_us,
             psnr_db: psnr(frame.pixels(), &reference),
         };
-        wavelet_before = now;
+        before[0] = now;
 
-        let start = Instant::now();
-        let stats = engines.adapt_forest(&h, camera, stats.triangles)?;
-        let adapt_us = start.elapsed().as_secs_f64() * 1e6;
-        let forest = &engines.forest;
-        frame
-            .draw_cut(forest, &h, camera, drawn)
-            .map_err(|e| e.to_string())?;
-        let nodes = forest.nodes();
-        let now = triangle_set(
-            forest
-                .triangles()
-                .iter()
-                .map(|t| t.map(|i| nodes[i as usize])),
-        );
-        let f = EngineFrame {
-            triangles: stats.triangles,
-            new: new_triangles(&forest_before, &now),
-            adapt_us,
-            psnr_db: psnr(frame.pixels(), &reference),
-        };
-        forest_before = now;
-        frames.push([w, f]);
+        let mut forests = [EngineFrame::default(); 2];
+        for (k, (cut, h)) in [(&mut engines.forest, &h), (&mut endpoint, &e)]
+            .into_iter()
+            .enumerate()
+        {
+            let start = Instant::now();
+            let stats = adapt_forest(cut, h, camera, w.triangles)?;
+            let adapt_us = start.elapsed().as_secs_f64() * 1e6;
+            frame
+                .draw_cut(cut, h, camera, drawn)
+                .map_err(|e| e.to_string())?;
+            let nodes = cut.nodes();
+            let now = triangle_set(
+                cut.triangles()
+                    .iter()
+                    .map(|t| t.map(|i| names[k][nodes[i as usize] as usize])),
+            );
+            forests[k] = EngineFrame {
+                triangles: stats.triangles,
+                new: new_triangles(&before[k + 1], &now),
+                adapt_us,
+                psnr_db: psnr(frame.pixels(), &reference),
+            };
+            before[k + 1] = now;
+        }
+        frames.push([w, forests[0], forests[1]]);
     }
 
-    let mut csv = String::from("frame,wavelet_triangles,forest_triangles,wavelet_new,forest_new,wavelet_adapt_us,forest_adapt_us,wavelet_psnr_db,forest_psnr_db\n");
-    for (i, [w, f]) in frames.iter().enumerate() {
+    let mut csv = String::from("frame,wavelet_triangles,forest_triangles,wavelet_new,forest_new,wavelet_adapt_us,forest_adapt_us,wavelet_psnr_db,forest_psnr_db,endpoint_triangles,endpoint_new,endpoint_adapt_us,endpoint_psnr_db\n");
+    for (i, [w, f, e]) in frames.iter().enumerate() {
         csv.push_str(&format!(
-            "{i},{},{},{},{},{:.1},{:.1},{:.2},{:.2}\n",
-            w.triangles, f.triangles, w.new, f.new, w.adapt_us, f.adapt_us, w.psnr_db, f.psnr_db
+            "{i},{},{},{},{},{:.1},{:.1},{:.2},{:.2},{},{},{:.1},{:.2}\n",
+            w.triangles,
+            f.triangles,
+            w.new,
+            f.new,
+            w.adapt_us,
+            f.adapt_us,
+            w.psnr_db,
+            f.psnr_db,
+            e.triangles,
+            e.new,
+            e.adapt_us,
+            e.psnr_db
         ));
     }
     let path = out.join("terrain_engines.csv");
@@ -288,12 +333,25 @@ pub fn terrain_engines(out: &Path, setup: Setup) -> Result<Vec<String>, String> 
             title: vec![
                 ("percent new triangles per frame: wavelets", BLUE),
                 (", vertex forest", ORANGE),
+                (", on endpoints", GREEN),
             ],
-            series: vec![(series(0, new_pct), BLUE), (series(1, new_pct), ORANGE)],
+            series: vec![
+                (series(0, new_pct), BLUE),
+                (series(1, new_pct), ORANGE),
+                (series(2, new_pct), GREEN),
+            ],
         },
         Panel {
-            title: vec![("PSNR dB: wavelets", BLUE), (", vertex forest", ORANGE)],
-            series: vec![(series(0, psnr_db), BLUE), (series(1, psnr_db), ORANGE)],
+            title: vec![
+                ("PSNR dB: wavelets", BLUE),
+                (", vertex forest", ORANGE),
+                (", on endpoints", GREEN),
+            ],
+            series: vec![
+                (series(0, psnr_db), BLUE),
+                (series(1, psnr_db), ORANGE),
+                (series(2, psnr_db), GREEN),
+            ],
         },
     ])?;
     let path = out.join("terrain_engines.png");
@@ -313,6 +371,13 @@ pub fn terrain_engines(out: &Path, setup: Setup) -> Result<Vec<String>, String> 
             ForestCut::BYTES,
             32_000,
             forest_build_s,
+        ),
+        (
+            "forest-endpoint",
+            [ebytes.len(), endpoint_shape_bytes],
+            ForestCut::BYTES,
+            32_000,
+            &endpoint_build_s,
         ),
     ];
     let mut lines = Vec::new();
@@ -506,20 +571,29 @@ mod tests {
             frames: 24,
         };
         let lines = terrain_engines(&out, setup).unwrap();
-        assert_eq!(lines.len(), 2);
-        let (w, f) = (&lines[0], &lines[1]);
-        assert!(w.contains("engine=wavelet") && f.contains("engine=forest"));
-        // The forest runs under the wavelet engine's count, at a finer tolerance: the same
-        // triangles in every frame (a split adds two, so it may stop one short).
+        assert_eq!(lines.len(), 3);
+        let (w, f, e) = (&lines[0], &lines[1], &lines[2]);
+        assert!(w.contains("engine=wavelet") && f.contains("engine=forest "));
+        assert!(e.contains("engine=forest-endpoint "));
+        // Both forests run under the wavelet engine's count, at a finer tolerance: the same
+        // triangles in every frame (a split adds two, so they may stop one short).
         let csv = std::fs::read_to_string(out.join("terrain_engines.csv")).unwrap();
         for row in csv.lines().skip(1) {
-            let v: Vec<&str> = row.split(',').collect();
-            let (wavelet, forest): (u32, u32) = (v[1].parse().unwrap(), v[2].parse().unwrap());
-            assert!(forest <= wavelet && forest + 1 >= wavelet, "{row}");
-            let new: u32 = v[3].parse().unwrap();
-            assert!(new <= v[1].parse().unwrap());
+            let v: Vec<u32> = row
+                .split(',')
+                .map(|x| x.parse::<f64>().unwrap() as u32)
+                .collect();
+            for forest in [v[2], v[9]] {
+                assert!(forest <= v[1] && forest + 1 >= v[1], "{row}");
+            }
+            assert!(v[3] <= v[1] && v[4] <= v[2] && v[10] <= v[9], "{row}");
         }
-        assert!((field(w, "triangles_mean") - field(f, "triangles_mean")).abs() <= 1.0);
+        for forest in [f, e] {
+            assert!((field(w, "triangles_mean") - field(forest, "triangles_mean")).abs() <= 1.0);
+        }
+        // A split of a forest on endpoints leaves the triangles round the staying child.
+        let churn = |l: &str| field(l, "new_triangles_pct_median");
+        assert!(churn(e) < churn(f), "{e}\n{f}");
         // Heights on a grid need no connectivity: the wavelet file is the smaller, two bytes a
         // sample and under a tenth of hierarchy and header beside the colours on a grid this
         // small.

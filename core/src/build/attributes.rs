@@ -18,7 +18,7 @@ use alloc::vec::Vec;
 
 use super::bound::{equation3, hoppe};
 use super::closest::{closest, point};
-use super::collapse::Engine;
+use super::collapse::{kept, Engine};
 use super::vec3::{add, cross, dot, from_f32, len, normalize, scale, sub, Vec3d};
 use super::{ErrorBound, Hierarchy, InputMesh, Node, NONE};
 use crate::format::{oct_decode, oct_encode};
@@ -137,7 +137,10 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, e: Engine<'_>) -> Hierarchy {
             scale(axis[a], weight[a].max(1e-30)),
             scale(axis[b], weight[b].max(1e-30)),
         );
-        axis[p] = quantized_axis(normalize(sum).unwrap_or(axis[a]));
+        axis[p] = match kept(e.opts, pos[p], [pos[a], pos[b]]) {
+            Some(k) => axis[[a, b][k]],
+            None => quantized_axis(normalize(sum).unwrap_or(axis[a])),
+        };
         half[p] = (angle(axis[p], axis[a]) + half[a]).max(angle(axis[p], axis[b]) + half[b]);
     }
 

@@ -15,7 +15,7 @@ use super::closest::Surface;
 use super::flatten::{flatten, PlanarCollapse};
 use super::quadric::{place, Quadric};
 use super::vec3::{add, cross, dot, from_f32, len, normalize, scale, sub, Vec3d};
-use super::{BuildOptions, Cost, ErrorBound, InputMesh, NONE};
+use super::{BuildOptions, Cost, ErrorBound, InputMesh, Placement, NONE};
 
 /// What one collapse did, enough to undo it by a vertex split.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -83,6 +83,15 @@ pub(crate) fn shape(t: [Vec3d; 3]) -> f64 {
     } else {
         0.0
     }
+}
+
+/// Which of `children`'s positions a parent at `v` keeps under [`Placement::Endpoint`] (the
+/// first when both are there), or `None` under [`Placement::Cost`]: the parent then copies that
+/// child's attributes.
+pub(crate) fn kept(opts: &BuildOptions, v: Vec3d, children: [Vec3d; 2]) -> Option<usize> {
+    (opts.placement == Placement::Endpoint)
+        .then(|| children.iter().position(|&c| c == v))
+        .flatten()
 }
 
 fn face_normal(p: &[Vec3d], f: [u32; 3]) -> Vec3d {
@@ -232,17 +241,19 @@ impl<'o> Engine<'o> {
         let (pa, pb) = (self.pos[a as usize], self.pos[b as usize]);
         let q = self.quadric[a as usize].add(&self.quadric[b as usize]);
         let len2 = dot(sub(pa, pb), sub(pa, pb));
+        let v = match (self.opts.placement, self.opts.cost) {
+            (Placement::Endpoint, _) if q.error(pb) < q.error(pa) => pb,
+            (Placement::Endpoint, _) => pa,
+            (Placement::Cost, Cost::Quadric) => place(&q, pa, pb),
+            (Placement::Cost, _) => scale(add(pa, pb), 0.5),
+        };
         match self.opts.cost {
-            Cost::Quadric => {
-                let v = place(&q, pa, pb);
-                (v, q.error(v))
-            }
-            Cost::ShortestEdge => (scale(add(pa, pb), 0.5), len2),
+            Cost::Quadric => (v, q.error(v)),
+            Cost::ShortestEdge => (v, len2),
             Cost::Color => {
                 // The importance paper's Gerr^2 + length^2 + sqrt(length * dcolor): the new
                 // vertex at the edge's midpoint (its Fig. 2), Gerr its distance to the closest
                 // point of the input surface.
-                let v = scale(add(pa, pb), 0.5);
                 let gerr = self.surface.as_ref().map_or(0.0, |s| s.distance(v));
                 let dc = len(sub(self.color[a as usize], self.color[b as usize]));
                 (v, gerr * gerr + len2 + libm::sqrt(libm::sqrt(len2) * dc))
@@ -445,11 +456,16 @@ impl<'o> Engine<'o> {
         let q = self.quadric[ia].add(&self.quadric[ib]);
         self.quadric.push(q);
         self.area.push(self.area[ia] + self.area[ib]);
-        let (wa, wb) = (self.area[ia].max(1e-30), self.area[ib].max(1e-30));
-        let c = scale(
-            add(scale(self.color[ia], wa), scale(self.color[ib], wb)),
-            1.0 / (wa + wb),
-        );
+        let c = match kept(self.opts, v, [self.pos[ia], self.pos[ib]]) {
+            Some(k) => self.color[[ia, ib][k]],
+            None => {
+                let (wa, wb) = (self.area[ia].max(1e-30), self.area[ib].max(1e-30));
+                scale(
+                    add(scale(self.color[ia], wa), scale(self.color[ib], wb)),
+                    1.0 / (wa + wb),
+                )
+            }
+        };
         self.color.push(c);
 
         let mut pf = Vec::new();

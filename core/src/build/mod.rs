@@ -71,6 +71,21 @@ pub enum Cost {
     Color,
 }
 
+/// Where a collapse puts the vertex it makes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Placement {
+    /// Where the cost puts it: the quadrics' minimiser for [`Cost::Quadric`], the edge's
+    /// midpoint for the other two.
+    #[default]
+    Cost,
+    /// On the endpoint with the smaller quadric error (a half-edge collapse), with that
+    /// endpoint's normal and colour: every vertex of the forest is an input vertex, so a split
+    /// leaves the triangles around the staying child as they were (a terrain's vertices stay on
+    /// its samples). Fewer triangles change from frame to frame, at some cost in fidelity
+    /// (`vdlod-demo reproduce terrain-engines`).
+    Endpoint,
+}
+
 /// What a parent's two error-bound lengths hold (the file's `a` and `b` codes), and how they are
 /// measured.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -103,6 +118,8 @@ pub struct BuildOptions {
     pub base_vertices: u32,
     /// The error bound the parents carry.
     pub bound: ErrorBound,
+    /// Where merged vertices go.
+    pub placement: Placement,
 }
 
 /// Progress of a build, for a progress bar.

@@ -164,6 +164,45 @@ fn sphere_round_trips_keeps_genus_and_stays_shallow_when_balanced() {
 }
 
 #[test]
+fn endpoint_placement_keeps_every_vertex_an_input_vertex() {
+    // A coloured grid: every parent repeats one child's position, normal and colour bit for
+    // bit (the child that stays), so the whole forest holds only input vertices; the forest
+    // still replays to the input and its bounds hold.
+    let (p, t) = grid(10);
+    let colors: Vec<[u8; 3]> = (0..p.len())
+        .map(|i| [(i % 7 * 30) as u8, (i % 5 * 50) as u8, 128])
+        .collect();
+    let mesh = InputMesh {
+        positions: &p,
+        colors: Some(&colors),
+        triangles: &t,
+    };
+    for cost in [Cost::Quadric, Cost::ShortestEdge, Cost::Color] {
+        let opts = BuildOptions {
+            cost,
+            placement: Placement::Endpoint,
+            ..BuildOptions::default()
+        };
+        let h = build(&mesh, &opts, &mut |_| {}).expect("valid mesh");
+        assert_eq!(sorted(h.refine_all()), sorted(t.clone()), "{cost:?}");
+        let vertex = |n: &Node| (n.position, n.normal, n.color);
+        for node in &h.nodes[h.leaves as usize..] {
+            let [a, b] = node.children.map(|c| vertex(&h.nodes[c as usize]));
+            assert!(vertex(node) == a || vertex(node) == b, "{cost:?}");
+            assert!(p.contains(&node.position), "{cost:?}");
+        }
+        bounds_hold(&h);
+    }
+    // Placed by the cost, a parent of the curved grid sits between its children.
+    let h = build(&mesh, &BuildOptions::default(), &mut |_| {}).expect("valid mesh");
+    let moved = h.nodes[h.leaves as usize..]
+        .iter()
+        .filter(|n| !p.contains(&n.position))
+        .count();
+    assert!(moved * 2 > h.nodes.len() - h.leaves as usize, "{moved}");
+}
+
+#[test]
 fn base_size_is_respected() {
     let (p, t) = sphere(3);
     let h = build_it(
