@@ -266,8 +266,9 @@ enum Experiment {
     /// and 10% with its colour cost and with QEM, then refined with its importance test at its
     /// threshold of 0.3; the figure set and PSNR against full detail.
     Terrain,
-    /// Both engines (wavelets, vertex forest) on one 257 x 257 terrain's fly-over at equal
-    /// triangle counts: PSNR, new triangles per frame, adaptation time, file and cut sizes.
+    /// Both engines (wavelets, and the vertex forest built by default and on endpoints) on one
+    /// 257 x 257 terrain's fly-over at equal triangle counts: PSNR, new triangles per frame,
+    /// adaptation time, file and cut sizes.
     TerrainEngines,
     /// Both engines on a 1025 x 1025 terrain at Lindstrom et al.'s tolerances (0.5, 1, 2,
     /// 4 px): triangles and the share of pixels differing from full detail (takes minutes and

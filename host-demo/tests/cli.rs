@@ -269,6 +269,27 @@ fn hoppe_bounds_are_built_marked_and_flown_with_his_test() {
 }
 
 #[test]
+fn endpoint_placement_builds_and_flies() {
+    let dir = scratch_dir("cli_placement");
+    let head = fixture("head.obj");
+    let args = ["build", head.to_str().unwrap(), "-o", "e.vdh"];
+    let built = succeed(&[&args[..], &["--placement", "endpoint"]].concat(), &dir);
+    let built = String::from_utf8_lossy(&built.stdout).into_owned();
+    assert!(built.contains("vertices 1487, faces 2918"), "{built}");
+    succeed(&["orbit", "e.vdh", "--frames", "2", "-o", "o"], &dir);
+    // The terrain's forest too; the stats count new triangles by what the vertices are.
+    let terrain = ["terrain", "--size", "33", "--frames", "3", "--width", "48"];
+    let out = succeed(
+        &[&terrain[..], &["--height", "32", "--placement", "endpoint"]].concat(),
+        &dir,
+    );
+    assert!(String::from_utf8_lossy(&out.stdout).contains("new)"));
+    assert!(dir.join("out/terrain/stats.csv").exists());
+    let out = demo(&[&args[..], &["--placement", "middle"]].concat(), &dir);
+    assert!(!out.status.success());
+}
+
+#[test]
 fn info_rejects_corrupted_files_in_one_line() {
     let dir = scratch_dir("cli_info_bad");
     let out = demo(
