@@ -330,6 +330,7 @@ fn relaxed(input: &InputMesh<'_>, mesh: &mut SemiRegular, on_input: &mut [(u32, 
         surface: &surface,
         normals: relax::Relax::normals(input),
         around_remesh: relax::Around::new(n, &triangles),
+        reach: 0.0,
     };
     relax.run(RELAX_ROUNDS, false, &mut mesh.positions, on_input);
     // Past the chord error a remesh this fine has anyway: its mean edge.
@@ -352,6 +353,7 @@ fn relaxed(input: &InputMesh<'_>, mesh: &mut SemiRegular, on_input: &mut [(u32, 
         }
         relax.run(RELAX_ROUNDS / 4, false, &mut mesh.positions, on_input);
     }
+    relax.reach = reach;
     relax.run(UNTANGLE_ROUNDS, true, &mut mesh.positions, on_input);
 }
 

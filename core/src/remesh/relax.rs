@@ -7,8 +7,9 @@
 //! plane, and puts it back on the input at the closest point of the triangles around where it
 //! was (a local walk, so a point never jumps across a thin part to the far side). A move is kept
 //! when it leaves fewer triangles around the vertex facing against the input, or as few and none
-//! worse shaped than the worst it had; border vertices stay, and vertices snapped onto a tip
-//! move only to untangle.
+//! worse shaped than the worst it had; a vertex of a triangle facing the wrong way also tries
+//! the centre of its star's kernel in a plane across the input there. Border vertices stay, and
+//! vertices snapped onto a tip move only to untangle.
 
 use alloc::vec;
 use alloc::vec::Vec;
@@ -70,6 +71,9 @@ pub(super) struct Relax<'a> {
     pub normals: Vec<Vec3d>,
     /// The remesh's triangles around each of its vertices.
     pub around_remesh: Around,
+    /// A gap from the input that an untangling move may open wherever it is, however close
+    /// the triangles were (the snapping's reach).
+    pub reach: f64,
 }
 
 impl Relax<'_> {
@@ -229,6 +233,91 @@ impl Relax<'_> {
         (against, least)
     }
 
+    /// Where `v` makes every triangle around it face the way the input does, as far as a plane
+    /// can tell: the ring of `v`'s neighbours is laid on the plane across the input's normals
+    /// there, and the region of that plane from which every ring edge is seen counter-clockwise
+    /// (the star's kernel, the ring's half-planes clipped from a box round it) gives its area
+    /// centroid. `None` when the kernel is empty (the ring itself is tangled: its vertices
+    /// must move first) or the ring is not a plain cycle of triangles.
+    fn kernel(
+        &self,
+        tris: &[u32],
+        v: u32,
+        positions: &[[f32; 3]],
+        on_input: &[(u32, [f64; 3])],
+    ) -> Option<Vec3d> {
+        let here = from_f32(positions[v as usize]);
+        let mut normal = self.normals[on_input[v as usize].0 as usize];
+        let mut edges: Vec<(u32, u32)> = Vec::with_capacity(tris.len());
+        for &t in tris {
+            let tri = self.triangles[t as usize];
+            let k = tri.iter().position(|&x| x == v)?;
+            let (a, b) = (tri[(k + 1) % 3], tri[(k + 2) % 3]);
+            normal = add(normal, self.normals[on_input[a as usize].0 as usize]);
+            edges.push((a, b));
+        }
+        let n = normalize(normal)?;
+        // Any unit vector across n, and the third axis.
+        let seed = if n[0].abs() < 0.6 {
+            [1.0, 0.0, 0.0]
+        } else {
+            [0.0, 1.0, 0.0]
+        };
+        let u = normalize(sub(seed, scale(n, dot(seed, n))))?;
+        let w = cross(n, u);
+        let flat = |x: u32| {
+            let d = sub(from_f32(positions[x as usize]), here);
+            [dot(d, u), dot(d, w)]
+        };
+        let mut reach = 0.0f64;
+        for &(a, _) in &edges {
+            let [x, y] = flat(a);
+            reach = reach.max(x.abs()).max(y.abs());
+        }
+        if reach <= 0.0 {
+            return None;
+        }
+        let r = 2.0 * reach;
+        let mut poly: Vec<[f64; 2]> = vec![[-r, -r], [r, -r], [r, r], [-r, r]];
+        let mut next: Vec<[f64; 2]> = Vec::with_capacity(poly.len() + edges.len());
+        for &(a, b) in &edges {
+            let (pa, pb) = (flat(a), flat(b));
+            let e = [pb[0] - pa[0], pb[1] - pa[1]];
+            // Positive on the side from which a -> b turns counter-clockwise.
+            let side = |p: [f64; 2]| e[0] * (p[1] - pa[1]) - e[1] * (p[0] - pa[0]);
+            next.clear();
+            for (i, &p) in poly.iter().enumerate() {
+                let q = poly[(i + 1) % poly.len()];
+                let (sp, sq) = (side(p), side(q));
+                if sp > 0.0 {
+                    next.push(p);
+                }
+                if (sp > 0.0) != (sq > 0.0) {
+                    let t = sp / (sp - sq);
+                    next.push([p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])]);
+                }
+            }
+            core::mem::swap(&mut poly, &mut next);
+            if poly.len() < 3 {
+                return None;
+            }
+        }
+        // The area centroid of the (convex) kernel.
+        let (mut area, mut cx, mut cy) = (0.0, 0.0, 0.0);
+        for (i, &p) in poly.iter().enumerate() {
+            let q = poly[(i + 1) % poly.len()];
+            let c = p[0] * q[1] - q[0] * p[1];
+            area += c;
+            cx += (p[0] + q[0]) * c;
+            cy += (p[1] + q[1]) * c;
+        }
+        if area <= 0.0 {
+            return None;
+        }
+        let (x, y) = (cx / (3.0 * area), cy / (3.0 * area));
+        Some(add(here, add(scale(u, x), scale(w, y))))
+    }
+
     /// `rounds` rounds over every free vertex (or, with `tangled`, over the vertices of
     /// triangles facing the wrong way only); `on_input` and `positions` are updated together.
     pub(super) fn run(
@@ -282,6 +371,7 @@ impl Relax<'_> {
                 targets.push(add(here, scale(tangent, 0.5)));
                 if before > 0 {
                     targets.push(add(here, tangent));
+                    targets.extend(self.kernel(tris, v, positions, on_input));
                 }
                 // In the last rounds over the tangles, half way to each neighbour too (a tip
                 // stays unless the move untangles; it does not wander between neighbours).
@@ -321,7 +411,9 @@ impl Relax<'_> {
                         && best.is_none_or(|(a, ..)| after < a)
                         && (!tangled
                             || self.gap(tris, v, moved, positions)
-                                <= *gap.get_or_insert_with(|| self.gap(tris, v, here, positions)))
+                                <= *gap.get_or_insert_with(|| {
+                                    self.gap(tris, v, here, positions).max(self.reach)
+                                }))
                     {
                         best = Some((after, face, w, moved));
                     }
