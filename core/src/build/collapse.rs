@@ -70,6 +70,9 @@ pub(crate) struct Engine<'o> {
     /// squared edges`, 1 for equilateral), unless the region already had one as bad: 0 for the
     /// hierarchy builder, where shape does not matter; the remesher's base faces need it.
     pub min_shape: f64,
+    /// The remesher's border rules ([`Engine::keep_borders`]): which vertices sit on a corner of
+    /// the input's border, where it turns by more than 30 degrees. Empty: no such rules.
+    pub corners: Vec<bool>,
 }
 
 /// `4 sqrt(3) area / (sum of squared edge lengths)`: 1 for an equilateral triangle, 0 for a
@@ -162,6 +165,7 @@ impl<'o> Engine<'o> {
                 .then(|| Surface::new(mesh.positions, mesh.triangles)),
             planar: None,
             min_shape: 0.0,
+            corners: Vec::new(),
         };
         e.alive_count = e.alive.iter().filter(|&&a| a).count();
         // Boundary quadrics keep open borders in place.
@@ -236,6 +240,32 @@ impl<'o> Engine<'o> {
             .collect()
     }
 
+    /// Turns on the remesher's border rules: the border stays where it is (an edge from it
+    /// inwards merges onto its border end, a border edge at a corner onto the corner), and only
+    /// a corner may be left with a single triangle (an ear). An ear where the border runs
+    /// straight subdivides into a corner triangle whose three vertices lie on one line.
+    pub fn keep_borders(&mut self) {
+        let turn = libm::cos(30f64.to_radians());
+        self.corners = (0..self.pos.len() as u32)
+            .map(|v| match self.boundary_neighbours(v).as_slice() {
+                &[x, y] => {
+                    let at = self.pos[v as usize];
+                    let (dx, dy) = (sub(at, self.pos[x as usize]), sub(self.pos[y as usize], at));
+                    let (lx, ly) = (len(dx), len(dy));
+                    !(lx > 0.0 && ly > 0.0 && dot(dx, dy) / (lx * ly) > turn)
+                }
+                _ => false,
+            })
+            .collect();
+    }
+
+    /// Whether the vertex that merges `a` and `b` at `v` is on a corner: one of them was, and
+    /// `v` is where it was.
+    fn corner_at(&self, a: u32, b: u32, v: Vec3d) -> bool {
+        let (pa, pb) = (self.pos[a as usize], self.pos[b as usize]);
+        (self.corners[a as usize] && v == pa) || (self.corners[b as usize] && v == pb)
+    }
+
     /// Where the merged vertex goes and what the collapse costs.
     fn evaluate(&self, a: u32, b: u32) -> (Vec3d, f64) {
         let (pa, pb) = (self.pos[a as usize], self.pos[b as usize]);
@@ -246,6 +276,17 @@ impl<'o> Engine<'o> {
             (Placement::Endpoint, _) => pa,
             (Placement::Cost, Cost::Quadric) => place(&q, pa, pb),
             (Placement::Cost, _) => scale(add(pa, pb), 0.5),
+        };
+        let v = if self.corners.is_empty() {
+            v
+        } else {
+            let border = |x: u32| self.vfaces[x as usize].len() < self.neighbours(x).len();
+            let corner = |x: u32| self.corners[x as usize];
+            match (border(a), border(b), corner(a), corner(b)) {
+                (true, false, ..) | (true, true, true, false) => pa,
+                (false, true, ..) | (true, true, false, true) => pb,
+                _ => v,
+            }
         };
         match self.opts.cost {
             Cost::Quadric => (v, q.error(v)),
@@ -334,12 +375,16 @@ impl<'o> Engine<'o> {
         // closed component from shrinking below a tetrahedron).
         let degree_p = na.len() + nb.len() - 2 - common.len();
         let border_p = ba || bb;
-        if degree_p < if border_p { 2 } else { 3 } {
+        // Under the remesher's border rules only a corner may be left as an ear.
+        let ruled = !self.corners.is_empty();
+        let straight = |x: u32| usize::from(ruled && !self.corners[x as usize]);
+        let straight_p = usize::from(ruled && !self.corner_at(a, b, v));
+        if degree_p < if border_p { 2 + straight_p } else { 3 } {
             return Ok(false);
         }
         for &x in &w {
             let ring = self.neighbours(x);
-            let min = if border(x, ring) { 3 } else { 4 };
+            let min = if border(x, ring) { 3 + straight(x) } else { 4 };
             if ring.len() < min {
                 return Ok(false);
             }
@@ -467,6 +512,10 @@ impl<'o> Engine<'o> {
             }
         };
         self.color.push(c);
+        if !self.corners.is_empty() {
+            let corner = self.corner_at(a, b, v);
+            self.corners.push(corner);
+        }
 
         let mut pf = Vec::new();
         for s in [a, b] {

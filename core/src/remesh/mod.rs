@@ -9,7 +9,9 @@
 //! 1. The vertex forest's own edge collapses (quadric costs, the same legality tests) simplify
 //!    the input to the chosen base size; each collapse also maps its region into the plane
 //!    before and after ([`crate::build`]'s `flatten`), and an edge whose region cannot be mapped
-//!    without a fold is not collapsed.
+//!    without a fold is not collapsed. A border stays where it is: edges from it merge onto it,
+//!    border edges at a corner onto the corner, and only a corner may be left with a single base
+//!    triangle (an ear on a straight stretch subdivides into triangles with no area).
 //! 2. The base mesh is subdivided `J` times; every vertex of every level is a point of a base
 //!    face at known barycentric weights.
 //! 3. Each point is carried back through the collapses, last first: where a collapse touched its
@@ -215,6 +217,7 @@ pub fn remesh(
     let mut engine = Engine::new(input, &build_options);
     engine.planar = Some(Vec::new());
     engine.min_shape = MIN_SHAPE;
+    engine.keep_borders();
     let (faces, collapses) = simplify(&mut engine, options.base_faces, input_faces, progress);
     if faces > options.base_faces.saturating_mul(2) {
         return Err(RemeshError::NotReached {

@@ -84,6 +84,29 @@ fn an_open_grid_keeps_its_border() {
             },
         );
         assert_eq!((lo, hi), ([0.0; 2], [1.0; 2]));
+        // No base ear where the border runs straight: a corner triangle with three vertices on
+        // it would have no area (the grid's own corners turn, and may keep theirs).
+        let finest = out.mesh.finest_triangles();
+        let mut edges: Vec<(u32, u32)> = finest
+            .iter()
+            .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
+            .collect();
+        edges.sort_unstable();
+        let mut on_border = vec![false; out.mesh.positions.len()];
+        for &(a, b) in &edges {
+            if edges.binary_search(&(b, a)).is_err() {
+                on_border[a as usize] = true;
+                on_border[b as usize] = true;
+            }
+        }
+        for t in finest
+            .iter()
+            .filter(|t| t.iter().all(|&v| on_border[v as usize]))
+        {
+            let corners = t.map(|v| crate::build::vec3::from_f32(out.mesh.positions[v as usize]));
+            let shape = crate::build::collapse::shape(corners);
+            assert!(shape > 0.1, "{levels}: {t:?} {shape}");
+        }
         if levels == 4 {
             assert!(q.hausdorff < 0.01 && q.rms < 0.001, "{q:?}");
         }
