@@ -34,10 +34,10 @@ fn fixtures_remesh_onto_themselves() {
         let q = out.quality(&input(&mesh));
         assert!(q.rms < 0.001, "{name}: {q:?}");
         assert!(q.hausdorff < 0.01, "{name}: {q:?}");
-        // Flipped triangles are not zero yet on the cow and the elk (the README says where);
-        // they stay rare, and the head's border rules leave it none.
+        // Flipped triangles are not zero yet on the elk (the README says where); they stay
+        // rare, and the others have none.
         assert!(q.flipped * 4000 < finest.len() as u32, "{name}: {q:?}");
-        if matches!(name, "head.obj" | "fandisk.obj") {
+        if name != "elk.obj" {
             assert_eq!(q.flipped, 0, "{name}: {q:?}");
         }
         // The relaxation leaves few slivers.

@@ -300,7 +300,7 @@ const RELAX_ROUNDS: u32 = 24;
 const SNAP_REACH: f64 = 0.003;
 
 /// Rounds over the vertices of triangles still facing the wrong way, at the end.
-const UNTANGLE_ROUNDS: u32 = 32;
+const UNTANGLE_ROUNDS: u32 = 128;
 
 /// Passes of snapping (each followed by a few rounds of relaxation).
 const SNAP_PASSES: u32 = 3;
