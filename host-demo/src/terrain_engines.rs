@@ -328,31 +328,21 @@ pub fn terrain_engines(out: &Path, setup: Setup) -> Result<Vec<String>, String> 
     };
     let new_pct = |f: &EngineFrame| 100.0 * f.new as f64 / f.triangles.max(1) as f64;
     let psnr_db = |f: &EngineFrame| f.psnr_db.min(99.0);
+    let panel = |what: &'static str, f: fn(&EngineFrame) -> f64| Panel {
+        title: vec![
+            (what, BLUE),
+            (", vertex forest", ORANGE),
+            (", on endpoints", GREEN),
+        ],
+        series: vec![
+            (series(0, f), BLUE),
+            (series(1, f), ORANGE),
+            (series(2, f), GREEN),
+        ],
+    };
     let png = chart::panels(&[
-        Panel {
-            title: vec![
-                ("percent new triangles per frame: wavelets", BLUE),
-                (", vertex forest", ORANGE),
-                (", on endpoints", GREEN),
-            ],
-            series: vec![
-                (series(0, new_pct), BLUE),
-                (series(1, new_pct), ORANGE),
-                (series(2, new_pct), GREEN),
-            ],
-        },
-        Panel {
-            title: vec![
-                ("PSNR dB: wavelets", BLUE),
-                (", vertex forest", ORANGE),
-                (", on endpoints", GREEN),
-            ],
-            series: vec![
-                (series(0, psnr_db), BLUE),
-                (series(1, psnr_db), ORANGE),
-                (series(2, psnr_db), GREEN),
-            ],
-        },
+        panel("percent new triangles per frame: wavelets", new_pct),
+        panel("PSNR dB: wavelets", psnr_db),
     ])?;
     let path = out.join("terrain_engines.png");
     std::fs::write(&path, png).map_err(|e| format!("{}: cannot write: {e}", path.display()))?;
