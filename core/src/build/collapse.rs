@@ -293,8 +293,8 @@ impl<'o> Engine<'o> {
             Cost::ShortestEdge => (v, len2),
             Cost::Color => {
                 // The importance paper's Gerr^2 + length^2 + sqrt(length * dcolor): the new
-                // vertex at the edge's midpoint (its Fig. 2), Gerr its distance to the closest
-                // point of the input surface.
+                // vertex at the edge's midpoint (its Fig. 2; or on an endpoint), Gerr its
+                // distance to the closest point of the input surface.
                 let gerr = self.surface.as_ref().map_or(0.0, |s| s.distance(v));
                 let dc = len(sub(self.color[a as usize], self.color[b as usize]));
                 (v, gerr * gerr + len2 + libm::sqrt(libm::sqrt(len2) * dc))

@@ -63,11 +63,12 @@ pub enum Cost {
     /// Quadric error metric with optimal placement.
     #[default]
     Quadric,
-    /// Shortest edge first, merged at its midpoint (merge-tree paper §3.1).
+    /// Shortest edge first, merged at its midpoint (merge-tree paper §3.1; see [`Placement`]).
     ShortestEdge,
     /// The importance paper's colour-aware cost `Gerr^2 + length^2 + sqrt(length * dcolor)`:
-    /// the merged vertex at the edge's midpoint, `Gerr` its distance to the closest point of
-    /// the input surface, `dcolor` the RGB distance of the two colours (0..1 per channel).
+    /// the merged vertex at the edge's midpoint ([`Placement`]), `Gerr` its distance to the
+    /// closest point of the input surface, `dcolor` the RGB distance of the two colours (0..1
+    /// per channel).
     Color,
 }
 

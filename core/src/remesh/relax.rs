@@ -238,7 +238,7 @@ impl Relax<'_> {
     /// there, and the region of that plane from which every ring edge is seen counter-clockwise
     /// (the star's kernel, the ring's half-planes clipped from a box round it) gives its area
     /// centroid. `None` when the kernel is empty (the ring itself is tangled: its vertices
-    /// must move first) or the ring is not a plain cycle of triangles.
+    /// must move first) or the input's normals there cancel out.
     fn kernel(
         &self,
         tris: &[u32],
@@ -269,15 +269,15 @@ impl Relax<'_> {
             let d = sub(from_f32(positions[x as usize]), here);
             [dot(d, u), dot(d, w)]
         };
-        let mut reach = 0.0f64;
+        let mut extent = 0.0f64;
         for &(a, _) in &edges {
             let [x, y] = flat(a);
-            reach = reach.max(x.abs()).max(y.abs());
+            extent = extent.max(x.abs()).max(y.abs());
         }
-        if reach <= 0.0 {
+        if extent <= 0.0 {
             return None;
         }
-        let r = 2.0 * reach;
+        let r = 2.0 * extent;
         let mut poly: Vec<[f64; 2]> = vec![[-r, -r], [r, -r], [r, r], [-r, r]];
         let mut next: Vec<[f64; 2]> = Vec::with_capacity(poly.len() + edges.len());
         for &(a, b) in &edges {
