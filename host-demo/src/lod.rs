@@ -385,18 +385,30 @@ pub fn vertex_names(h: &HierarchyView<'_>) -> Vec<u32> {
         let (p, n, c) = h.vertex(i);
         (p.map(f32::to_bits), n.map(f32::to_bits), c)
     };
-    (0..h.nodes())
-        .map(|mut n| {
-            while h.is_parent(n) {
-                let k = key(n);
-                match h.children(n).into_iter().find(|&c| key(c) == k) {
-                    Some(c) => n = c,
-                    None => break,
-                }
-            }
-            n
-        })
-        .collect()
+    // A child's id is larger than its parent's: from the last node down, every child is named
+    // before its parent.
+    let mut names: Vec<u32> = (0..h.nodes()).collect();
+    for n in (0..h.nodes()).rev().filter(|&n| h.is_parent(n)) {
+        let k = key(n);
+        if let Some(c) = h.children(n).into_iter().find(|&c| key(c) == k) {
+            names[n as usize] = names[c as usize];
+        }
+    }
+    names
+}
+
+/// A vertex cut's triangles as [`triangle_set`] compares them, each corner by its node's
+/// [`vertex_names`] entry.
+pub fn cut_triangle_set<const V: usize, const F: usize, const Q: usize, I: SlotIndex>(
+    cut: &Cut<V, F, Q, I>,
+    names: &[u32],
+) -> Vec<[u32; 3]> {
+    let nodes = cut.nodes();
+    triangle_set(
+        cut.triangles()
+            .iter()
+            .map(|t| t.map(|i| names[nodes[i.index()] as usize])),
+    )
 }
 
 /// How many of `now` are not in `before` (both from [`triangle_set`]): ROAM's measure of how
@@ -736,13 +748,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex + VertexIndex>
     }
 
     fn triangle_set(&self) -> Vec<[u32; 3]> {
-        let nodes = self.cut.nodes();
-        triangle_set(
-            self.cut
-                .triangles()
-                .iter()
-                .map(|t| t.map(|i| self.names[nodes[i.index()] as usize])),
-        )
+        cut_triangle_set(self.cut, &self.names)
     }
 }
 

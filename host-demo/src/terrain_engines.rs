@@ -39,7 +39,7 @@ use crate::chart::{self, Panel, BLUE, GREEN, ORANGE};
 use crate::frame::Frame;
 use crate::ground::{draw_on_ground, GroundTexture};
 use crate::hierarchy::build_with_progress;
-use crate::lod::{new_triangles, psnr, triangle_set, vertex_names};
+use crate::lod::{cut_triangle_set, new_triangles, psnr, triangle_set, vertex_names};
 use crate::mesh::IndexedMesh;
 use crate::render::style;
 use crate::terrain::{FlyOver, Terrain, DEFAULT_VERTICAL_SCALE, UP_AXIS};
@@ -286,12 +286,7 @@ pub fn terrain_engines(out: &Path, setup: Setup) -> Result<Vec<String>, String> 
             frame
                 .draw_cut(cut, h, camera, drawn)
                 .map_err(|e| e.to_string())?;
-            let nodes = cut.nodes();
-            let now = triangle_set(
-                cut.triangles()
-                    .iter()
-                    .map(|t| t.map(|i| names[k][nodes[i as usize] as usize])),
-            );
+            let now = cut_triangle_set(cut, &names[k]);
             forests[k] = EngineFrame {
                 triangles: stats.triangles,
                 new: new_triangles(&before[k + 1], &now),
