@@ -24,7 +24,8 @@
 //!    shrink spikes, so a horn's tip gets no point. A relaxation on the input surface evens the
 //!    triangles out and untangles the few that face the wrong way, then the input vertices
 //!    still farther from the remesh than 0.3% of the diagonal and than its mean edge (the tips)
-//!    each pull the nearest remesh vertex onto themselves (`relax`).
+//!    each pull one of the nearest remesh vertices onto themselves (`relax`); the last folds
+//!    are untangled a patch at a time, by descent on an untangling energy (`untangle`).
 //!
 //! Every vertex stays on the input surface, the result keeps the input's genus and borders,
 //! and colours follow each vertex's place on the input ([`Remesh::on_input`]).
@@ -56,6 +57,7 @@
 
 mod quality;
 mod relax;
+mod untangle;
 
 use alloc::vec;
 use alloc::vec::Vec;
@@ -358,6 +360,7 @@ fn relaxed(input: &InputMesh<'_>, mesh: &mut SemiRegular, on_input: &mut [(u32, 
     }
     relax.reach = reach;
     relax.run(UNTANGLE_ROUNDS, true, &mut mesh.positions, on_input);
+    relax.untangle(&mut mesh.positions, on_input);
 }
 
 /// Collapses edges until at most `base_faces` faces are left or none is legal; returns the faces

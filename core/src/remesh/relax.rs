@@ -9,7 +9,8 @@
 //! when it leaves fewer triangles around the vertex facing against the input, or as few and none
 //! worse shaped than the worst it had; a vertex of a triangle facing the wrong way also tries
 //! the centre of its star's kernel in a plane across the input there. Border vertices stay, and
-//! vertices snapped onto a tip move only to untangle.
+//! vertices snapped onto a tip move only to untangle. The folds this leaves are untangled a
+//! patch at a time (`untangle`).
 
 use alloc::vec;
 use alloc::vec::Vec;
@@ -21,6 +22,9 @@ use crate::build::InputMesh;
 
 /// How many of the nearest free vertices a far input vertex tries to pull.
 const SNAP_TRIES: usize = 8;
+
+/// How many of those a tip tries to pull with its neighbours untangling round it.
+const UNTANGLE_TRIES: usize = 3;
 
 /// The input's triangles around each vertex, as flat arrays.
 pub(super) struct Around {
@@ -50,7 +54,7 @@ impl Around {
         Around { starts, faces }
     }
 
-    fn of(&self, v: u32) -> &[u32] {
+    pub(super) fn of(&self, v: u32) -> &[u32] {
         &self.faces[self.starts[v as usize] as usize..self.starts[v as usize + 1] as usize]
     }
 }
@@ -77,7 +81,7 @@ pub(super) struct Relax<'a> {
 }
 
 impl Relax<'_> {
-    fn corners(&self, f: u32) -> [Vec3d; 3] {
+    pub(super) fn corners(&self, f: u32) -> [Vec3d; 3] {
         self.input.triangles[f as usize].map(|v| from_f32(self.input.positions[v as usize]))
     }
 
@@ -95,7 +99,7 @@ impl Relax<'_> {
 
     /// The closest point to `p` on the input triangles around `face`, walking on while a
     /// neighbouring triangle is closer (at most a few steps).
-    fn project(&self, p: Vec3d, face: u32) -> (u32, [f64; 3]) {
+    pub(super) fn project(&self, p: Vec3d, face: u32) -> (u32, [f64; 3]) {
         let mut best = (face, closest(p, self.corners(face)));
         for _ in 0..4 {
             let start = best.0;
@@ -114,9 +118,11 @@ impl Relax<'_> {
         (best.0, best.1 .0)
     }
 
-    /// Moves the nearest free remesh vertex onto each input vertex farther than `reach` from
-    /// the remesh (a spike's tip the map left unsampled), farthest first, where that turns no
-    /// triangle against the input; a vertex moved there stays. Returns how many moved.
+    /// Moves one of the nearest free remesh vertices onto each input vertex farther than `reach`
+    /// from the remesh (a spike's tip the map left unsampled), farthest first, where that turns
+    /// no triangle against the input or its neighbours can untangle what it turns
+    /// ([`Relax::move_untangled`]), preferring moves that open no gap wider than `reach`; a
+    /// vertex moved there stays. Returns how many moved.
     pub(super) fn snap(
         &mut self,
         reach: f64,
@@ -134,6 +140,7 @@ impl Relax<'_> {
             .collect();
         far.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
         let mut moved = 0;
+        let mut candidates: Vec<(u32, bool, f64)> = Vec::new();
         for (distance, x) in far {
             let Some(&face) = self.around.of(x).first() else {
                 continue;
@@ -162,21 +169,57 @@ impl Relax<'_> {
                 .select_nth_unstable_by(tried - 1, |a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
             nearest.truncate(tried);
             nearest.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            // Nearest first, the first move that turns no triangle against the input and opens
+            // no gap wider than the reach; else the first whose folds its neighbours can
+            // untangle within the reach; else, of the moves that turn nothing, the one opening
+            // the smallest gap, if narrower than the one it closes.
+            candidates.clear();
+            let mut chosen = None;
             for (_, v) in nearest {
                 let tris = self.around_remesh.of(v as u32);
                 let (before, _) = self.facing(tris, v as u32, None, positions, on_input);
                 let (after, _) =
                     self.facing(tris, v as u32, Some((target, face)), positions, on_input);
-                // Nor may it open a gap wider than the one it closes: the moved triangles'
-                // centroids and edge midpoints stay nearer the input than the vertex was.
                 let gap = self.gap(tris, v as u32, target, positions);
-                if after <= before && gap < distance {
-                    positions[v] = target.map(|c| c as f32);
-                    on_input[v] = (face, w);
-                    self.snapped[v] = true;
-                    moved += 1;
+                if after <= before && gap <= reach {
+                    chosen = Some(v as u32);
                     break;
                 }
+                if gap < distance {
+                    candidates.push((v as u32, after <= before, gap));
+                }
+            }
+            let chosen = chosen
+                .or_else(|| {
+                    candidates
+                        .iter()
+                        .filter(|&&(_, turns_none, _)| !turns_none)
+                        .take(UNTANGLE_TRIES)
+                        .find_map(|&(v, ..)| {
+                            self.snapped[v as usize] = true;
+                            let ok = self.move_untangled(
+                                v,
+                                (target, face, w),
+                                reach,
+                                positions,
+                                on_input,
+                            );
+                            self.snapped[v as usize] = ok;
+                            ok.then_some(v)
+                        })
+                })
+                .or_else(|| {
+                    candidates
+                        .iter()
+                        .filter(|&&(_, turns_none, _)| turns_none)
+                        .min_by(|a, b| a.2.total_cmp(&b.2).then(a.0.cmp(&b.0)))
+                        .map(|&(v, ..)| v)
+                });
+            if let Some(v) = chosen {
+                positions[v as usize] = target.map(|c| c as f32);
+                on_input[v as usize] = (face, w);
+                self.snapped[v as usize] = true;
+                moved += 1;
             }
         }
         moved
@@ -184,7 +227,7 @@ impl Relax<'_> {
 
     /// The largest distance from the input of the centroids and edge midpoints of the
     /// triangles `tris` around `v`, with `v` at `at`.
-    fn gap(&self, tris: &[u32], v: u32, at: Vec3d, positions: &[[f32; 3]]) -> f64 {
+    pub(super) fn gap(&self, tris: &[u32], v: u32, at: Vec3d, positions: &[[f32; 3]]) -> f64 {
         tris.iter().fold(0.0f64, |g, &t| {
             let c = self.triangles[t as usize].map(|x| {
                 if x == v {
@@ -203,7 +246,7 @@ impl Relax<'_> {
 
     /// How many of the triangles `tris` around `v` face against the input, and the worst
     /// shape among them, with `v` where it is or at `moved` (a point and its input triangle).
-    fn facing(
+    pub(super) fn facing(
         &self,
         tris: &[u32],
         v: u32,
@@ -318,6 +361,61 @@ impl Relax<'_> {
         Some(add(here, add(scale(u, x), scale(w, y))))
     }
 
+    /// Where `v` may go this round: part of the way to its neighbours' centroid within its
+    /// tangent plane; for a vertex of a triangle facing the wrong way (`before > 0`) also all the
+    /// way and its star's kernel; in the last rounds over the tangles (`tangled`) also half way to
+    /// each neighbour (a tip stays unless a move untangles; it does not wander between
+    /// neighbours). Returns the worst shape round `v`, or `None` when its star has no normal.
+    fn targets(
+        &self,
+        v: u32,
+        before: u32,
+        tangled: bool,
+        positions: &[[f32; 3]],
+        on_input: &[(u32, [f64; 3])],
+        out: &mut Vec<Vec3d>,
+    ) -> Option<f64> {
+        out.clear();
+        let tris = self.around_remesh.of(v);
+        let here = from_f32(positions[v as usize]);
+        let mut centroid = [0.0; 3];
+        let mut normal = [0.0; 3];
+        let mut count = 0.0;
+        let mut worst = f64::INFINITY;
+        for &t in tris {
+            let c = self.triangles[t as usize].map(|x| from_f32(positions[x as usize]));
+            normal = add(normal, cross(sub(c[1], c[0]), sub(c[2], c[0])));
+            worst = worst.min(shape(c));
+            for (k, &x) in self.triangles[t as usize].iter().enumerate() {
+                if x != v {
+                    centroid = add(centroid, c[k]);
+                    count += 1.0;
+                }
+            }
+        }
+        let normal = normalize(normal)?;
+        if count == 0.0 {
+            return None;
+        }
+        let towards = sub(scale(centroid, 1.0 / count), here);
+        let tangent = sub(towards, scale(normal, dot(towards, normal)));
+        out.push(add(here, scale(tangent, 0.5)));
+        if before > 0 {
+            out.push(add(here, tangent));
+            out.extend(self.kernel(tris, v, positions, on_input));
+        }
+        if tangled && !self.snapped[v as usize] {
+            for &t in tris {
+                for &x in &self.triangles[t as usize] {
+                    if x != v {
+                        out.push(scale(add(here, from_f32(positions[x as usize])), 0.5));
+                    }
+                }
+            }
+        }
+        Some(worst)
+    }
+
     /// `rounds` rounds over every free vertex (or, with `tangled`, over the vertices of
     /// triangles facing the wrong way only); `on_input` and `positions` are updated together.
     pub(super) fn run(
@@ -328,7 +426,6 @@ impl Relax<'_> {
         on_input: &mut [(u32, [f64; 3])],
     ) {
         let n = positions.len();
-        // Triangles around each remesh vertex, flat.
         let mut targets: Vec<Vec3d> = Vec::new();
         for _ in 0..rounds {
             for v in 0..n as u32 {
@@ -340,89 +437,71 @@ impl Relax<'_> {
                 if (self.snapped[v as usize] || tangled) && before == 0 {
                     continue;
                 }
-                let here = from_f32(positions[v as usize]);
-                let mut centroid = [0.0; 3];
-                let mut normal = [0.0; 3];
-                let mut count = 0.0;
-                let mut worst = f64::INFINITY;
-                for &t in tris {
-                    let c = self.triangles[t as usize].map(|x| from_f32(positions[x as usize]));
-                    normal = add(normal, cross(sub(c[1], c[0]), sub(c[2], c[0])));
-                    worst = worst.min(shape(c));
-                    for (k, &x) in self.triangles[t as usize].iter().enumerate() {
-                        if x != v {
-                            centroid = add(centroid, c[k]);
-                            count += 1.0;
-                        }
-                    }
-                }
-                let Some(normal) = normalize(normal) else {
+                let Some(worst) =
+                    self.targets(v, before, tangled, positions, on_input, &mut targets)
+                else {
                     continue;
                 };
-                if count == 0.0 {
-                    continue;
-                }
-                let towards = sub(scale(centroid, 1.0 / count), here);
-                let tangent = sub(towards, scale(normal, dot(towards, normal)));
-                // Half way to the centroid; a vertex of a triangle facing the wrong way also
-                // tries all the way. A move is kept when it leaves fewer triangles around facing
-                // against the input, or as few and none worse shaped than the worst was.
-                targets.clear();
-                targets.push(add(here, scale(tangent, 0.5)));
-                if before > 0 {
-                    targets.push(add(here, tangent));
-                    targets.extend(self.kernel(tris, v, positions, on_input));
-                }
-                // In the last rounds over the tangles, half way to each neighbour too (a tip
-                // stays unless the move untangles; it does not wander between neighbours).
-                if tangled && !self.snapped[v as usize] {
-                    for &t in tris {
-                        for &x in &self.triangles[t as usize] {
-                            if x != v {
-                                targets
-                                    .push(scale(add(here, from_f32(positions[x as usize])), 0.5));
-                            }
-                        }
-                    }
-                }
-                let mut best: Option<(u32, u32, [f64; 3], Vec3d)> = None;
-                // In the last rounds an untangling move may not open a gap from the input wider
-                // than there was (measured once a move is worth it).
-                let mut gap = None;
-                for &target in &targets {
-                    let (face, w) = self.project(target, on_input[v as usize].0);
-                    let moved = point(self.corners(face), w);
-                    let (after, least) =
-                        self.facing(tris, v, Some((moved, face)), positions, on_input);
-                    if before == 0 {
-                        if after == 0 && least >= worst.min(0.5) {
-                            best = Some((after, face, w, moved));
-                        }
-                        break;
-                    }
-                    // A vertex of a tangle takes the move that leaves fewest triangles facing
-                    // the wrong way, even if no fewer yet: its neighbours' moves may finish it.
-                    let enough = if self.snapped[v as usize] {
-                        after < before
-                    } else {
-                        after <= before
-                    };
-                    if enough
-                        && best.is_none_or(|(a, ..)| after < a)
-                        && (!tangled
-                            || self.gap(tris, v, moved, positions)
-                                <= *gap.get_or_insert_with(|| {
-                                    self.gap(tris, v, here, positions).max(self.reach)
-                                }))
-                    {
-                        best = Some((after, face, w, moved));
-                    }
-                }
-                if let Some((_, face, w, moved)) = best {
+                if let Some((_, face, w, moved)) =
+                    self.best_move(v, before, worst, tangled, &targets, positions, on_input)
+                {
                     positions[v as usize] = moved.map(|x| x as f32);
                     on_input[v as usize] = (face, w);
                 }
             }
         }
     }
+
+    /// The move of `v` among `targets` to keep, if any: with no triangle round it facing the
+    /// wrong way (`before == 0`), the first target if it turns none and makes no triangle worse
+    /// shaped than the worst (or 0.5); else the one that leaves fewest triangles facing the wrong
+    /// way, even if no fewer yet (its neighbours' moves may finish it; a tip needs fewer), and in
+    /// the last rounds (`tangled`) opens no gap from the input wider than there was or than
+    /// [`Relax::reach`].
+    #[allow(clippy::too_many_arguments)]
+    fn best_move(
+        &self,
+        v: u32,
+        before: u32,
+        worst: f64,
+        tangled: bool,
+        targets: &[Vec3d],
+        positions: &[[f32; 3]],
+        on_input: &[(u32, [f64; 3])],
+    ) -> Option<(u32, u32, [f64; 3], Vec3d)> {
+        let tris = self.around_remesh.of(v);
+        let here = from_f32(positions[v as usize]);
+        let mut best: Option<(u32, u32, [f64; 3], Vec3d)> = None;
+        let mut gap = None;
+        for &target in targets {
+            let (face, w) = self.project(target, on_input[v as usize].0);
+            let moved = point(self.corners(face), w);
+            let (after, least) = self.facing(tris, v, Some((moved, face)), positions, on_input);
+            if before == 0 {
+                if after == 0 && least >= worst.min(0.5) {
+                    best = Some((after, face, w, moved));
+                }
+                break;
+            }
+            let enough = if self.snapped[v as usize] {
+                after < before
+            } else {
+                after <= before
+            };
+            if enough
+                && best.is_none_or(|(a, ..)| after < a)
+                && (!tangled
+                    || self.gap(tris, v, moved, positions)
+                        <= *gap.get_or_insert_with(|| {
+                            self.gap(tris, v, here, positions).max(self.reach)
+                        }))
+            {
+                best = Some((after, face, w, moved));
+            }
+        }
+        best
+    }
 }
+
+/// No vertex: [`Relax::facing`] and [`Relax::gap`] then measure the triangles as they are.
+pub(super) const NONE_VERTEX: u32 = u32::MAX;

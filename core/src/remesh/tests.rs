@@ -68,10 +68,7 @@ fn an_open_grid_keeps_its_border() {
         };
         let out = remesh(&mesh, &options, &mut |_| {}).unwrap();
         let q = check(&mesh, &out, levels);
-        // Where the base is coarse against the curvature a few triangles still flip (see the
-        // README's remesher section); here at most one in a hundred.
-        let faces: u32 = q.shapes.iter().sum();
-        assert!(q.flipped * 100 <= faces, "{levels}: {q:?}");
+        assert_eq!(q.flipped, 0, "{levels}: {q:?}");
         assert_eq!(topology(&t), (1, 1));
         // The finest level covers the grid's whole square: its border is the grid's.
         let (lo, hi) = out.mesh.positions.iter().fold(
@@ -205,4 +202,84 @@ fn bad_requests_are_typed_errors() {
             reached: 12
         }
     );
+}
+
+#[test]
+fn a_folded_patch_is_untangled() {
+    // A remeshed bumpy grid with one interior vertex thrown across a neighbour: the triangles
+    // round it face the wrong way, and the patch descent turns them back, every vertex still on
+    // the input.
+    let (p, t) = grid(24);
+    let mesh = input(&p, &t);
+    let options = RemeshOptions {
+        base_faces: 30,
+        levels: 3,
+    };
+    let out = remesh(&mesh, &options, &mut |_| {}).unwrap();
+    let triangles = out.mesh.finest_triangles();
+    let mut positions = out.mesh.positions.clone();
+    let mut on_input = out.on_input.clone();
+    let n = positions.len();
+    let around = relax::Around::new(p.len(), &t);
+    let surface = crate::build::closest::Surface::new(&p, &t);
+    let around_remesh = relax::Around::new(n, &triangles);
+    let mut fixed = vec![false; n];
+    for v in 0..n as u32 {
+        let star = around_remesh.of(v);
+        let ring: usize = star.len();
+        // On a closed fan every neighbour is shared by two triangles; count edges seen once.
+        let mut ends: Vec<u32> = star
+            .iter()
+            .flat_map(|&s| triangles[s as usize].into_iter().filter(move |&x| x != v))
+            .collect();
+        ends.sort_unstable();
+        let paired = ends.chunks(2).all(|c| c.len() == 2 && c[0] == c[1]);
+        fixed[v as usize] = ring == 0 || !paired;
+    }
+    let relax = relax::Relax {
+        input: &mesh,
+        around: &around,
+        triangles: &triangles,
+        fixed,
+        snapped: vec![false; n],
+        surface: &surface,
+        normals: relax::Relax::normals(&mesh),
+        around_remesh,
+        reach: 0.02,
+    };
+    let wrong = |positions: &[[f32; 3]], on_input: &[(u32, [f64; 3])]| {
+        (0..triangles.len() as u32)
+            .filter(|&t| relax.wrong(t, positions, on_input))
+            .count()
+    };
+    assert_eq!(wrong(&positions, &on_input), 0);
+    // The interior vertex nearest the middle, thrown across its first neighbour (on the input).
+    let v = (0..n)
+        .filter(|&v| !relax.fixed[v])
+        .min_by(|&a, &b| {
+            let d = |x: usize| (positions[x][0] - 0.5).abs() + (positions[x][1] - 0.5).abs();
+            d(a).total_cmp(&d(b))
+        })
+        .unwrap();
+    let star = relax.around_remesh.of(v as u32);
+    let x = triangles[star[0] as usize]
+        .into_iter()
+        .find(|&x| x as usize != v)
+        .unwrap() as usize;
+    let across = [0, 1, 2].map(|k| 2.0 * f64::from(positions[x][k]) - f64::from(positions[v][k]));
+    let (face, w) = relax.project(across, on_input[x].0);
+    positions[v] = crate::build::closest::point(relax.corners(face), w).map(|c| c as f32);
+    on_input[v] = (face, w);
+    let folded = wrong(&positions, &on_input);
+    assert!(folded >= 2, "{folded}");
+    assert_eq!(relax.untangle(&mut positions, &mut on_input), 0);
+    assert_eq!(wrong(&positions, &on_input), 0);
+    for (q, &(f, w)) in positions.iter().zip(&on_input) {
+        let at = crate::build::closest::point(relax.corners(f), w);
+        let d = crate::build::vec3::sub(crate::build::vec3::from_f32(*q), at);
+        assert!(
+            crate::build::vec3::dot(d, d) < 1e-10,
+            "{q:?} is off its input point"
+        );
+    }
 }
