@@ -13,7 +13,11 @@
 //! Loop-subdivided bunny: time and peak heap, and both per input triangle, so a user with a large
 //! scan knows what to expect. It has no peer here.
 //!
-//! Run: `cargo bench --bench hierarchy` (both), `-- build` or `-- remesh` (one).
+//! `scale` builds the bunny after one, two and three steps of Loop subdivision (up to 4.8M
+//! triangles), beside meshopt, and prints both per input triangle: minutes and several GB.
+//!
+//! Run: `cargo bench --bench hierarchy` (build and remesh), `-- build` or `-- remesh` (one),
+//! `-- scale` (only that).
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -50,12 +54,18 @@ static GLOBAL: Counting = Counting;
 
 const RUNS: usize = 3;
 
-/// Median seconds and peak extra heap bytes of `f`, and its last result.
-fn measure<T>(mut f: impl FnMut() -> T) -> (f64, usize, T) {
+/// Median seconds and peak extra heap bytes of `f` over [`RUNS`] runs, and its last result.
+fn measure<T>(f: impl FnMut() -> T) -> (f64, usize, T) {
+    measure_runs(RUNS, f)
+}
+
+/// [`measure`] over `runs` runs (at least one).
+fn measure_runs<T>(runs: usize, mut f: impl FnMut() -> T) -> (f64, usize, T) {
+    let runs = runs.max(1);
     let mut times = Vec::new();
     let mut peak = 0;
     let mut last = None;
-    for _ in 0..RUNS {
+    for _ in 0..runs {
         let base = IN_USE.load(Ordering::Relaxed);
         PEAK.store(base, Ordering::Relaxed);
         let t = Instant::now();
@@ -65,23 +75,24 @@ fn measure<T>(mut f: impl FnMut() -> T) -> (f64, usize, T) {
         last = Some(out);
     }
     times.sort_by(f64::total_cmp);
-    (times[RUNS / 2], peak, last.expect("RUNS > 0"))
+    (times[runs / 2], peak, last.expect("runs > 0"))
 }
 
-fn compare(name: &str, mesh: &IndexedMesh) {
+fn compare(name: &str, mesh: &IndexedMesh, runs: usize) {
     let input = InputMesh {
         positions: &mesh.positions,
         colors: None,
         triangles: &mesh.triangles,
     };
-    let (t_ours, m_ours, h) =
-        measure(|| build(&input, &BuildOptions::default(), &mut |_| {}).expect("valid mesh"));
+    let (t_ours, m_ours, h) = measure_runs(runs, || {
+        build(&input, &BuildOptions::default(), &mut |_| {}).expect("valid mesh")
+    });
     let base = h.base_triangles.len();
 
     let indices: Vec<u32> = mesh.triangles.iter().flatten().copied().collect();
     let adapter =
         VertexDataAdapter::new(meshopt::typed_to_bytes(&mesh.positions), 12, 0).expect("positions");
-    let (t_theirs, m_theirs, out) = measure(|| {
+    let (t_theirs, m_theirs, out) = measure_runs(runs, || {
         meshopt::simplify(
             &indices,
             &adapter,
@@ -103,6 +114,16 @@ fn compare(name: &str, mesh: &IndexedMesh) {
         out.len() / 3,
         t_ours / t_theirs,
         m_ours as f64 / m_theirs as f64
+    );
+    let n = mesh.triangles.len() as f64;
+    println!(
+        "{:<24} {:>8} per input triangle: vdlod {:.2} us {:.0} B | meshopt {:.3} us {:.1} B",
+        "",
+        "",
+        t_ours * 1e6 / n,
+        m_ours as f64 / n,
+        t_theirs * 1e6 / n,
+        m_theirs as f64 / n
     );
 }
 
@@ -134,15 +155,30 @@ fn main() {
     if !args.iter().any(|a| a == "--bench") {
         return;
     }
-    let only = |what: &str| {
-        let named = args.iter().any(|a| a == "build" || a == "remesh");
-        !named || args.iter().any(|a| a == what)
-    };
+    let named = |what: &str| args.iter().any(|a| a == what);
+    // `scale` (minutes, several GB) runs only when named.
+    let only = |what: &str| !["build", "remesh", "scale"].iter().any(|a| named(a)) || named(what);
     let bunny = load_obj_bytes(BUNNY_NAME, BUNNY_OBJ).expect("bundled bunny");
     let loop_bunny = bunny.loop_subdivide();
     if only("build") {
-        compare("bunny", &bunny);
-        compare("bunny, Loop-subdivided", &loop_bunny);
+        compare("bunny", &bunny, RUNS);
+        compare("bunny, Loop-subdivided", &loop_bunny, RUNS);
+    }
+    if named("scale") {
+        // Time and memory per input triangle as the input grows: the bunny after one, two and
+        // three steps of Loop subdivision (301,632 / 1,206,528 / 4,826,112 triangles), one run
+        // each of the largest.
+        let mut mesh = loop_bunny.clone();
+        for level in 1..=3 {
+            compare(
+                &format!("bunny, Loop x{level}"),
+                &mesh,
+                if level < 3 { RUNS } else { 1 },
+            );
+            if level < 3 {
+                mesh = mesh.loop_subdivide();
+            }
+        }
     }
     if only("remesh") {
         let fixtures = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures");
