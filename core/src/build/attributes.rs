@@ -49,8 +49,9 @@ fn angle(a: Vec3d, b: Vec3d) -> f64 {
     libm::atan2(len(cross(a, b)), dot(a, b))
 }
 
-pub(crate) fn finish(mesh: &InputMesh<'_>, e: Engine<'_>) -> Hierarchy {
+pub(crate) fn finish(mesh: &InputMesh<'_>, mut e: Engine<'_>) -> Hierarchy {
     let heap_pushes = e.pushed.len() as u64;
+    e.release_work();
     let leaves = mesh.positions.len();
     let m = e.pos.len();
     let mut nodes: Vec<Node> = (0..m)
@@ -63,7 +64,9 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, e: Engine<'_>) -> Hierarchy {
             parent: NONE,
             children: [NONE; 2],
             wings: [NONE; 2],
-            color: e.color[i].map(|c| (c * 255.0 + 0.5).clamp(0.0, 255.0) as u8),
+            color: e
+                .color_of(i as u32)
+                .map(|c| (c * 255.0 + 0.5).clamp(0.0, 255.0) as u8),
             ..Node::default()
         })
         .collect();

@@ -38,6 +38,7 @@ pub(crate) struct Engine<'o> {
     pub pos: Vec<Vec3d>,
     pub quadric: Vec<Quadric>,
     pub area: Vec<f64>,
+    /// Colours in `0..=1` by vertex id; empty when the mesh has none ([`Engine::color_of`]).
     pub color: Vec<[f64; 3]>,
     pub faces: Vec<[u32; 3]>,
     pub face_alive: Vec<bool>,
@@ -124,12 +125,10 @@ impl<'o> Engine<'o> {
                 area[v as usize] += ar / 3.0;
             }
         }
-        let color = (0..n)
-            .map(|i| {
-                mesh.colors
-                    .map_or([0.0; 3], |c| c[i].map(|v| v as f64 / 255.0))
-            })
-            .collect();
+        // Colours in 0..=1, only when the mesh has them (none: black, and no array).
+        let color = mesh.colors.map_or_else(Vec::new, |c| {
+            c.iter().map(|c| c.map(|v| v as f64 / 255.0)).collect()
+        });
         let mut vverts: Vec<Vec<u32>> = vec![Vec::new(); n];
         for tri in &faces {
             for k in 0..3 {
@@ -168,6 +167,19 @@ impl<'o> Engine<'o> {
             corners: Vec::new(),
         };
         e.alive_count = e.alive.iter().filter(|&&a| a).count();
+        // Every collapse makes one vertex id and at most n - 1 are made: the per-id arrays are
+        // sized once, so that none doubles (and, while it is copied, holds both sizes) mid-build.
+        let ids = n.saturating_sub(1);
+        e.pos.reserve_exact(ids);
+        e.quadric.reserve_exact(ids);
+        e.area.reserve_exact(ids);
+        e.color
+            .reserve_exact(if e.color.is_empty() { 0 } else { ids });
+        e.vfaces.reserve_exact(ids);
+        e.vverts.reserve_exact(ids);
+        e.alive.reserve_exact(ids);
+        e.rejected.reserve_exact(ids);
+        e.collapses.reserve_exact(ids);
         // Boundary quadrics keep open borders in place.
         for f in 0..e.faces.len() {
             let tri = e.faces[f];
@@ -190,6 +202,29 @@ impl<'o> Engine<'o> {
             }
         }
         e
+    }
+
+    /// Frees what only the collapses need (the heap of costs, the rings, quadrics, areas and
+    /// the input surface), keeping what the hierarchy is made from: positions, colours, faces,
+    /// the collapse records and fans. Called once the last collapse is made, so that the
+    /// hierarchy's own arrays do not add to the engine's at the build's peak.
+    pub fn release_work(&mut self) {
+        self.heap = BinaryHeap::new();
+        self.pushed = Vec::new();
+        self.deferred = Vec::new();
+        self.rejected = Vec::new();
+        self.vfaces = Vec::new();
+        self.vverts = Vec::new();
+        self.quadric = Vec::new();
+        self.area = Vec::new();
+        self.marked = Vec::new();
+        self.alive = Vec::new();
+        self.surface = None;
+    }
+
+    /// Vertex `v`'s colour in `0..=1` (black when the mesh has none).
+    pub fn color_of(&self, v: u32) -> Vec3d {
+        self.color.get(v as usize).copied().unwrap_or([0.0; 3])
     }
 
     /// Sorted distinct neighbours of a live vertex.
@@ -296,7 +331,7 @@ impl<'o> Engine<'o> {
                 // vertex at the edge's midpoint (its Fig. 2; or on an endpoint), Gerr its
                 // distance to the closest point of the input surface.
                 let gerr = self.surface.as_ref().map_or(0.0, |s| s.distance(v));
-                let dc = len(sub(self.color[a as usize], self.color[b as usize]));
+                let dc = len(sub(self.color_of(a), self.color_of(b)));
                 (v, gerr * gerr + len2 + libm::sqrt(libm::sqrt(len2) * dc))
             }
         }
@@ -501,17 +536,19 @@ impl<'o> Engine<'o> {
         let q = self.quadric[ia].add(&self.quadric[ib]);
         self.quadric.push(q);
         self.area.push(self.area[ia] + self.area[ib]);
-        let c = match kept(self.opts, v, [self.pos[ia], self.pos[ib]]) {
-            Some(k) => self.color[[ia, ib][k]],
-            None => {
-                let (wa, wb) = (self.area[ia].max(1e-30), self.area[ib].max(1e-30));
-                scale(
-                    add(scale(self.color[ia], wa), scale(self.color[ib], wb)),
-                    1.0 / (wa + wb),
-                )
-            }
-        };
-        self.color.push(c);
+        if !self.color.is_empty() {
+            let c = match kept(self.opts, v, [self.pos[ia], self.pos[ib]]) {
+                Some(k) => self.color[[ia, ib][k]],
+                None => {
+                    let (wa, wb) = (self.area[ia].max(1e-30), self.area[ib].max(1e-30));
+                    scale(
+                        add(scale(self.color[ia], wa), scale(self.color[ib], wb)),
+                        1.0 / (wa + wb),
+                    )
+                }
+            };
+            self.color.push(c);
+        }
         if !self.corners.is_empty() {
             let corner = self.corner_at(a, b, v);
             self.corners.push(corner);
@@ -567,8 +604,8 @@ impl<'o> Engine<'o> {
             neighbours,
         });
         self.rejected.push(Vec::new());
-        self.rejected[ia].clear();
-        self.rejected[ib].clear();
+        self.rejected[ia] = Vec::new();
+        self.rejected[ib] = Vec::new();
         // The ring of p: both rings but a and b. Its members swap a and b for p, which as the
         // newest vertex goes last and keeps their rings sorted.
         let mut ring: Vec<u32> = core::mem::take(&mut self.vverts[ia]);
