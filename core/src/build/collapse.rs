@@ -6,7 +6,7 @@
 //! skipped when popped, and the edges around a collapse are pushed again with fresh costs, which
 //! keeps the whole build at O(n log n) for meshes of bounded vertex degree.
 
-use alloc::collections::BinaryHeap;
+use alloc::collections::{BTreeMap, BinaryHeap};
 use alloc::vec;
 use alloc::vec::Vec;
 use core::cmp::Reverse;
@@ -36,16 +36,21 @@ pub struct Collapse {
 pub(crate) struct Engine<'o> {
     pub opts: &'o BuildOptions,
     pub pos: Vec<Vec3d>,
-    pub quadric: Vec<Quadric>,
-    pub area: Vec<f64>,
+    /// Quadric and area of each live vertex, by its slot (as are its faces and ring below): a
+    /// collapse's vertex takes its first child's slot, so there are never more slots than input
+    /// vertices.
+    quadric: Vec<Quadric>,
+    area: Vec<f64>,
+    /// The slot of each vertex id (meaningful while the vertex is live).
+    slot: Vec<u32>,
     /// Colours in `0..=1` by vertex id; empty when the mesh has none ([`Engine::color_of`]).
     pub color: Vec<[f64; 3]>,
     pub faces: Vec<[u32; 3]>,
     pub face_alive: Vec<bool>,
     marked: Vec<bool>,
-    /// Live faces around each live vertex.
-    pub vfaces: Vec<Vec<u32>>,
-    /// Sorted neighbours of each live vertex, kept up to date by [`Engine::collapse`].
+    /// Live faces around each live vertex, by slot.
+    vfaces: Vec<Vec<u32>>,
+    /// Sorted neighbours of each live vertex, by slot, kept up to date by [`Engine::collapse`].
     vverts: Vec<Vec<u32>>,
     pub alive: Vec<bool>,
     pub alive_count: usize,
@@ -54,8 +59,9 @@ pub(crate) struct Engine<'o> {
     heap: BinaryHeap<Reverse<(u32, u32)>>,
     pub pushed: Vec<(u32, u32)>,
     deferred: Vec<(u32, u32)>,
-    /// Edges found illegal, by endpoint: retried when a collapse changes that endpoint's ring.
-    rejected: Vec<Vec<u32>>,
+    /// Edges found illegal, by endpoint: retried when a collapse changes that endpoint's ring
+    /// (a map, since few vertices have any).
+    rejected: BTreeMap<u32, Vec<u32>>,
     pub collapses: Vec<Collapse>,
     /// For error bounds measured as residuals ([`ErrorBound::Spheroid`], [`ErrorBound::Hoppe`]):
     /// the triangles around each collapse's new vertex as it made them, collapse `k`'s at
@@ -146,6 +152,7 @@ impl<'o> Engine<'o> {
             pos,
             quadric,
             area,
+            slot: (0..n as u32).collect(),
             color,
             face_alive: vec![true; faces.len()],
             marked: vec![false; faces.len()],
@@ -156,7 +163,7 @@ impl<'o> Engine<'o> {
             heap: BinaryHeap::new(),
             pushed: Vec::new(),
             deferred: Vec::new(),
-            rejected: vec![Vec::new(); n],
+            rejected: BTreeMap::new(),
             collapses: Vec::new(),
             fans: Vec::new(),
             fan_ends: Vec::new(),
@@ -171,14 +178,10 @@ impl<'o> Engine<'o> {
         // sized once, so that none doubles (and, while it is copied, holds both sizes) mid-build.
         let ids = n.saturating_sub(1);
         e.pos.reserve_exact(ids);
-        e.quadric.reserve_exact(ids);
-        e.area.reserve_exact(ids);
+        e.slot.reserve_exact(ids);
         e.color
             .reserve_exact(if e.color.is_empty() { 0 } else { ids });
-        e.vfaces.reserve_exact(ids);
-        e.vverts.reserve_exact(ids);
         e.alive.reserve_exact(ids);
-        e.rejected.reserve_exact(ids);
         e.collapses.reserve_exact(ids);
         // Boundary quadrics keep open borders in place.
         for f in 0..e.faces.len() {
@@ -212,11 +215,12 @@ impl<'o> Engine<'o> {
         self.heap = BinaryHeap::new();
         self.pushed = Vec::new();
         self.deferred = Vec::new();
-        self.rejected = Vec::new();
+        self.rejected = BTreeMap::new();
         self.vfaces = Vec::new();
         self.vverts = Vec::new();
         self.quadric = Vec::new();
         self.area = Vec::new();
+        self.slot = Vec::new();
         self.marked = Vec::new();
         self.alive = Vec::new();
         self.surface = None;
@@ -227,9 +231,14 @@ impl<'o> Engine<'o> {
         self.color.get(v as usize).copied().unwrap_or([0.0; 3])
     }
 
+    /// The slot of live vertex `v` (its quadric, area, faces and ring).
+    fn at(&self, v: u32) -> usize {
+        self.slot[v as usize] as usize
+    }
+
     /// Sorted distinct neighbours of a live vertex.
     pub fn neighbours(&self, v: u32) -> &[u32] {
-        &self.vverts[v as usize]
+        &self.vverts[self.at(v)]
     }
 
     /// The faces with directed edge `a -> b` and `b -> a`, as (third corner of the first or NONE,
@@ -237,7 +246,7 @@ impl<'o> Engine<'o> {
     fn edge_faces(&self, a: u32, b: u32) -> ([u32; 2], usize) {
         let mut wings = [NONE; 2];
         let mut count = 0;
-        for &f in &self.vfaces[a as usize] {
+        for &f in &self.vfaces[self.at(a)] {
             let t = self.faces[f as usize];
             for k in 0..3 {
                 if t[k] == a && t[(k + 1) % 3] == b {
@@ -257,7 +266,7 @@ impl<'o> Engine<'o> {
         if a == NONE || b == NONE {
             return NONE;
         }
-        self.vfaces[a as usize]
+        self.vfaces[self.at(a)]
             .iter()
             .copied()
             .find(|&f| {
@@ -304,7 +313,7 @@ impl<'o> Engine<'o> {
     /// Where the merged vertex goes and what the collapse costs.
     fn evaluate(&self, a: u32, b: u32) -> (Vec3d, f64) {
         let (pa, pb) = (self.pos[a as usize], self.pos[b as usize]);
-        let q = self.quadric[a as usize].add(&self.quadric[b as usize]);
+        let q = self.quadric[self.at(a)].add(&self.quadric[self.at(b)]);
         let len2 = dot(sub(pa, pb), sub(pa, pb));
         let v = match (self.opts.placement, self.opts.cost) {
             (Placement::Endpoint, _) if q.error(pb) < q.error(pa) => pb,
@@ -315,7 +324,7 @@ impl<'o> Engine<'o> {
         let v = if self.corners.is_empty() {
             v
         } else {
-            let border = |x: u32| self.vfaces[x as usize].len() < self.neighbours(x).len();
+            let border = |x: u32| self.vfaces[self.at(x)].len() < self.neighbours(x).len();
             let corner = |x: u32| self.corners[x as usize];
             match (border(a), border(b), corner(a), corner(b)) {
                 (true, false, ..) | (true, true, true, false) => pa,
@@ -362,9 +371,9 @@ impl<'o> Engine<'o> {
         }
         if self.opts.balanced {
             // Cheapest test first: blocked edges wait for the next pass anyway.
-            let touched = self.vfaces[a as usize]
+            let touched = self.vfaces[self.at(a)]
                 .iter()
-                .chain(&self.vfaces[b as usize])
+                .chain(&self.vfaces[self.at(b)])
                 .any(|&f| self.marked[f as usize]);
             if touched {
                 return Err(());
@@ -385,7 +394,7 @@ impl<'o> Engine<'o> {
         let edge_on_border = count == 1;
         // In a manifold fan an inner vertex has as many triangles as neighbours, a border vertex
         // one fewer.
-        let border = |v: u32, ring: &[u32]| self.vfaces[v as usize].len() < ring.len();
+        let border = |v: u32, ring: &[u32]| self.vfaces[self.at(v)].len() < ring.len();
         let (ba, bb) = (border(a, na), border(b, nb));
         if ba && bb && !edge_on_border {
             return Ok(false); // would pinch two borders (or a border and itself) together
@@ -428,7 +437,7 @@ impl<'o> Engine<'o> {
         let mut worst_before = f64::INFINITY;
         let mut worst_after = f64::INFINITY;
         for &s in &[a, b] {
-            for &f in &self.vfaces[s as usize] {
+            for &f in &self.vfaces[self.at(s)] {
                 let t = self.faces[f as usize];
                 if t.contains(&a) && t.contains(&b) {
                     continue;
@@ -478,8 +487,8 @@ impl<'o> Engine<'o> {
                     return true;
                 }
                 Ok(false) => {
-                    self.rejected[a as usize].push(b);
-                    self.rejected[b as usize].push(a);
+                    self.rejected.entry(a).or_default().push(b);
+                    self.rejected.entry(b).or_default().push(a);
                 }
                 Err(()) => self.deferred.push((a, b)),
             }
@@ -492,9 +501,9 @@ impl<'o> Engine<'o> {
         if self.planar.is_none() {
             return true;
         }
-        let mut ids: Vec<u32> = self.vfaces[a as usize]
+        let mut ids: Vec<u32> = self.vfaces[self.at(a)]
             .iter()
-            .chain(&self.vfaces[b as usize])
+            .chain(&self.vfaces[self.at(b)])
             .copied()
             .collect();
         ids.sort_unstable();
@@ -533,14 +542,16 @@ impl<'o> Engine<'o> {
         let p = self.pos.len() as u32;
         let (ia, ib) = (a as usize, b as usize);
         self.pos.push(v);
-        let q = self.quadric[ia].add(&self.quadric[ib]);
-        self.quadric.push(q);
-        self.area.push(self.area[ia] + self.area[ib]);
+        let (sa, sb) = (self.slot[ia] as usize, self.slot[ib] as usize);
+        let (area_a, area_b) = (self.area[sa], self.area[sb]);
+        self.quadric[sa] = self.quadric[sa].add(&self.quadric[sb]);
+        self.area[sa] = area_a + area_b;
+        self.slot.push(sa as u32);
         if !self.color.is_empty() {
             let c = match kept(self.opts, v, [self.pos[ia], self.pos[ib]]) {
                 Some(k) => self.color[[ia, ib][k]],
                 None => {
-                    let (wa, wb) = (self.area[ia].max(1e-30), self.area[ib].max(1e-30));
+                    let (wa, wb) = (area_a.max(1e-30), area_b.max(1e-30));
                     scale(
                         add(scale(self.color[ia], wa), scale(self.color[ib], wb)),
                         1.0 / (wa + wb),
@@ -556,7 +567,8 @@ impl<'o> Engine<'o> {
 
         let mut pf = Vec::new();
         for s in [a, b] {
-            for f in core::mem::take(&mut self.vfaces[s as usize]) {
+            let slot = self.at(s);
+            for f in core::mem::take(&mut self.vfaces[slot]) {
                 let t = &mut self.faces[f as usize];
                 if t.contains(&a) && t.contains(&b) {
                     if self.face_alive[f as usize] {
@@ -566,7 +578,8 @@ impl<'o> Engine<'o> {
                             .copied()
                             .find(|&x| x != a && x != b)
                             .unwrap_or(NONE);
-                        if let Some(list) = self.vfaces.get_mut(third as usize) {
+                        let list = self.slot.get(third as usize).copied();
+                        if let Some(list) = list.and_then(|l| self.vfaces.get_mut(l as usize)) {
                             list.retain(|&g| g != f);
                         }
                     }
@@ -591,7 +604,7 @@ impl<'o> Engine<'o> {
             self.fans.extend(pf.iter().map(|&f| self.faces[f as usize]));
             self.fan_ends.push(self.fans.len() as u32);
         }
-        self.vfaces.push(pf);
+        self.vfaces[sa] = pf;
         self.alive[ia] = false;
         self.alive[ib] = false;
         self.alive.push(true);
@@ -603,34 +616,39 @@ impl<'o> Engine<'o> {
             faces,
             neighbours,
         });
-        self.rejected.push(Vec::new());
-        self.rejected[ia] = Vec::new();
-        self.rejected[ib] = Vec::new();
+        self.rejected.remove(&a);
+        self.rejected.remove(&b);
         // The ring of p: both rings but a and b. Its members swap a and b for p, which as the
         // newest vertex goes last and keeps their rings sorted.
-        let mut ring: Vec<u32> = core::mem::take(&mut self.vverts[ia]);
-        ring.extend(core::mem::take(&mut self.vverts[ib]));
+        let mut ring: Vec<u32> = core::mem::take(&mut self.vverts[sa]);
+        ring.extend(core::mem::take(&mut self.vverts[sb]));
         ring.retain(|&x| x != a && x != b);
         ring.sort_unstable();
         ring.dedup();
         for &x in &ring {
-            let r = &mut self.vverts[x as usize];
+            let slot = self.at(x);
+            let r = &mut self.vverts[slot];
             r.retain(|&y| y != a && y != b);
             r.push(p);
         }
-        self.vverts.push(ring.clone());
+        self.vverts[sa] = ring.clone();
         // Fresh costs for the edges of p (no other edge's cost changed); edges around it that were
         // illegal may have become legal.
         for &x in &ring {
             self.push(p, x);
-            let mut retry = core::mem::take(&mut self.rejected[x as usize]);
+            let mut retry = self.rejected.remove(&x).unwrap_or_default();
             retry.sort_unstable();
             retry.dedup();
             for y in retry {
                 if self.alive[y as usize] {
                     // Out of y's list too, or every retry would push the edge once more per
                     // endpoint and the copies would double with each rejection.
-                    self.rejected[y as usize].retain(|&z| z != x);
+                    if let Some(list) = self.rejected.get_mut(&y) {
+                        list.retain(|&z| z != x);
+                        if list.is_empty() {
+                            self.rejected.remove(&y);
+                        }
+                    }
                     self.push(x, y);
                 }
             }
