@@ -26,6 +26,9 @@ const SNAP_TRIES: usize = 8;
 /// How many of those a tip tries to pull with its neighbours untangling round it.
 const UNTANGLE_TRIES: usize = 3;
 
+/// A remesh vertex's place on the input: a triangle and barycentric weights there.
+pub(super) type OnInput = (u32, [f64; 3]);
+
 /// The input's triangles around each vertex, as flat arrays.
 pub(super) struct Around {
     starts: Vec<u32>,
@@ -99,7 +102,7 @@ impl Relax<'_> {
 
     /// The closest point to `p` on the input triangles around `face`, walking on while a
     /// neighbouring triangle is closer (at most a few steps).
-    pub(super) fn project(&self, p: Vec3d, face: u32) -> (u32, [f64; 3]) {
+    pub(super) fn project(&self, p: Vec3d, face: u32) -> OnInput {
         let mut best = (face, closest(p, self.corners(face)));
         for _ in 0..4 {
             let start = best.0;
@@ -127,7 +130,7 @@ impl Relax<'_> {
         &mut self,
         reach: f64,
         positions: &mut [[f32; 3]],
-        on_input: &mut [(u32, [f64; 3])],
+        on_input: &mut [OnInput],
     ) -> u32 {
         let surface = Surface::new(positions, self.triangles);
         let mut far: Vec<(f64, u32)> = self
@@ -196,16 +199,8 @@ impl Relax<'_> {
                         .filter(|&&(_, turns_none, _)| !turns_none)
                         .take(UNTANGLE_TRIES)
                         .find_map(|&(v, ..)| {
-                            self.snapped[v as usize] = true;
-                            let ok = self.move_untangled(
-                                v,
-                                (target, face, w),
-                                reach,
-                                positions,
-                                on_input,
-                            );
-                            self.snapped[v as usize] = ok;
-                            ok.then_some(v)
+                            self.move_untangled(v, (target, face, w), reach, positions, on_input)
+                                .then_some(v)
                         })
                 })
                 .or_else(|| {
@@ -252,7 +247,7 @@ impl Relax<'_> {
         v: u32,
         moved: Option<(Vec3d, u32)>,
         positions: &[[f32; 3]],
-        on_input: &[(u32, [f64; 3])],
+        on_input: &[OnInput],
     ) -> (u32, f64) {
         let mut against = 0u32;
         let mut least = f64::INFINITY;
@@ -287,7 +282,7 @@ impl Relax<'_> {
         tris: &[u32],
         v: u32,
         positions: &[[f32; 3]],
-        on_input: &[(u32, [f64; 3])],
+        on_input: &[OnInput],
     ) -> Option<Vec3d> {
         let here = from_f32(positions[v as usize]);
         let mut normal = self.normals[on_input[v as usize].0 as usize];
@@ -372,7 +367,7 @@ impl Relax<'_> {
         before: u32,
         tangled: bool,
         positions: &[[f32; 3]],
-        on_input: &[(u32, [f64; 3])],
+        on_input: &[OnInput],
         out: &mut Vec<Vec3d>,
     ) -> Option<f64> {
         out.clear();
@@ -423,7 +418,7 @@ impl Relax<'_> {
         rounds: u32,
         tangled: bool,
         positions: &mut [[f32; 3]],
-        on_input: &mut [(u32, [f64; 3])],
+        on_input: &mut [OnInput],
     ) {
         let n = positions.len();
         let mut targets: Vec<Vec3d> = Vec::new();
@@ -467,7 +462,7 @@ impl Relax<'_> {
         tangled: bool,
         targets: &[Vec3d],
         positions: &[[f32; 3]],
-        on_input: &[(u32, [f64; 3])],
+        on_input: &[OnInput],
     ) -> Option<(u32, u32, [f64; 3], Vec3d)> {
         let tris = self.around_remesh.of(v);
         let here = from_f32(positions[v as usize]);

@@ -19,7 +19,7 @@
 use alloc::vec;
 use alloc::vec::Vec;
 
-use super::relax::{Relax, NONE_VERTEX};
+use super::relax::{OnInput, Relax, NONE_VERTEX};
 use crate::build::closest::point;
 use crate::build::vec3::{add, cross, dot, from_f32, len, normalize, scale, sub, Vec3d};
 
@@ -28,9 +28,6 @@ const STEPS: u32 = 300;
 
 /// Rings round a folded triangle tried, smallest first.
 const MAX_RINGS: u32 = 4;
-
-/// A remesh vertex's place on the input (a triangle and weights there).
-type OnInput = (u32, [f64; 3]);
 
 /// Where some remesh vertices are, in space and on the input, to be put back.
 struct Saved(Vec<([f32; 3], OnInput)>);
