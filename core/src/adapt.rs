@@ -886,11 +886,13 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                     let Some(cs) = self.slot(c) else {
                         continue;
                     };
-                    let d = self.judged(h, cs as usize, &h.bounds(c), view, policy);
+                    // Located once: its bounds and whether it splits.
+                    let record = h.record(c);
+                    let d = self.judged(h, cs as usize, &h.bounds_at(record), view, policy);
                     let flags = &mut self.v.flags[cs as usize];
                     *flags = (*flags & !VISIBLE) | d.visible as u8;
                     if d.error > t
-                        && h.is_parent(c)
+                        && record.is_parent()
                         && self.candidates.heap_push((d.error.to_bits(), c)).is_err()
                     {
                         frame.stats.queue_overflow = true;

@@ -545,6 +545,15 @@ pub struct Record {
     parent: bool,
 }
 
+impl Record {
+    /// Whether it is a parent's record (the node splits).
+    #[inline(always)]
+    #[must_use]
+    pub fn is_parent(&self) -> bool {
+        self.parent
+    }
+}
+
 /// One parent's split record.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct SplitView {
@@ -626,16 +635,23 @@ fn low(width: u32) -> u32 {
 #[inline]
 fn window(b: &[u8], bit: u64) -> u128 {
     let byte = usize::try_from(bit / 8).unwrap_or(usize::MAX);
-    let mut w = [0xFFu8; 16];
-    match b.get(byte..byte.saturating_add(16)) {
-        Some(s) => w.copy_from_slice(s),
-        None => {
-            for (k, x) in w.iter_mut().enumerate() {
-                *x = b.get(byte.saturating_add(k)).copied().unwrap_or(0xFF);
-            }
-        }
+    // Two loads when the 16 bytes are there (a copy into a shared array made it sixteen).
+    if let Some(Ok(w)) = b
+        .get(byte..byte.saturating_add(16))
+        .map(<[u8; 16]>::try_from)
+    {
+        return u128::from_le_bytes(w) >> (bit % 8);
     }
-    u128::from_le_bytes(w) >> (bit % 8)
+    window_at_end(b, byte) >> (bit % 8)
+}
+
+/// [`window`]'s 16 bytes from `byte` on, near the end of `b`.
+#[cold]
+#[inline(never)]
+fn window_at_end(b: &[u8], byte: usize) -> u128 {
+    let w: [u8; 16] =
+        core::array::from_fn(|k| b.get(byte.saturating_add(k)).copied().unwrap_or(0xFF));
+    u128::from_le_bytes(w)
 }
 
 /// An id read at `width` bits: all ones becomes [`NONE`].

@@ -169,40 +169,56 @@ impl<const N: usize> Arena<(u32, u32), N> {
     pub fn heap_push(&mut self, x: (u32, u32)) -> Result<(), (u32, u32)> {
         let mut i = self.push(x)? as usize;
         let items = self.as_mut_slice();
+        // Parents smaller than `x` move down into the hole; `x` is written once.
         while i > 0 {
             let up = (i - 1) / 2;
-            if items[up] >= items[i] {
+            if heap_key(items[up]) >= heap_key(x) {
                 break;
             }
-            items.swap(up, i);
+            items[i] = items[up];
             i = up;
         }
+        items[i] = x;
         Ok(())
     }
 
     /// Pops the largest item of the heap.
     pub fn heap_pop(&mut self) -> Option<(u32, u32)> {
-        let n = self.len().checked_sub(1)?;
-        self.items.swap(0, n);
-        let top = self.pop();
+        let last = self.pop()?;
         let items = self.as_mut_slice();
+        let Some(&top) = items.first() else {
+            return Some(last);
+        };
+        // The last item sinks from the root: the larger child moves up into the hole while it
+        // is larger (the left one on a tie, as a swap-based sift would choose).
+        let (n, key) = (items.len(), heap_key(last));
         let mut i = 0;
         loop {
-            let (l, r) = (2 * i + 1, 2 * i + 2);
-            let mut big = i;
-            if l < n && items[l] > items[big] {
-                big = l;
+            let l = 2 * i + 1;
+            if l >= n {
+                break;
             }
-            if r < n && items[r] > items[big] {
-                big = r;
+            let r = l + 1;
+            let big = if r < n && heap_key(items[r]) > heap_key(items[l]) {
+                r
+            } else {
+                l
+            };
+            if heap_key(items[big]) <= key {
+                break;
             }
-            if big == i {
-                return top;
-            }
-            items.swap(i, big);
+            items[i] = items[big];
             i = big;
         }
+        items[i] = last;
+        Some(top)
     }
+}
+
+/// A heap item as one integer, ordered as the pair is.
+#[inline(always)]
+fn heap_key((a, b): (u32, u32)) -> u64 {
+    (a as u64) << 32 | b as u64
 }
 
 #[cfg(test)]
