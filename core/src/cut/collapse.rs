@@ -167,7 +167,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             if f == fl || f == fr {
                 continue;
             }
-            if let Some(k) = corner(self.t.at(f), b) {
+            if let Some(k) = self.t.corner_of(f, b) {
                 self.t.set_corner(f, k, a);
             }
         }

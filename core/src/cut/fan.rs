@@ -7,7 +7,7 @@
 //! crafted to contradict the mesh.
 
 use super::slot::SlotIndex;
-use super::{corner, prev3, Cut, NIL};
+use super::{prev3, Cut, NIL};
 
 /// Longest fan walked around one vertex; a hierarchy with larger vertex degrees is refused
 /// rather than walked forever.
@@ -45,17 +45,15 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
     /// The triangle after `f` going counter-clockwise around vertex `v` (`NIL` at a border).
     #[inline]
     pub(crate) fn ccw(&self, f: u32, v: u32) -> Option<u32> {
-        let t = self.t.get(f)?;
-        let k = corner(t, v)?;
-        Some(self.t.adj(f)[prev3(k)])
+        let k = self.t.corner_of(f, v)?;
+        Some(self.t.adj_at(f, prev3(k)))
     }
 
     /// The triangle before `f` going counter-clockwise around `v` (`NIL` at a border).
     #[inline]
     pub(crate) fn cw(&self, f: u32, v: u32) -> Option<u32> {
-        let t = self.t.get(f)?;
-        let k = corner(t, v)?;
-        Some(self.t.adj(f)[k])
+        let k = self.t.corner_of(f, v)?;
+        Some(self.t.adj_at(f, k))
     }
 
     /// Collects `v`'s triangles into `out` and says whether the walk found every triangle that

@@ -567,7 +567,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             let whole = self.complete_fan(last, fan);
             debug_assert!(whole, "the last vertex's fan was proven whole");
             for &f in fan.iter() {
-                if let Some(k) = corner(self.t.at(f), last) {
+                if let Some(k) = self.t.corner_of(f, last) {
                     self.t.set_corner(f, k, v);
                 }
             }

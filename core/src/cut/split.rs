@@ -3,7 +3,7 @@
 
 use super::fan::Fan;
 use super::slot::SlotIndex;
-use super::{corner, next3, Cut, Refused, NIL};
+use super::{next3, Cut, Refused, NIL};
 use crate::format::{HierarchyView, NONE};
 
 /// Everything a legal split needs, found while proving it legal.
@@ -69,9 +69,8 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
 
         // Wings, read off the neighbours (the nodes there now may be finer than at formation).
         let third = |f: u32, v: u32, offset: usize| -> Option<u32> {
-            let t = self.t.get(f)?;
-            let k = corner(t, v)?;
-            Some(t[(k + offset) % 3])
+            let k = self.t.corner_of(f, v)?;
+            Some(self.t.corner_at(f, (k + offset) % 3))
         };
         // n1 holds c0 -> wl, n2 holds wr -> c0: both still have the parent's slot as c0.
         let wl = if ns[1] != NIL {
@@ -90,9 +89,8 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         // Each neighbour pair must meet along the edge the new triangle will take over
         // (n0: wl -> p, n1: p -> wl, n2: wr -> p, n3: p -> wr), so the new links are mutual.
         let across = |f: u32, a: u32, b: u32| -> Option<u32> {
-            let t = self.t.get(f)?;
-            let k = corner(t, a)?;
-            (t[next3(k)] == b).then(|| self.t.adj(f)[k])
+            let k = self.t.corner_of(f, a)?;
+            (self.t.corner_at(f, next3(k)) == b).then(|| self.t.adj_at(f, k))
         };
         let pairs_meet = |x: u32, y: u32, w: u32| -> bool {
             // x holds w -> p, y holds p -> w; across each lies the other (or a border).
@@ -179,7 +177,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             self.start_blend_from(c1s as usize, &from, frames, false);
         }
         for &f in moved {
-            if let Some(k) = corner(self.t.at(f), ps) {
+            if let Some(k) = self.t.corner_of(f, ps) {
                 self.t.set_corner(f, k, c1s);
             }
         }
@@ -213,11 +211,8 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
 
     /// Points the edge `a -> b` of triangle `f` (if `f` is a triangle with that edge) at `to`.
     fn point_edge(&mut self, f: u32, a: u32, b: u32, to: u32) {
-        let Some(t) = self.t.get(f) else {
-            return;
-        };
-        if let Some(k) = corner(t, a) {
-            if t[next3(k)] == b {
+        if let Some(k) = self.t.corner_of(f, a) {
+            if self.t.corner_at(f, next3(k)) == b {
                 self.t.set_adj(f, k, to);
             }
         }

@@ -191,6 +191,27 @@ impl<const F: usize, I: SlotIndex> Triangles<F, I> {
         self.corners[f as usize][k] = I::store(v);
     }
 
+    /// Which corner of triangle `f` is vertex slot `v` (`None` when `f` is out of range or `v`
+    /// is not a corner): compared in the stored form, so nothing is widened.
+    #[inline(always)]
+    pub fn corner_of(&self, f: u32, v: u32) -> Option<usize> {
+        let t = self.corners[..self.len as usize].get(f as usize)?;
+        let v = I::store(v);
+        t.iter().position(|&c| c == v)
+    }
+
+    /// Corner `k` of triangle `f` alone (`f` in range).
+    #[inline(always)]
+    pub fn corner_at(&self, f: u32, k: usize) -> u32 {
+        self.corners[f as usize][k].load()
+    }
+
+    /// `adj(f)[k]` alone (`f` in range).
+    #[inline(always)]
+    pub fn adj_at(&self, f: u32, k: usize) -> u32 {
+        self.adj[f as usize][k].load()
+    }
+
     /// `adj(f)[k]`: the triangle across edge `t[k] -> t[k + 1]`, or `NIL`.
     #[inline(always)]
     pub fn adj(&self, f: u32) -> [u32; 3] {
