@@ -4,7 +4,8 @@
 # every version adapts the same views of the peer orbit (QRefine, no budget, no geomorphs) in
 # blocks of 8 frames, the order rotating, so the machine's slow phases hit them alike. Prints,
 # per tolerance, each version's median microseconds and mean triangles, and the median of the
-# per-frame time ratios against the first version given.
+# per-frame time ratios against this checkout; then the same for the first frame (orbit frame 0
+# refined from the base mesh, 20 rounds, each version in turn).
 #
 #   benches/versions/run.sh COMMIT... [-- TOLERANCES [REVOLUTIONS]]
 #   benches/versions/run.sh 14ce786 97fab9c -- 0.25,0.5,1,2,4 2

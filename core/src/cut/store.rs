@@ -192,7 +192,8 @@ impl<const F: usize, I: SlotIndex> Triangles<F, I> {
     }
 
     /// Which corner of triangle `f` is vertex slot `v` (`None` when `f` is out of range or `v`
-    /// is not a corner): compared in the stored form, so nothing is widened.
+    /// is not a corner; `v` a vertex slot or `NIL`): compared in the stored form, so nothing is
+    /// widened.
     #[inline(always)]
     pub fn corner_of(&self, f: u32, v: u32) -> Option<usize> {
         let t = self.corners[..self.len as usize].get(f as usize)?;
