@@ -70,6 +70,9 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, mut e: Engine<'_>) -> Hierarchy {
             ..Node::default()
         })
         .collect();
+    // The collapse-time positions and colours are in the nodes now.
+    e.pos = Vec::new();
+    e.color = Vec::new();
     // Triangle ids as the file numbers them: the base triangles first, then two per split.
     let base_count = e.face_alive.iter().filter(|&&a| a).count() as u32;
     let mut face_id = vec![NONE; e.faces.len()];
@@ -98,6 +101,7 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, mut e: Engine<'_>) -> Hierarchy {
             nodes[ch as usize].parent = c.parent;
         }
     }
+    drop(face_id);
     // Positions as stored (f32) are what the bounds are measured from.
     let pos: Vec<Vec3d> = nodes.iter().map(|n| from_f32(n.position)).collect();
 
@@ -129,6 +133,7 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, mut e: Engine<'_>) -> Hierarchy {
             half[v] = half[v].max(n.map_or(core::f64::consts::PI, |n| angle(axis[v], n)));
         }
     }
+    drop(face_normals);
     // Parents, in formation order (children first).
     for c in &e.collapses {
         let p = c.parent as usize;
@@ -146,6 +151,7 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, mut e: Engine<'_>) -> Hierarchy {
         };
         half[p] = (angle(axis[p], axis[a]) + half[a]).max(angle(axis[p], axis[b]) + half[b]);
     }
+    drop(weight);
 
     // Depth, top-down: a parent always has a larger id than its children.
     for p in (leaves..m).rev() {
@@ -179,11 +185,13 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, mut e: Engine<'_>) -> Hierarchy {
     }
 
     // Input vertices on a border (an endpoint of an edge only one triangle uses).
-    let mut edges: Vec<(u32, u32)> = mesh
-        .triangles
-        .iter()
-        .flat_map(|t| (0..3).map(move |k| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]))))
-        .collect();
+    // Sized exactly: collected from a flat map it grew by doubling, and was the peak.
+    let mut edges: Vec<(u32, u32)> = Vec::with_capacity(mesh.triangles.len() * 3);
+    edges.extend(
+        mesh.triangles.iter().flat_map(|t| {
+            (0..3).map(move |k| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3])))
+        }),
+    );
     edges.sort_unstable();
     let mut on_border = vec![false; leaves];
     let mut k = 0;
@@ -202,6 +210,7 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, mut e: Engine<'_>) -> Hierarchy {
         }
         k = j;
     }
+    drop(edges);
 
     let mut errors: Vec<(f32, f32)> = Vec::new();
     for (k, c) in e.collapses.iter().enumerate() {
