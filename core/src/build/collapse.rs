@@ -57,7 +57,7 @@ pub(crate) struct Engine<'o> {
     /// (cost as `f32` bits, index into `pushed`): eight bytes an entry, so sifting the heap
     /// touches half the memory it would with the edge inside.
     heap: BinaryHeap<Reverse<(u32, u32)>>,
-    pub pushed: Vec<(u32, u32)>,
+    pub pushed: Pushed,
     deferred: Vec<(u32, u32)>,
     /// Edges found illegal, by endpoint: retried when a collapse changes that endpoint's ring
     /// (a map, since few vertices have any).
@@ -107,6 +107,42 @@ pub(crate) fn kept(opts: &BuildOptions, v: Vec3d, children: [Vec3d; 2]) -> Optio
 fn face_normal(p: &[Vec3d], f: [u32; 3]) -> Vec3d {
     let [a, b, c] = f.map(|i| p[i as usize]);
     cross(sub(b, a), sub(c, a))
+}
+
+/// Every edge ever pushed on the cost heap, in push order (the heap holds indices into it), in
+/// blocks of a fixed size: it only grows, and a vector grown by doubling held up to twice its
+/// length plus, while it moved, its old copy (the builder's peak memory was there).
+#[derive(Default)]
+pub(crate) struct Pushed {
+    blocks: Vec<Vec<(u32, u32)>>,
+    len: usize,
+}
+
+impl Pushed {
+    /// Edges per block.
+    const BLOCK: usize = 1 << 14;
+
+    fn push(&mut self, edge: (u32, u32)) {
+        match self.blocks.last_mut() {
+            Some(block) if block.len() < Self::BLOCK => block.push(edge),
+            _ => {
+                let mut block = Vec::with_capacity(Self::BLOCK);
+                block.push(edge);
+                self.blocks.push(block);
+            }
+        }
+        self.len += 1;
+    }
+
+    /// Edge `index` (an index the heap got from [`Pushed::len`]).
+    fn get(&self, index: u32) -> (u32, u32) {
+        let i = index as usize;
+        self.blocks[i / Self::BLOCK][i % Self::BLOCK]
+    }
+
+    pub fn len(&self) -> usize {
+        self.len
+    }
 }
 
 impl<'o> Engine<'o> {
@@ -161,7 +197,7 @@ impl<'o> Engine<'o> {
             alive_count: 0,
             vfaces,
             heap: BinaryHeap::new(),
-            pushed: Vec::new(),
+            pushed: Pushed::default(),
             deferred: Vec::new(),
             rejected: BTreeMap::new(),
             collapses: Vec::new(),
@@ -213,7 +249,7 @@ impl<'o> Engine<'o> {
     /// hierarchy's own arrays do not add to the engine's at the build's peak.
     pub fn release_work(&mut self) {
         self.heap = BinaryHeap::new();
-        self.pushed = Vec::new();
+        self.pushed = Pushed::default();
         self.deferred = Vec::new();
         self.rejected = BTreeMap::new();
         self.vfaces = Vec::new();
@@ -475,7 +511,7 @@ impl<'o> Engine<'o> {
                 }
                 continue;
             };
-            let (a, b) = self.pushed[index as usize];
+            let (a, b) = self.pushed.get(index);
             if !self.alive[a as usize] || !self.alive[b as usize] {
                 continue;
             }
