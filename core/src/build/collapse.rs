@@ -691,3 +691,29 @@ impl<'o> Engine<'o> {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::Pushed;
+
+    #[test]
+    fn pushed_edges_come_back_across_blocks() {
+        let mut p = Pushed::default();
+        let n = 2 * Pushed::BLOCK + 5;
+        for i in 0..n as u32 {
+            p.push((i, i.wrapping_mul(7)));
+        }
+        assert_eq!(p.len(), n);
+        assert_eq!(p.blocks.len(), 3);
+        assert!(p.blocks[..2].iter().all(|b| b.len() == Pushed::BLOCK));
+        for i in [
+            0,
+            1,
+            Pushed::BLOCK - 1,
+            Pushed::BLOCK,
+            2 * Pushed::BLOCK + 4,
+        ] {
+            assert_eq!(p.get(i as u32), (i as u32, (i as u32).wrapping_mul(7)));
+        }
+    }
+}
