@@ -284,90 +284,108 @@ pub fn shade_vertices<M: MeshSource>(
     base: [f32; 3],
     out: &mut [ShadedVertex],
 ) {
-    let out_len = out.len();
-    let m = mvp.to_cols_array_2d();
-    let colors = mesh.has_colors();
+    let stage = Stage {
+        m: mvp.to_cols_array_2d(),
+        viewport,
+        lighting,
+        base,
+        colors: mesh.has_colors(),
+    };
     // Whole batches as fixed-size arrays, so that every lane loop is unrolled and runs in SIMD
     // registers; only the last, partial batch takes the variable-length path.
+    let whole = out.len() - out.len() % BATCH;
     let mut batches = out.chunks_exact_mut(BATCH);
     for (first, out) in (0..).step_by(BATCH).zip(&mut batches) {
-        let mut lanes = [ShadedVertex::ZERO; BATCH];
-        shade_batch(
-            &m, viewport, mesh, lighting, base, colors, first, BATCH, &mut lanes,
-        );
-        out.copy_from_slice(&lanes);
+        if let Ok(out) = <&mut [ShadedVertex; BATCH]>::try_from(out) {
+            stage.batch(mesh, first, BATCH, out);
+        }
     }
     let tail = batches.into_remainder();
     if !tail.is_empty() {
         let mut lanes = [ShadedVertex::ZERO; BATCH];
-        let (first, len) = (out_len - tail.len(), tail.len());
-        shade_batch(
-            &m, viewport, mesh, lighting, base, colors, first, len, &mut lanes,
-        );
+        let len = tail.len();
+        stage.batch(mesh, whole, len, &mut lanes);
         tail.copy_from_slice(&lanes[..len]);
     }
 }
 
-/// The vertex stage of vertices `first..first + len` into the first `len` of `out`.
-#[inline(always)]
-#[allow(clippy::too_many_arguments)] // the stage's inputs, split once in `shade_vertices`
-fn shade_batch<M: MeshSource>(
-    m: &[[f32; 4]; 4],
-    viewport: &Viewport,
-    mesh: &M,
-    lighting: Option<&PreparedLighting>,
+/// What the vertex stage keeps the same for every vertex of a draw.
+#[derive(Clone, Copy)]
+struct Stage<'a> {
+    /// The matrix's columns.
+    m: [[f32; 4]; 4],
+    viewport: &'a Viewport,
+    lighting: Option<&'a PreparedLighting>,
+    /// Colour of vertices when the mesh has none.
     base: [f32; 3],
+    /// Whether the mesh has vertex colours.
     colors: bool,
-    first: usize,
-    len: usize,
-    out: &mut [ShadedVertex; BATCH],
-) {
-    // Gather the batch; lanes past the end of the mesh hold zeros and are not stored.
-    let mut batch = VertexBatch::default();
-    mesh.batch(first, len, &mut batch);
-    let VertexBatch {
-        positions: p,
-        normals: n,
-        colors: mut rgb,
-    } = batch;
-    if !colors {
-        for (channel, b) in rgb.iter_mut().zip(base) {
-            *channel = [b; BATCH];
-        }
-    }
+}
 
-    // Clip space, in the order of `to_clip`: x, y, z columns, then the translation.
-    let mut clip = [[0.0f32; BATCH]; 4];
-    for (r, row) in clip.iter_mut().enumerate() {
-        for k in 0..BATCH {
-            row[k] = m[0][r] * p[0][k] + m[1][r] * p[1][k] + m[2][r] * p[2][k] + m[3][r];
+impl Stage<'_> {
+    /// Vertices `first..first + len` into the first `len` of `out`.
+    #[inline(always)]
+    fn batch<M: MeshSource>(
+        &self,
+        mesh: &M,
+        first: usize,
+        len: usize,
+        out: &mut [ShadedVertex; BATCH],
+    ) {
+        let Stage {
+            m,
+            viewport,
+            lighting,
+            base,
+            colors,
+        } = *self;
+        // Gather the batch; lanes past the end of the mesh hold zeros and are not stored.
+        let mut batch = VertexBatch::default();
+        mesh.batch(first, len, &mut batch);
+        let VertexBatch {
+            positions: p,
+            normals: n,
+            colors: mut rgb,
+        } = batch;
+        if !colors {
+            for (channel, b) in rgb.iter_mut().zip(base) {
+                *channel = [b; BATCH];
+            }
         }
-    }
-    let mut light = [1.0f32; BATCH];
-    if let Some(p) = lighting {
-        p.intensities(&n, &mut light);
-    }
-    let mut screen = [(0, 0, 0.0f32); BATCH];
-    for (k, s) in screen.iter_mut().enumerate() {
-        *s = viewport.project_xyz(clip[0][k], clip[1][k], clip[2][k], clip[3][k]);
-    }
-    // Colour and outcode packed in one 32-bit lane (the record's last four bytes, little end
-    // first), so that each record is stored as four words rather than byte by byte.
-    let mut packed = [0u32; BATCH];
-    for (k, word) in packed.iter_mut().enumerate() {
-        let channel = |a: usize| saturate_u8(rgb[a][k] * light[k]) as u32;
-        let code = clip::outcode(Vec4::new(clip[0][k], clip[1][k], clip[2][k], clip[3][k]));
-        *word = channel(0) | channel(1) << 8 | channel(2) << 16 | (code as u32) << 24;
-    }
-    for (k, v) in out.iter_mut().enumerate() {
-        let [r, g, b, outcode] = packed[k].to_le_bytes();
-        *v = ShadedVertex {
-            x: screen[k].0,
-            y: screen[k].1,
-            z: screen[k].2,
-            rgb: [r, g, b],
-            outcode,
-        };
+
+        // Clip space, in the order of `to_clip`: x, y, z columns, then the translation.
+        let mut clip = [[0.0f32; BATCH]; 4];
+        for (r, row) in clip.iter_mut().enumerate() {
+            for k in 0..BATCH {
+                row[k] = m[0][r] * p[0][k] + m[1][r] * p[1][k] + m[2][r] * p[2][k] + m[3][r];
+            }
+        }
+        let mut light = [1.0f32; BATCH];
+        if let Some(p) = lighting {
+            p.intensities(&n, &mut light);
+        }
+        let mut screen = [(0, 0, 0.0f32); BATCH];
+        for (k, s) in screen.iter_mut().enumerate() {
+            *s = viewport.project_xyz(clip[0][k], clip[1][k], clip[2][k], clip[3][k]);
+        }
+        // Colour and outcode packed in one 32-bit lane (the record's last four bytes, little end
+        // first), so that each record is stored as four words rather than byte by byte.
+        let mut packed = [0u32; BATCH];
+        for (k, word) in packed.iter_mut().enumerate() {
+            let channel = |a: usize| saturate_u8(rgb[a][k] * light[k]) as u32;
+            let code = clip::outcode(Vec4::new(clip[0][k], clip[1][k], clip[2][k], clip[3][k]));
+            *word = channel(0) | channel(1) << 8 | channel(2) << 16 | (code as u32) << 24;
+        }
+        for (k, v) in out.iter_mut().enumerate() {
+            let [r, g, b, outcode] = packed[k].to_le_bytes();
+            *v = ShadedVertex {
+                x: screen[k].0,
+                y: screen[k].1,
+                z: screen[k].2,
+                rgb: [r, g, b],
+                outcode,
+            };
+        }
     }
 }
 
