@@ -198,10 +198,9 @@ fn validate<M: MeshSource>(mesh: &M, params: &DrawParams, scratch: usize) -> Res
     if params.shading == Shading::Gouraud && !mesh.has_normals() {
         return Err(DrawError::MissingNormals);
     }
-    // Whether any index is out of range, without a branch per index (the reduction runs in
-    // SIMD registers); the offender is searched for only when there is one.
-    // (A comparison and an `or` per index: half of a maximum's work where SIMD has no unsigned
-    // maximum, as on baseline x86-64.)
+    // Whether any index is out of range: a comparison and an `or` per index, no branch (the
+    // reduction runs in SIMD registers, where an unsigned maximum would cost twice as much on
+    // baseline x86-64); the offender is searched for only when there is one.
     let Ok(limit) = u32::try_from(n) else {
         return Ok(()); // every `u32` index is in range
     };
