@@ -158,6 +158,25 @@ fn each_kind_of_damage_has_its_own_error() {
     );
 }
 
+/// A base vertex that no face uses (here the square's face 0 names corner 3 instead of 1, a
+/// case the property test below once drew) is not counted among the mesh's vertices.
+#[test]
+fn an_unused_base_vertex_is_not_counted() {
+    for mut bytes in [square_bytes(), heights_bytes()] {
+        let corner = HEADER_SIZE + 4;
+        assert_eq!(bytes[corner], 1);
+        bytes[corner] = 3;
+        reseal(&mut bytes);
+        let view = SemiRegularView::parse(&bytes).unwrap();
+        let mut cut = WaveletCut::<64, 1024, 600, 128>::boxed();
+        cut.reset(&view).unwrap();
+        assert_eq!(cut.live_vertices(), 3);
+        cut.check(&view, false, &mut vec![[0u32; 2]; 3 * 1024])
+            .unwrap();
+        fly(&view);
+    }
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(300))]
 

@@ -414,9 +414,11 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         self.tile_level = tile_level;
         self.tiles = c.base_faces << (2 * self.tile_level);
         self.built = false;
-        // The base mesh fits, so emitting it cannot fail.
+        // The base mesh fits, so emitting it cannot fail. A base vertex no face uses (a file
+        // may hold one) is not in the mesh.
         let _complete = self.emit(s);
         debug_assert!(_complete);
+        self.vertices = self.live_vertices() as u32;
         Ok(())
     }
 
