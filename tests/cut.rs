@@ -318,99 +318,133 @@ impl<P: vdlod_core::policy::Policy> vdlod_core::policy::Policy for Opaque<P> {
 /// sphere is in the frustum, an asked one when the policy sees it, so blends may differ).
 #[test]
 fn settled_vertices_change_no_frame() {
-    use vdlod_core::policy::{QRefine, View};
-    use vdlod_demo::camera::peer_orbit;
-    type C = Cut<32_767, 65_534, 4096>;
+    use vdlod_core::policy::QRefine;
     for name in ["bunny.obj", "head.obj"] {
-        let mesh = fixture(name);
-        let bytes = hierarchy_bytes(&mesh);
-        let h = HierarchyView::parse(&bytes).unwrap();
-        let b = mesh.bounds();
-        let (c, r) = (b.center().to_array(), b.radius());
-        let orbit = peer_orbit(&b, 200, 640, 480);
-        let mut path = Path::new(11);
-        let mut views: Vec<(View, f32)> = (0..240).map(|i| (orbit.camera(i).view(), 1.0)).collect();
-        let mut held = path.view(c, r);
-        for i in 0..240u32 {
-            // Pauses (the same view again), drift with jumps, and a new tolerance now and then.
-            if i % 40 >= 8 {
-                held = path.view(c, r);
-            }
-            views.push((held, [0.5, 2.0][(i / 60) as usize % 2]));
-        }
-        let [mut skipping, mut asked, mut opaque] = [C::boxed(), C::boxed(), C::boxed()];
-        asked.set_settling(false);
-        for cut in [&mut skipping, &mut asked, &mut opaque] {
-            cut.reset(&h).unwrap();
-        }
-        let positions = |cut: &C| -> Vec<[u32; 3]> {
-            (0..cut.vertex_count())
-                .map(|s| cut.vertex(&h, s).position.map(f32::to_bits))
-                .collect()
-        };
-        let (mut settled, mut vertices, mut skipped_blending) = (0u64, 0u64, 0u64);
-        for (i, (view, tau)) in views.iter().enumerate() {
-            // Geomorphs over the second revolution and parts of the path.
-            let frames = if (120..240).contains(&i) || (300..380).contains(&i) {
-                4
-            } else {
-                0
-            };
-            skipping.set_geomorph_frames(frames);
-            asked.set_geomorph_frames(frames);
-            let budget = if (320..380).contains(&i) {
-                Budget {
-                    max_triangles: 3000,
-                    max_ops: 40,
-                    ..Budget::default()
-                }
-            } else {
-                Budget::default()
-            };
-            let policy = QRefine::new(*tau);
-            let s = skipping.adapt(&h, view, &policy, &budget);
-            let a = asked.adapt(&h, view, &policy, &budget);
-            assert_eq!(a.settled, 0);
-            // A skipped vertex is one not asked.
-            assert_eq!(s.visited + s.settled, a.visited, "{name}, frame {i}");
-            assert_eq!(
-                FrameStats {
-                    settled: 0,
-                    visited: a.visited,
-                    ..s
-                },
-                a,
-                "{name}, frame {i}: the stats differ"
-            );
-            assert_eq!(
-                node_triangles(&skipping),
-                node_triangles(&asked),
-                "{name}, frame {i}: the cuts differ"
-            );
-            assert_eq!(
-                positions(&skipping),
-                positions(&asked),
-                "{name}, frame {i}: the blended positions differ"
-            );
-            if i < 120 {
-                let o = opaque.adapt(&h, view, &Opaque(policy), &budget);
-                assert_eq!(o, a, "{name}, frame {i}: asking every vertex differs");
-                assert_eq!(node_triangles(&opaque), node_triangles(&asked));
-                settled += s.settled as u64;
-                vertices += s.vertices as u64;
-            } else if frames > 0 {
-                skipped_blending += s.settled as u64;
-            }
-        }
-        assert!(
-            settled * 3 > vertices,
-            "{name}: only {settled} of {vertices} vertices skipped on the orbit"
-        );
-        assert!(
-            skipped_blending > 0,
-            "{name}: nothing skipped with geomorphs"
+        settling_changes_no_frame(name, |tau, _| QRefine::new(tau), 1.0, 3);
+    }
+}
+
+/// The same under the merge-tree paper's policy, which refines to the leaves near the eye and
+/// in a narrowed frustum: its envelope settles the vertices that stay out of the frustum or
+/// beyond the near zone, the leaves, and the pairs whose parent stays near and in view.
+#[test]
+fn settled_vertices_change_no_frame_under_the_merge_tree() {
+    use vdlod_core::policy::MergeTree;
+    // The head's cut is small and mostly near the eye: fewer of its vertices can settle.
+    for (name, share) in [("bunny.obj", 5), ("head.obj", 25)] {
+        settling_changes_no_frame(
+            name,
+            |tau, radius| MergeTree {
+                near: 1.5 * radius / tau,
+            },
+            0.4,
+            share,
         );
     }
+}
+
+/// Flies `name` with and without settling under `policy(tau, model radius)` (`tau` 1, 0.5 or
+/// 2), the orbit's frustum scaled by `scale`, and checks that the cuts agree and that at least
+/// one vertex in `share` was skipped on the orbit.
+fn settling_changes_no_frame<P: vdlod_core::policy::Policy + Copy>(
+    name: &str,
+    policy: impl Fn(f32, f32) -> P,
+    scale: f32,
+    share: u64,
+) {
+    use vdlod_core::policy::View;
+    use vdlod_demo::camera::peer_orbit;
+    type C = Cut<32_767, 65_534, 4096>;
+    let mesh = fixture(name);
+    let bytes = hierarchy_bytes(&mesh);
+    let h = HierarchyView::parse(&bytes).unwrap();
+    let b = mesh.bounds();
+    let (c, r) = (b.center().to_array(), b.radius());
+    let orbit = peer_orbit(&b, 200, 640, 480);
+    let mut path = Path::new(11);
+    let mut views: Vec<(View, f32)> = (0..240)
+        .map(|i| (orbit.camera(i).view_scaled(scale), 1.0))
+        .collect();
+    let mut held = path.view(c, r);
+    for i in 0..240u32 {
+        // Pauses (the same view again), drift with jumps, and a new tolerance now and then.
+        if i % 40 >= 8 {
+            held = path.view(c, r);
+        }
+        views.push((held, [0.5, 2.0][(i / 60) as usize % 2]));
+    }
+    let [mut skipping, mut asked, mut opaque] = [C::boxed(), C::boxed(), C::boxed()];
+    asked.set_settling(false);
+    for cut in [&mut skipping, &mut asked, &mut opaque] {
+        cut.reset(&h).unwrap();
+    }
+    let positions = |cut: &C| -> Vec<[u32; 3]> {
+        (0..cut.vertex_count())
+            .map(|s| cut.vertex(&h, s).position.map(f32::to_bits))
+            .collect()
+    };
+    let (mut settled, mut vertices, mut skipped_blending) = (0u64, 0u64, 0u64);
+    for (i, (view, tau)) in views.iter().enumerate() {
+        // Geomorphs over the second revolution and parts of the path.
+        let frames = if (120..240).contains(&i) || (300..380).contains(&i) {
+            4
+        } else {
+            0
+        };
+        skipping.set_geomorph_frames(frames);
+        asked.set_geomorph_frames(frames);
+        let budget = if (320..380).contains(&i) {
+            Budget {
+                max_triangles: 3000,
+                max_ops: 40,
+                ..Budget::default()
+            }
+        } else {
+            Budget::default()
+        };
+        let policy = policy(*tau, r);
+        let s = skipping.adapt(&h, view, &policy, &budget);
+        let a = asked.adapt(&h, view, &policy, &budget);
+        assert_eq!(a.settled, 0);
+        // A skipped vertex is one not asked.
+        assert_eq!(s.visited + s.settled, a.visited, "{name}, frame {i}");
+        assert_eq!(
+            FrameStats {
+                settled: 0,
+                visited: a.visited,
+                ..s
+            },
+            a,
+            "{name}, frame {i}: the stats differ"
+        );
+        assert_eq!(
+            node_triangles(&skipping),
+            node_triangles(&asked),
+            "{name}, frame {i}: the cuts differ"
+        );
+        assert_eq!(
+            positions(&skipping),
+            positions(&asked),
+            "{name}, frame {i}: the blended positions differ"
+        );
+        if i < 120 {
+            let o = opaque.adapt(&h, view, &Opaque(policy), &budget);
+            assert_eq!(o, a, "{name}, frame {i}: asking every vertex differs");
+            assert_eq!(node_triangles(&opaque), node_triangles(&asked));
+            settled += s.settled as u64;
+            vertices += s.vertices as u64;
+        } else if frames > 0 {
+            skipped_blending += s.settled as u64;
+        }
+    }
+    assert!(
+        settled * share > vertices,
+        "{name}: only {settled} of {vertices} vertices skipped on the orbit"
+    );
+    assert!(
+        skipped_blending > 0,
+        "{name}: nothing skipped with geomorphs"
+    );
 }
 
 /// Regulation towards a triangle target does not overshoot with geomorphs: coarsening lands a
@@ -449,8 +483,8 @@ fn regulation_does_not_overshoot_with_geomorphs() {
 }
 
 /// A policy that reads only bounding spheres is answered from the cut's digests instead of the
-/// file's records ([`vdlod_core::policy::Policy::sphere_only`]): the same cut, stats and
-/// positions in every frame as when the same policy does not say so, over the merge-tree
+/// file's records ([`vdlod_core::policy::Policy::sphere_only`]), and its envelope settles
+/// vertices: the same cut, stats and positions in every frame as when the same policy does not say so, over the merge-tree
 /// paper's level orbit (scaled frustums, near limits) and a random path, with and without
 /// geomorphs.
 #[test]
@@ -494,7 +528,17 @@ fn sphere_only_policies_decide_from_digests_exactly() {
             assert!(policy.sphere_only() && !Opaque(policy).sphere_only());
             let d = digest.adapt(&h, view, &policy, &Budget::default());
             let a = records.adapt(&h, view, &Opaque(policy), &Budget::default());
-            assert_eq!(d, a, "{name}, frame {i}: the stats differ");
+            // The policy's envelope also lets the digest cut skip settled vertices.
+            assert_eq!(d.visited + d.settled, a.visited, "{name}, frame {i}");
+            assert_eq!(
+                FrameStats {
+                    settled: 0,
+                    visited: a.visited,
+                    ..d
+                },
+                a,
+                "{name}, frame {i}: the stats differ"
+            );
             assert_eq!(
                 node_triangles(&digest),
                 node_triangles(&records),

@@ -74,7 +74,7 @@ use crate::cut::{
     VISIBLE, WAS_VISIBLE,
 };
 use crate::format::{HierarchyView, Record, NONE};
-use crate::policy::{dot, sub, Bounds, Demand, Policy, View};
+use crate::policy::{dot, sub, Bounds, Demand, Envelope, Policy, View};
 
 /// Limits on one frame's cut.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -351,6 +351,8 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             policy.envelope(view)
         };
         let upper = envelope.map_or(f32::INFINITY, |e| e.upper);
+        // Where the upper bound holds: beyond the near zone (everywhere without one).
+        let zone = envelope.unwrap_or(Envelope::ZERO);
         // A policy that reads only the bounding sphere is answered from the digest's copy of it:
         // the same floats the record decodes to, so the same demand, without reading the file.
         let sphere_only = policy.sphere_only() && !policy.judges_triangles();
@@ -436,7 +438,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 };
                 let wants_none = match sphere {
                     Some(d) => d.error <= t,
-                    None => s * s * upper * SLACK <= t * d2,
+                    None => (s * s * upper * SLACK <= t * d2) & zone.beyond_near(d2, radius, SLACK),
                 };
                 let alone = (flags & (BLENDING | COLLAPSING) == 0)
                     & ((self.v.mate(i) == NIL) | (calm & (flags & FIRST_CHILD == 0)));
@@ -447,16 +449,20 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 };
                 let mut next_flags = if done { seen(flags, visible) } else { flags };
                 if let Some(m) = &anchor {
-                    // Wants no split wherever the eye gets; with geomorphs also seen (or not)
-                    // wherever the frustum gets, as in the frame before, since that flag
-                    // decides whether a change blends.
-                    quiet[n] = wants_none
-                        && self.steady.stays_quiet(m, s, d2)
-                        && (!blends
-                            || (self.steady.stays_visible(m, center, radius) == Some(visible)
-                                && (flags & VISIBLE != 0) == visible));
+                    // Wants no split wherever the eye gets (or, answered from its sphere, is a
+                    // leaf, which never splits); and when its visibility flag is kept (with
+                    // geomorphs, or answered from its sphere) seen (or not) wherever the
+                    // frustum gets, as in the frame before, since that flag decides whether a
+                    // change blends (once geomorphs come on, for a flag kept without them).
+                    quiet[n] = (if wants_none {
+                        self.steady.stays_unwanted(m, s, (center, radius), d2)
+                    } else {
+                        sphere_only && !h.is_parent(self.v.node[i])
+                    }) && (!(blends || sphere_only)
+                        || (self.steady.stays_visible(m, center, radius) == Some(visible)
+                            && (flags & VISIBLE != 0) == visible));
                     next_flags &= !SETTLED;
-                    if done && quiet[n] {
+                    if alone && quiet[n] {
                         next_flags |= SETTLED;
                     }
                 }
@@ -524,7 +530,11 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             }
             core::hint::black_box(touched);
             for &k in pairs {
-                parent_bounds[k] = h.bounds_at(records[k]);
+                parent_bounds[k] = if sphere_only {
+                    h.sphere_at(records[k])
+                } else {
+                    h.bounds_at(records[k])
+                };
             }
             if let Some(m) = &anchor {
                 for &k in pairs {

@@ -1168,6 +1168,29 @@ impl<'a> HierarchyView<'a> {
         self.bounds_at(self.record(i))
     }
 
+    /// The bounding sphere of a located record, as [`crate::policy::Bounds`] with the rest at
+    /// its default: all a policy that reads only spheres ([`crate::policy::Policy::sphere_only`])
+    /// needs, without decoding the normal, the cone or the spheroid.
+    #[inline]
+    #[must_use]
+    pub fn sphere_at(&self, at: Record) -> crate::policy::Bounds {
+        let r: [u8; PARENT_SIZE] = match at.parent {
+            true => self.fixed(at.offset).unwrap_or([0; PARENT_SIZE]),
+            false => {
+                let leaf: [u8; 6] = self.fixed(at.offset).unwrap_or([0; 6]);
+                return crate::policy::Bounds {
+                    center: self.model.position(&leaf),
+                    ..crate::policy::Bounds::default()
+                };
+            }
+        };
+        crate::policy::Bounds {
+            center: self.model.position(&r),
+            radius: self.length(r[8]),
+            ..crate::policy::Bounds::default()
+        }
+    }
+
     /// [`HierarchyView::bounds`] of a located record.
     #[inline]
     #[must_use]

@@ -93,16 +93,19 @@ impl Demand {
 ///
 /// - `demand(b, view)` is culled exactly when `frustum` and `b`'s sphere misses the frustum
 ///   ([`View::sphere_visible`]), or `back_face` and `b`'s normal cone faces away ([`BackFace`]);
-/// - otherwise `max(b.b2 d2, b.a2 p2) lower / d2^2 <= demand(b, view).error` and
-///   `demand(b, view).error <= max(b.a2, b.b2) upper / d2`;
-/// - and the error depends on the view only through its eye and these two scales.
+/// - otherwise, when `near` is 0 or `b`'s sphere keeps at least `near` from the eye
+///   (`sqrt(d2) - b.radius >= near`), `max(b.b2 d2, b.a2 p2) lower / d2^2 <= demand(b,
+///   view).error` and `demand(b, view).error <= max(b.a2, b.b2) upper / d2`;
+/// - otherwise (the sphere comes within `near > 0` of the eye) `demand(b, view).error >=
+///   near_error`, with no upper bound;
+/// - and the error depends on the view only through its eye and these scales.
 ///
 /// (Up to float rounding: a policy's sums may cancel, so a user of the lower bound leaves a
 /// margin of a small share of `max(b.a2, b.b2) d2`.)
 ///
-/// A cut proves "wants no split" from `upper` and a node's largest spheroid radius (its digest),
-/// and, while the eye moves less than a margin, "still wants no split" and "the parent is still
-/// wanted" without asking again.
+/// A cut proves "wants no split" from `upper`, `near` and a node's largest spheroid radius and
+/// bounding sphere (its digest), and, while the eye moves less than a margin, "still wants no
+/// split" and "the parent is still wanted" without asking again.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Envelope {
     /// Scale of the upper bound (0: never wants a split).
@@ -113,6 +116,10 @@ pub struct Envelope {
     pub frustum: bool,
     /// Culls by the normal cone.
     pub back_face: bool,
+    /// Distance from the eye within which the error is only bounded below (0: nowhere).
+    pub near: f32,
+    /// The least error of a seen vertex whose sphere comes within `near` of the eye.
+    pub near_error: f32,
 }
 
 impl Envelope {
@@ -122,18 +129,39 @@ impl Envelope {
         lower: 0.0,
         frustum: false,
         back_face: false,
+        near: 0.0,
+        near_error: 0.0,
     };
 
     /// Both policies' tests: culled when either culls, the larger error otherwise (the tuple
-    /// policy's rule).
+    /// policy's rule). Outside both near zones both bounds hold; inside either, the error is at
+    /// least the smaller near error of those that have a zone.
     #[must_use]
     pub fn and(self, other: Envelope) -> Envelope {
+        let near_error = match (self.near > 0.0, other.near > 0.0) {
+            (true, true) => self.near_error.min(other.near_error),
+            (true, false) => self.near_error,
+            (false, true) => other.near_error,
+            (false, false) => 0.0,
+        };
         Envelope {
             upper: self.upper.max(other.upper),
             lower: self.lower.max(other.lower),
             frustum: self.frustum || other.frustum,
             back_face: self.back_face || other.back_face,
+            near: self.near.max(other.near),
+            near_error,
         }
+    }
+
+    /// Whether a seen sphere at squared distance `d2` from the eye with radius `radius`
+    /// provably keeps `near` from it, with relative slack `slack` (`> 1`) for rounding: where
+    /// the upper bound holds.
+    #[inline(always)]
+    #[must_use]
+    pub fn beyond_near(&self, d2: f32, radius: f32, slack: f32) -> bool {
+        let edge = self.near + radius;
+        (self.near == 0.0) | (d2 >= edge * edge * slack)
     }
 }
 
@@ -560,8 +588,7 @@ impl Policy for ScreenError {
         Some(Envelope {
             upper: ppu2 / (lo * lo),
             lower: ppu2 / (hi * hi),
-            frustum: false,
-            back_face: false,
+            ..Envelope::ZERO
         })
     }
 }
@@ -675,7 +702,7 @@ pub struct MergeTree {
 }
 
 impl Policy for MergeTree {
-    #[inline]
+    #[inline(always)]
     fn demand(&self, b: &Bounds, view: &View) -> Demand {
         if !view.sphere_visible(b.center, b.radius) {
             return Demand::CULLED;
@@ -690,6 +717,20 @@ impl Policy for MergeTree {
                 0.0
             },
         }
+    }
+
+    /// Wants nothing (error 0) but where the sphere comes within `near` of the eye, and there
+    /// wants a split at an error over `1 + 1 / (1 + near)`.
+    #[inline]
+    fn envelope(&self, _: &View) -> Option<Envelope> {
+        // A `near` of 0, negative or NaN wants nothing anywhere: no zone.
+        let near = if self.near > 0.0 { self.near } else { 0.0 };
+        Some(Envelope {
+            frustum: true,
+            near,
+            near_error: 1.0 + 1.0 / (1.0 + near),
+            ..Envelope::ZERO
+        })
     }
 
     #[inline]
@@ -976,8 +1017,6 @@ mod tests {
                 assert!(d.error >= floor * (1.0 - 1e-5), "{b:?}");
             }
         }
-        // Policies that cannot describe their error say so.
-        assert_eq!(MergeTree { near: 1.0 }.envelope(&v), None);
         assert_eq!(
             Frustum.envelope(&v),
             Some(Envelope {
@@ -993,6 +1032,65 @@ mod tests {
         .envelope(&v)
         .unwrap();
         assert_eq!(two.upper, 16.0 * two.lower);
+    }
+
+    /// The merge-tree policy's envelope holds: culled exactly outside the frustum, error 0
+    /// beyond the near zone, at least the near error inside it; a `near` that wants nothing
+    /// has no zone.
+    #[test]
+    fn the_merge_tree_envelope_holds() {
+        let v = view();
+        let mut x = 0x2545_f491u32;
+        let mut next = move || {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            (x >> 8) as f32 / (1u32 << 24) as f32
+        };
+        for near in [0.5, 4.0, 12.0, f32::INFINITY] {
+            let m = MergeTree { near };
+            let env = m.envelope(&v).unwrap();
+            assert_eq!((env.near, env.frustum, env.back_face), (near, true, false));
+            let (mut inside, mut beyond) = (0, 0);
+            for _ in 0..10_000 {
+                let c = [0, 1, 2].map(|_| next() * 30.0 - 15.0);
+                let b = Bounds {
+                    center: c,
+                    radius: 2.0 * next(),
+                    ..Bounds::default()
+                };
+                let d = m.demand(&b, &v);
+                assert_eq!(d.visible, v.sphere_visible(c, b.radius), "{b:?}");
+                if !d.visible {
+                    assert_eq!(d.error, 0.0);
+                    continue;
+                }
+                let r = sub(c, v.eye);
+                if env.beyond_near(dot(r, r), b.radius, 1.0 + 1e-5) {
+                    beyond += 1;
+                    assert_eq!(d.error, 0.0, "{b:?}");
+                } else {
+                    inside += 1;
+                    assert!(d.error >= env.near_error * (1.0 - 1e-6), "{b:?}");
+                }
+            }
+            assert!(
+                inside > 0 && (beyond > 100 || near > 12.0),
+                "{near}: {inside} {beyond}"
+            );
+        }
+        for near in [0.0, -1.0, f32::NAN] {
+            let env = MergeTree { near }.envelope(&v).unwrap();
+            assert_eq!(env.near, 0.0);
+            let b = bounds([0.0, 0.0, 9.0], [0.0, 0.0, 1.0], 0.0, 0.0);
+            assert_eq!(MergeTree { near }.demand(&b, &v).error, 0.0);
+        }
+        // Beside a screen-space policy, inside the zone the near error still holds.
+        let both = (MergeTree { near: 4.0 }, ScreenError::new(1.0))
+            .envelope(&v)
+            .unwrap();
+        assert_eq!((both.near, both.near_error), (4.0, 1.2));
+        assert!(both.upper > 0.0);
     }
 
     #[test]

@@ -234,8 +234,8 @@ fn fly(
         let t_full = start.elapsed().as_secs_f64() * 1e3;
         let _ = writeln!(
             csv,
-            "{},{size},{i},{},{},{},{t_adapt:.3},{t_render:.3},{t_full:.3}",
-            orbit.frames, stats.triangles, stats.vsplits, stats.ecols
+            "{},{size},{i},{},{},{},{},{},{t_adapt:.3},{t_render:.3},{t_full:.3}",
+            orbit.frames, stats.triangles, stats.vsplits, stats.ecols, stats.visited, stats.settled
         );
         if i == picture {
             shot.draw_cut(&cut, h, &camera, &style(Shading::Gouraud, true))
@@ -303,8 +303,9 @@ pub fn table1(out_dir: &Path, input: IndexedMesh, setup: Setup) -> Result<Vec<St
         near / circle.radius,
         100.0 * share_in_view(&model.mesh.positions, &cameras, 0.2 * c, near),
     )];
-    let mut csv =
-        String::from("frames,size,frame,triangles,vsplits,ecols,adapt_ms,render_ms,full_ms\n");
+    let mut csv = String::from(
+        "frames,size,frame,triangles,vsplits,ecols,visited,settled,adapt_ms,render_ms,full_ms\n",
+    );
     let mut shot = Frame::new(WIDTH, HEIGHT).map_err(|e| e.to_string())?;
     let mut panels = Vec::new();
     for (run, &frames) in setup.frames.iter().enumerate() {

@@ -206,12 +206,34 @@ impl Steady {
         }
     }
 
-    /// Whether a vertex of spheroid radius `s`, at `d2` from the anchor's eye, keeps its bound
-    /// `s^2 upper / d^2` at most `t / slack` within the reach (`slack` the cut's own margin on
-    /// its bound): whether `d >= s sqrt(upper slack / t) + reach`, with float slop.
-    pub fn stays_quiet(&self, m: &Margins, s: f32, d2: f32) -> bool {
-        let least = s * m.scale + self.reach + m.slop;
+    /// Whether a vertex of spheroid radius `s` and bounding radius `radius`, at `d2` from the
+    /// anchor's eye, keeps its bound `s^2 upper / d^2` at most `t / slack` within the reach
+    /// (`slack` the cut's own margin on its bound), and its sphere beyond the envelope's near
+    /// zone: whether `d >= max(s sqrt(upper slack / t), near + radius) + reach`, with float slop.
+    pub fn stays_quiet(&self, m: &Margins, s: f32, radius: f32, d2: f32) -> bool {
+        let near = self.envelope.near;
+        let zone = if near > 0.0 {
+            (near + radius) * (1.0 + SLACK)
+        } else {
+            0.0
+        };
+        let least = (s * m.scale).max(zone) + self.reach + m.slop;
         d2 >= least * least
+    }
+
+    /// Whether a vertex that wants no split (spheroid radius `s`, sphere `(center, radius)` at
+    /// `d2` from the anchor's eye) provably wants none within the reach and sway: it stays
+    /// quiet ([`Steady::stays_quiet`]), or the envelope culls by the frustum and the sphere
+    /// stays out of it (a culled vertex's error is 0).
+    pub fn stays_unwanted(
+        &self,
+        m: &Margins,
+        s: f32,
+        (center, radius): ([f32; 3], f32),
+        d2: f32,
+    ) -> bool {
+        self.stays_quiet(m, s, radius, d2)
+            || (self.envelope.frustum && self.stays_visible(m, center, radius) == Some(false))
     }
 
     /// Whether a sphere at `center` of `radius` provably stays in the frustum (`Some(true)`)
@@ -236,7 +258,9 @@ impl Steady {
 
     /// Whether a parent with bounds `b` stays wanted within the reach and sway: seen (with
     /// margin from every culling plane), facing the eye (with margin), and its error's lower
-    /// bound over `t * slack` at the farthest the eye can get.
+    /// bound over `t * slack` wherever the eye gets: the spheroid's at the farthest the eye
+    /// can get while the sphere may be beyond the near zone, the near error while it may be
+    /// inside.
     pub fn stays_wanted(&self, m: &Margins, b: &Bounds, t: f32, slack: f32) -> bool {
         let e = &self.envelope;
         let seen = !e.frustum || self.stays_visible(m, b.center, b.radius) == Some(true);
@@ -255,6 +279,17 @@ impl Steady {
         // Less what rounding can take from the policy's own sum (which cancels when the eye is
         // near the axis): far below this share of its largest term.
         let floor = (b.b2 * far * far).max(b.a2 * p * p) - SLACK * b.a2.max(b.b2) * far * far;
-        seen && facing && floor * e.lower > t * slack * (1.0 + SLACK) * far * far * far * far
+        let spheroid = floor * e.lower > t * slack * (1.0 + SLACK) * far * far * far * far;
+        // Where the sphere can get relative to the near zone (`d - radius < near`).
+        let edge = e.near + b.radius;
+        let inside = e.near > 0.0 && far * (1.0 + SLACK) < edge;
+        let outside = e.near == 0.0 || d - shift >= edge * (1.0 + SLACK);
+        let near = e.near_error > t * slack * (1.0 + SLACK);
+        seen && facing
+            && if inside {
+                near
+            } else {
+                spheroid && (outside || near)
+            }
     }
 }

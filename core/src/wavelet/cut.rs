@@ -865,10 +865,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
             self.settled.iter_mut().for_each(|w| *w = 0);
             self.quiet.iter_mut().for_each(|w| *w = 0);
             let upper = envelope.map_or(f32::INFINITY, |e| e.upper);
-            (
-                self.steady.margins(upper, t, SLACK, model),
-                envelope.is_some_and(|e| e.frustum),
-            )
+            self.steady.margins(upper, t, SLACK, model)
         });
 
         // Coarsen: a member none of whose children stays leaves when unwanted (blending unless
@@ -894,7 +891,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
                 }
                 let d = Self::demand(s, id, p, view, policy);
                 let wanted = d.visible && d.error > t;
-                if let Some((m, _)) = &anchor {
+                if let Some(m) = &anchor {
                     if wanted
                         && !leaving
                         && self.steady.stays_wanted(m, &s.bounds_at(p, id), t, SLACK)
@@ -953,8 +950,8 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
                 continue;
             }
             if let (false, Some(p)) = (self.includes(id), s.point(id)) {
-                if let Some((m, frustum)) = &anchor {
-                    if self.stays_unwanted(m, *frustum, &s.bounds_at(p, id), view) {
+                if let Some(m) = &anchor {
+                    if self.stays_unwanted(m, &s.bounds_at(p, id), view) {
                         put(&mut self.settled, self.base_vertices, id, true);
                     }
                 }
@@ -969,8 +966,8 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
                 continue;
             }
             if !self.leaving(id) {
-                if let Some((m, frustum)) = &anchor {
-                    if self.children_stay_unwanted(s, id, m, *frustum, view) {
+                if let Some(m) = &anchor {
+                    if self.children_stay_unwanted(s, id, m, view) {
                         put(&mut self.quiet, self.base_vertices, id, true);
                     }
                 }
@@ -1036,14 +1033,16 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         has(&self.settled, self.base_vertices, self.wavelets, id)
     }
 
-    /// Whether a wavelet with bounds `b` provably stays unwanted while the anchor holds: its
-    /// error bound stays under the threshold wherever the eye gets, or (with `frustum`) it
-    /// stays out of the view.
-    fn stays_unwanted(&self, m: &Margins, frustum: bool, b: &Bounds, view: &View) -> bool {
+    /// Whether a wavelet with bounds `b` provably stays unwanted while the anchor holds (see
+    /// [`Steady::stays_unwanted`]).
+    fn stays_unwanted(&self, m: &Margins, b: &Bounds, view: &View) -> bool {
         let r = sub(b.center, view.eye);
-        self.steady
-            .stays_quiet(m, libm::sqrtf(b.a2.max(b.b2)), dot(r, r))
-            || (frustum && self.steady.stays_visible(m, b.center, b.radius) == Some(false))
+        self.steady.stays_unwanted(
+            m,
+            libm::sqrtf(b.a2.max(b.b2)),
+            (b.center, b.radius),
+            dot(r, r),
+        )
     }
 
     /// Whether every child of member `id` out of the set provably stays unwanted while the
@@ -1053,13 +1052,12 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         s: &SemiRegularView<'_>,
         id: u32,
         m: &Margins,
-        frustum: bool,
         view: &View,
     ) -> bool {
         let Some(p) = s.point(id) else { return false };
         s.children(p, s.level(p)).into_iter().flatten().all(|c| {
             s.vertex_id(c).is_some_and(|cid| {
-                self.includes(cid) || self.stays_unwanted(m, frustum, &s.bounds_at(c, cid), view)
+                self.includes(cid) || self.stays_unwanted(m, &s.bounds_at(c, cid), view)
             })
         })
     }
