@@ -684,7 +684,9 @@ impl Policy for QRefine {
 /// the frustum and comes within `near` of the eye; nearer is more urgent. Everything so placed
 /// refines to the leaves (`vdlod-demo reproduce table1` uses `near` = the eye's distance from
 /// the model's centre; with `near` infinite, the whole frustum refines). It reads only bounding
-/// spheres ([`Policy::sphere_only`]), so a cut decides most vertices without reading the file.
+/// spheres ([`Policy::sphere_only`]), so a cut decides most vertices without reading the file,
+/// and describes itself by a near zone ([`Envelope::near`]), so a cut skips the vertices whose
+/// answer cannot change while the camera moves a little.
 ///
 /// ```
 /// use vdlod_core::policy::{Bounds, MergeTree, Policy, View};
@@ -694,6 +696,8 @@ impl Policy for QRefine {
 /// assert!(policy.demand(&at(6.0), &view).error > 1.0); // 3.5 from the eye: refine
 /// assert_eq!(policy.demand(&at(-6.0), &view).error, 0.0); // too far: simplify
 /// assert!(!policy.demand(&at(20.0), &view).visible); // behind the eye
+/// let envelope = policy.envelope(&view).unwrap();
+/// assert_eq!((envelope.near, envelope.frustum), (5.0, true));
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct MergeTree {
