@@ -1014,7 +1014,7 @@ fn checker_sheet(
 /// at equal triangle counts, PSNR against the *input* (the vertex forest built from the input
 /// itself). Writes `NAME.csv` and `NAME_coarse.png`, `NAME_adapted.png` and `NAME_fine.png`
 /// (wireframe, from that first camera), and `NAME_checker.png` (the same with a checker over
-/// the base faces, and the vertex forest beside them: [`checker_sheet`]) per mesh into `out`.
+/// the base faces, and the vertex forest beside them: `checker_sheet`) per mesh into `out`.
 pub fn fish(out: &Path) -> Result<Vec<String>, String> {
     use crate::mesh::{BUNNY_NAME, BUNNY_OBJ};
     use vdlod_core::remesh::RemeshOptions;
