@@ -214,7 +214,9 @@ fn pair_error(d: Demand) -> f32 {
 }
 
 /// A vertex's flags after a frame in which it was `visible` or not: `VISIBLE` moves to
-/// `WAS_VISIBLE`.
+/// `WAS_VISIBLE`. Only geomorphs read them (whether a change blends), so a frame without them
+/// stores "not seen" (`visible` false): the flags of a vertex skipped in such frames are then
+/// those of one asked, and the first frame with geomorphs blends nothing, as after a reset.
 #[inline(always)]
 fn seen(flags: u8, visible: bool) -> u8 {
     let was = if flags & VISIBLE != 0 { WAS_VISIBLE } else { 0 };
@@ -342,6 +344,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         const SLACK: f32 = 1.0 + 1e-5;
         let t = frame.threshold;
         let blends = self.geomorph_frames > 0;
+
         // No geomorph runs or can start: no decision reaches a vertex but its own and its
         // pair's first child's, so a second child is done with as early as a lone vertex.
         let calm = !blends && self.blends.len() == 0;
@@ -447,18 +450,21 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                     Some(d) => d.visible,
                     None => blends && view.sphere_visible(center, radius),
                 };
-                let mut next_flags = if done { seen(flags, visible) } else { flags };
+                let mut next_flags = if done {
+                    seen(flags, blends & visible)
+                } else {
+                    flags
+                };
                 if let Some(m) = &anchor {
                     // Wants no split wherever the eye gets (or, answered from its sphere, is a
-                    // leaf, which never splits); and when its visibility flag is kept (with
-                    // geomorphs, or answered from its sphere) seen (or not) wherever the
+                    // leaf, which never splits); with geomorphs also seen (or not) wherever the
                     // frustum gets, as in the frame before, since that flag decides whether a
-                    // change blends (once geomorphs come on, for a flag kept without them).
+                    // change blends.
                     quiet[n] = (if wants_none {
                         self.steady.stays_unwanted(m, s, (center, radius), d2)
                     } else {
                         sphere_only && !h.is_parent(self.v.node[i])
-                    }) && (!(blends || sphere_only)
+                    }) && (!blends
                         || (self.steady.stays_visible(m, center, radius) == Some(visible)
                             && (flags & VISIBLE != 0) == visible));
                     next_flags &= !SETTLED;
@@ -589,7 +595,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         }
         let node = self.v.node[i];
         let flags = self.v.flags[i];
-        self.v.flags[i] = seen(flags, d.visible);
+        self.v.flags[i] = seen(flags, self.geomorph_frames > 0 && d.visible);
         let collapsing = flags & COLLAPSING != 0;
         if collapsing && self.v.mate(i) == NIL {
             // The pair was broken up (a forced split took the sibling): blend back.
@@ -900,7 +906,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                     let record = h.record(c);
                     let d = self.judged(h, cs as usize, &h.bounds_at(record), view, policy);
                     let flags = &mut self.v.flags[cs as usize];
-                    *flags = (*flags & !VISIBLE) | d.visible as u8;
+                    *flags = (*flags & !VISIBLE) | (frames > 0 && d.visible) as u8;
                     if d.error > t
                         && record.is_parent()
                         && self.candidates.heap_push((d.error.to_bits(), c)).is_err()
