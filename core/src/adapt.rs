@@ -344,7 +344,6 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         const SLACK: f32 = 1.0 + 1e-5;
         let t = frame.threshold;
         let blends = self.geomorph_frames > 0;
-
         // No geomorph runs or can start: no decision reaches a vertex but its own and its
         // pair's first child's, so a second child is done with as early as a lone vertex.
         let calm = !blends && self.blends.len() == 0;
