@@ -213,14 +213,21 @@ fn pair_error(d: Demand) -> f32 {
     }
 }
 
-/// A vertex's flags after a frame in which it was `visible` or not: `VISIBLE` moves to
-/// `WAS_VISIBLE`. Only geomorphs read them (whether a change blends), so a frame without them
-/// stores "not seen" (`visible` false): the flags of a vertex skipped in such frames are then
-/// those of one asked, and the first frame with geomorphs blends nothing, as after a reset.
+/// A vertex's flags after a frame in which it was `visible` or not, with geomorphs on
+/// (`blends`) or off: `VISIBLE` moves to `WAS_VISIBLE`. Only geomorphs read them (whether a
+/// change blends), so a frame without them stores "not seen" ([`kept`]): the flags of a
+/// vertex skipped in such frames are then those of one asked, and the first frame with
+/// geomorphs blends nothing, as after a reset.
 #[inline(always)]
-fn seen(flags: u8, visible: bool) -> u8 {
+fn seen(flags: u8, visible: bool, blends: bool) -> u8 {
     let was = if flags & VISIBLE != 0 { WAS_VISIBLE } else { 0 };
-    (flags & !(VISIBLE | WAS_VISIBLE)) | was | visible as u8
+    (flags & !(VISIBLE | WAS_VISIBLE)) | was | kept(visible, blends) as u8
+}
+
+/// The visibility a vertex's flags keep: only with geomorphs (see [`seen`]).
+#[inline(always)]
+fn kept(visible: bool, blends: bool) -> bool {
+    visible & blends
 }
 
 /// Sorts pairs by error, then parent (a total order: the result never depends on the order
@@ -450,7 +457,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                     None => blends && view.sphere_visible(center, radius),
                 };
                 let mut next_flags = if done {
-                    seen(flags, blends & visible)
+                    seen(flags, visible, blends)
                 } else {
                     flags
                 };
@@ -594,7 +601,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         }
         let node = self.v.node[i];
         let flags = self.v.flags[i];
-        self.v.flags[i] = seen(flags, self.geomorph_frames > 0 && d.visible);
+        self.v.flags[i] = seen(flags, d.visible, self.geomorph_frames > 0);
         let collapsing = flags & COLLAPSING != 0;
         if collapsing && self.v.mate(i) == NIL {
             // The pair was broken up (a forced split took the sibling): blend back.
@@ -905,7 +912,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                     let record = h.record(c);
                     let d = self.judged(h, cs as usize, &h.bounds_at(record), view, policy);
                     let flags = &mut self.v.flags[cs as usize];
-                    *flags = (*flags & !VISIBLE) | (frames > 0 && d.visible) as u8;
+                    *flags = (*flags & !VISIBLE) | kept(d.visible, frames > 0) as u8;
                     if d.error > t
                         && record.is_parent()
                         && self.candidates.heap_push((d.error.to_bits(), c)).is_err()

@@ -1101,7 +1101,13 @@ impl<'a> HierarchyView<'a> {
     /// out of range all zeros but no cone.
     #[inline]
     fn record_bytes(&self, i: u32) -> [u8; PARENT_SIZE] {
-        let Record { offset: o, parent } = self.record(i);
+        self.record_bytes_at(self.record(i))
+    }
+
+    /// [`HierarchyView::record_bytes`] of a located record.
+    #[inline(always)]
+    fn record_bytes_at(&self, at: Record) -> [u8; PARENT_SIZE] {
+        let Record { offset: o, parent } = at;
         if parent {
             return self.fixed(o).unwrap_or([0; PARENT_SIZE]);
         }
@@ -1174,16 +1180,8 @@ impl<'a> HierarchyView<'a> {
     #[inline]
     #[must_use]
     pub fn sphere_at(&self, at: Record) -> crate::policy::Bounds {
-        let r: [u8; PARENT_SIZE] = match at.parent {
-            true => self.fixed(at.offset).unwrap_or([0; PARENT_SIZE]),
-            false => {
-                let leaf: [u8; 6] = self.fixed(at.offset).unwrap_or([0; 6]);
-                return crate::policy::Bounds {
-                    center: self.model.position(&leaf),
-                    ..crate::policy::Bounds::default()
-                };
-            }
-        };
+        // A leaf's padded radius code is 0, which decodes to 0.
+        let r = self.record_bytes_at(at);
         crate::policy::Bounds {
             center: self.model.position(&r),
             radius: self.length(r[8]),

@@ -160,8 +160,9 @@ impl Envelope {
     #[inline(always)]
     #[must_use]
     pub fn beyond_near(&self, d2: f32, radius: f32, slack: f32) -> bool {
+        // Without a zone (a loop invariant for the cut's walk) nothing more is computed.
         let edge = self.near + radius;
-        (self.near == 0.0) | (d2 >= edge * edge * slack)
+        self.near == 0.0 || d2 >= edge * edge * slack
     }
 }
 
@@ -885,6 +886,17 @@ mod tests {
         )
     }
 
+    /// Numbers in `[0, 1)` from a xorshift generator seeded with `seed` (non-zero).
+    fn uniform(seed: u32) -> impl FnMut() -> f32 {
+        let mut x = seed;
+        move || {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            (x >> 8) as f32 / (1u32 << 24) as f32
+        }
+    }
+
     fn bounds(center: [f32; 3], axis: [f32; 3], a: f32, b: f32) -> Bounds {
         Bounds {
             center,
@@ -978,13 +990,7 @@ mod tests {
                 interior: 3.0,
             },
         };
-        let mut x = 0x1234_5678u32;
-        let mut next = || {
-            x ^= x << 13;
-            x ^= x >> 17;
-            x ^= x << 5;
-            (x >> 8) as f32 / (1u32 << 24) as f32
-        };
+        let mut next = uniform(0x1234_5678);
         for _ in 0..10_000 {
             let c = [
                 next() * 20.0 - 10.0,
@@ -1044,13 +1050,7 @@ mod tests {
     #[test]
     fn the_merge_tree_envelope_holds() {
         let v = view();
-        let mut x = 0x2545_f491u32;
-        let mut next = move || {
-            x ^= x << 13;
-            x ^= x >> 17;
-            x ^= x << 5;
-            (x >> 8) as f32 / (1u32 << 24) as f32
-        };
+        let mut next = uniform(0x2545_f491);
         for near in [0.5, 4.0, 12.0, f32::INFINITY] {
             let m = MergeTree { near };
             let env = m.envelope(&v).unwrap();
