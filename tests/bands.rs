@@ -250,3 +250,47 @@ fn bad_windows_and_frames_are_typed_errors() {
         })
     );
 }
+
+/// A band steps over a run of triangles that draw nothing in one go; a run longer than a bin
+/// entry can count (back faces, a triangle between pixel centres, and one off screen, 70,000 in
+/// all) is stepped over in parts, and the triangles around it are drawn as in the whole frame.
+#[test]
+fn long_runs_of_empty_triangles_are_skipped_exactly() {
+    let positions = [
+        [-0.9, -0.9, 0.5],
+        [0.9, -0.9, 0.5],
+        [0.0, 0.9, 0.5],
+        [0.001, 0.001, 0.2],
+        [0.002, 0.001, 0.2],
+        [0.001, 0.002, 0.2],
+        [5.0, 5.0, 0.5],
+        [6.0, 5.0, 0.5],
+        [5.0, 6.0, 0.5],
+        [-0.5, -0.5, 0.3],
+        [0.5, -0.5, 0.3],
+        [0.0, 0.5, 0.3],
+    ];
+    let normals = [[0.0, 0.0, 1.0]; 12];
+    let (front, back, speck, away) = ([0u32, 1, 2], [0u32, 2, 1], [3u32, 4, 5], [6u32, 7, 8]);
+    let mut triangles = vec![front];
+    for k in 0..70_000 {
+        triangles.push([back, speck, away][k % 3]);
+    }
+    triangles.push([9, 10, 11]);
+    triangles.extend([back; 5]);
+    let mesh = Mesh {
+        positions: &positions,
+        normals: Some(&normals),
+        triangles: &triangles,
+        ..Mesh::default()
+    };
+    let p = params(Mat4::IDENTITY, false);
+    let (color, depth, stats) = whole::<u32>(&mesh, &p);
+    assert_eq!(stats.rasterized, 2 + 70_000 / 3, "{stats:?}");
+    assert!(color.iter().filter(|&&c| c != BG).count() > W * H / 4);
+    for rows in [1, 16, H] {
+        let bands: Vec<Window> = Window::bands(W, H, rows).collect();
+        let (c, d) = windowed::<u32>(&mesh, &p, &bands, W, true);
+        assert!(c == color && d == depth, "rows {rows}");
+    }
+}

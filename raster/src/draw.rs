@@ -24,7 +24,7 @@ use crate::edge::{
     SUBPIXEL_BITS,
 };
 use crate::mesh::{MeshSource, Uv, VertexIndex};
-use crate::target::{check_frame, Depth, Pixel, Target, TargetError};
+use crate::target::{check_frame, Depth, Pixel, Target, TargetError, Window};
 use crate::vertex::{
     shade_vertices, to_clip, Light, PreparedLighting, ShadedVertex, VertexLighting, Viewport,
 };
@@ -394,6 +394,14 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
         let (params, scratch) = (self.params, self.vertices);
         let facing = Facing::culling(params.cull_back_faces);
         let last = self.frame.1 as i32 - 1;
+        let frame = Window {
+            x: 0,
+            y: 0,
+            width: self.frame.0,
+            height: self.frame.1,
+        };
+        // Without a wireframe, a triangle that covers no pixel centre's box draws nothing.
+        let outlined = params.wireframe.is_some();
         const EMPTY: [u16; 2] = [1, 0];
         let mut stats = DrawStats {
             submitted: triangles.len() as u32,
@@ -418,6 +426,9 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
                     if facing == Facing::Front {
                         continue; // neither filled nor outlined
                     }
+                }
+                if !outlined && pixel_bounds(v.map(|v| [v.x, v.y]), &frame).is_none() {
+                    continue;
                 }
                 // Whole pixel rows: they hold the pixel centres filled and the wireframe's pixels.
                 let ys = v.map(|v| v.y >> SUBPIXEL_BITS);
@@ -444,6 +455,18 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
                     },
                 );
                 *row = [0, last as u16];
+            }
+        }
+        // Each run of triangles that meet no row holds its remaining length, so that a band steps
+        // over the run at once: the full-detail bunny on a small frame has five such triangles
+        // to each one drawn.
+        let mut run = 0u16;
+        for row in rows[..triangles.len()].iter_mut().rev() {
+            if row[0] > row[1] {
+                run = run.saturating_add(1);
+                *row = [SKIP, run];
+            } else {
+                run = 0;
             }
         }
         Ok(BinnedMesh {
@@ -493,16 +516,22 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
             ..DrawStats::default()
         };
         let (top, bottom) = (target.window.y, target.window.y + target.window.height - 1);
-        let misses = |t: usize| {
-            BINNED && {
+        let triangles = mesh.triangles();
+        let mut next = 0;
+        while next < triangles.len() {
+            let t = next;
+            next += 1;
+            if BINNED {
                 let [first, last] = rows[t].map(usize::from);
-                last < top || first > bottom
+                if first == usize::from(SKIP) {
+                    next = t + last.max(1);
+                    continue;
+                }
+                if (last < top) | (first > bottom) {
+                    continue;
+                }
             }
-        };
-        for (t, tri) in mesh.triangles().iter().enumerate() {
-            if misses(t) {
-                continue;
-            }
+            let tri = &triangles[t];
             // Indices as scalars and references, not copies: a culled triangle reads only
             // positions and outcodes (an index array here went through the stack, and reading
             // one index back from the wider store stalled every triangle).
@@ -659,6 +688,10 @@ fn clockwise<T>(area: i64, [a, b, c]: [T; 3]) -> [T; 3] {
         [a, b, c]
     }
 }
+
+/// First row of a [`ShadedMesh::bin`] entry that starts a run of triangles meeting no row; the
+/// entry's second value is the run's remaining length. (Rows are below [`crate::MAX_DIMENSION`].)
+const SKIP: u16 = u16::MAX;
 
 /// How the triangle loop fills each triangle it keeps: the one thing a plain and a textured draw
 /// do differently. A trait rather than a closure, so that the fill is inlined at both of the
