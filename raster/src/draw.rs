@@ -382,7 +382,9 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
     /// Bins the triangles by pixel row once, so that each band of a frame drawn in bands skips
     /// the triangles that miss it after reading four bytes, instead of three shaded vertices.
     /// `rows` needs one entry per triangle (4 bytes each) and holds each triangle's first and
-    /// last row. The statistics of the whole frame are counted here, and every draw returns them.
+    /// last row, or, for a run of triangles that meet no row (facing away, or without a
+    /// wireframe covering no pixel centre's box), the run's remaining length, so that a band
+    /// steps over the run at once. The statistics of the whole frame are counted here, and every draw returns them.
     pub fn bin(self, rows: &'a mut [[u16; 2]]) -> Result<BinnedMesh<'a, M>, DrawError> {
         let triangles = self.mesh.triangles();
         if rows.len() < triangles.len() {
