@@ -170,8 +170,8 @@ impl Bands {
         let shaded = shade(&scene.mesh, &scene.params, w, h, &mut self.scratch).expect("shades");
         let binned = shaded.bin(&mut self.bins).expect("bins");
         for band in Window::bands(w, h, BAND_ROWS) {
-            let mut t = Target::window(&mut self.color, &mut self.depth, w, h, band, w)
-                .expect("band");
+            let mut t =
+                Target::window(&mut self.color, &mut self.depth, w, h, band, w).expect("band");
             t.clear(BACKGROUND);
             black_box(binned.draw(&mut t).expect("draws"));
             black_box(t.color());
