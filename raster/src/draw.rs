@@ -285,6 +285,10 @@ pub struct BinnedMesh<'a, M: MeshSource> {
     stats: DrawStats,
 }
 
+/// First row of a [`ShadedMesh::bin`] entry in a run of triangles that meet no row; the entry's
+/// second value is the run's remaining length. (Rows are below [`crate::MAX_DIMENSION`].)
+const SKIP: u16 = u16::MAX;
+
 // By hand: a derive would ask `M: Copy`, and both hold only references and plain values.
 impl<M: MeshSource> Clone for ShadedMesh<'_, M> {
     fn clone(&self) -> Self {
@@ -384,7 +388,8 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
     /// `rows` needs one entry per triangle (4 bytes each) and holds each triangle's first and
     /// last row, or, for a run of triangles that meet no row (facing away, or without a
     /// wireframe covering no pixel centre's box), the run's remaining length, so that a band
-    /// steps over the run at once. The statistics of the whole frame are counted here, and every draw returns them.
+    /// steps over the run at once. The statistics of the whole frame are counted here, and
+    /// every draw returns them.
     pub fn bin(self, rows: &'a mut [[u16; 2]]) -> Result<BinnedMesh<'a, M>, DrawError> {
         let triangles = self.mesh.triangles();
         if rows.len() < triangles.len() {
@@ -396,12 +401,7 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
         let (params, scratch) = (self.params, self.vertices);
         let facing = Facing::culling(params.cull_back_faces);
         let last = self.frame.1 as i32 - 1;
-        let frame = Window {
-            x: 0,
-            y: 0,
-            width: self.frame.0,
-            height: self.frame.1,
-        };
+        let frame = Window::full(self.frame.0, self.frame.1);
         // Without a wireframe, a triangle that covers no pixel centre's box draws nothing.
         let outlined = params.wireframe.is_some();
         const EMPTY: [u16; 2] = [1, 0];
@@ -420,7 +420,8 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
             let union = v[0].outcode | v[1].outcode | v[2].outcode;
             *row = EMPTY;
             if union == 0 {
-                let area = signed_area2_xy(v.map(|v| [v.x, v.y]));
+                let xy = v.map(|v| [v.x, v.y]);
+                let area = signed_area2_xy(xy);
                 if facing.draws(area) {
                     stats.rasterized += 1;
                 } else {
@@ -429,7 +430,7 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
                         continue; // neither filled nor outlined
                     }
                 }
-                if !outlined && pixel_bounds(v.map(|v| [v.x, v.y]), &frame).is_none() {
+                if !outlined && pixel_bounds(xy, &frame).is_none() {
                     continue;
                 }
                 // Whole pixel rows: they hold the pixel centres filled and the wireframe's pixels.
@@ -690,10 +691,6 @@ fn clockwise<T>(area: i64, [a, b, c]: [T; 3]) -> [T; 3] {
         [a, b, c]
     }
 }
-
-/// First row of a [`ShadedMesh::bin`] entry that starts a run of triangles meeting no row; the
-/// entry's second value is the run's remaining length. (Rows are below [`crate::MAX_DIMENSION`].)
-const SKIP: u16 = u16::MAX;
 
 /// How the triangle loop fills each triangle it keeps: the one thing a plain and a textured draw
 /// do differently. A trait rather than a closure, so that the fill is inlined at both of the
