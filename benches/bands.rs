@@ -3,11 +3,11 @@
 //! Scenes, both at 320x240 in Rgb565 with 16-bit depth, from the peer camera (azimuth 30 and
 //! elevation 20 degrees): the bunny's cut under a 5,000-triangle budget at 1 px (what a device
 //! draws), and the full-detail bunny (75,408 triangles). Each frame is drawn whole (one 320x240
-//! colour and depth buffer) and in bands of 16 and of 40 rows through one band-sized buffer
-//! (vertices shaded once per frame, every triangle re-read per band); the three alternate frame
-//! by frame, and the minimum and median per frame and the ratios to the whole-frame draw are
-//! printed; then the same bands with the triangles binned by row once per frame
-//! (`ShadedMesh::bin`, 4 bytes per triangle).
+//! colour and depth buffer) and in bands through one band-sized buffer (vertices shaded once per
+//! frame): 16-row bands that re-read every triangle; 16- and 40-row bands that scan the row bins
+//! (`ShadedMesh::bin` with 4 bytes per triangle); and the same with room for the per-band lists,
+//! so that each band reads only its own triangles. The six alternate frame by frame, and the
+//! minimum and median per frame and the ratios to the whole-frame draw are printed.
 //!
 //! Run: `cargo bench --bench bands`.
 
@@ -38,16 +38,38 @@ fn whole<M: MeshSource>(mesh: &M, params: &vdlod_raster::DrawParams, buf: &mut B
     shaded.draw(&mut t).expect("draws").rasterized
 }
 
-/// Bands without bins (a function of its own, so that profiles tell the two apart).
+/// How a band finds its triangles.
+#[derive(Clone, Copy)]
+enum Bins {
+    /// It reads them all.
+    None,
+    /// It scans the row bins (4 bytes per triangle).
+    Rows,
+    /// It reads its own list (the bins have room for them).
+    Lists,
+}
+
+/// Bands without bins (a function of its own per kind, so that profiles tell them apart).
 #[inline(never)]
 fn plain<M: MeshSource>(m: &M, p: &vdlod_raster::DrawParams, b: &mut Buffers, rows: usize) -> u32 {
-    banded(m, p, b, rows, false)
+    banded(m, p, b, rows, Bins::None)
 }
 
 /// Bands with row bins.
 #[inline(never)]
-fn binned<M: MeshSource>(m: &M, p: &vdlod_raster::DrawParams, b: &mut Buffers, rows: usize) -> u32 {
-    banded(m, p, b, rows, true)
+fn scanned<M: MeshSource>(
+    m: &M,
+    p: &vdlod_raster::DrawParams,
+    b: &mut Buffers,
+    rows: usize,
+) -> u32 {
+    banded(m, p, b, rows, Bins::Rows)
+}
+
+/// Bands with a list each.
+#[inline(never)]
+fn listed<M: MeshSource>(m: &M, p: &vdlod_raster::DrawParams, b: &mut Buffers, rows: usize) -> u32 {
+    banded(m, p, b, rows, Bins::Lists)
 }
 
 #[inline(always)]
@@ -56,10 +78,19 @@ fn banded<M: MeshSource>(
     params: &vdlod_raster::DrawParams,
     buf: &mut Buffers,
     rows: usize,
-    binned: bool,
+    bins: Bins,
 ) -> u32 {
     let shaded = shade(mesh, params, W, H, &mut buf.scratch).expect("shades");
-    let binned = binned.then(|| shaded.bin(&mut buf.bins).expect("bins"));
+    let space = match bins {
+        Bins::None => None,
+        Bins::Rows => Some(&mut buf.bins[..mesh.triangles().len()]),
+        Bins::Lists => Some(&mut buf.bins[..]),
+    };
+    let binned = space.map(|space| shaded.bin(rows, space).expect("bins"));
+    assert_eq!(
+        binned.is_some_and(|b| b.has_band_lists()),
+        matches!(bins, Bins::Lists)
+    );
     let mut n = 0;
     for band in Window::bands(W, H, rows) {
         let mut t = Target::window(&mut buf.color, &mut buf.depth, W, H, band, W).expect("band");
@@ -78,7 +109,7 @@ struct Buffers {
     color: Vec<Rgb565>,
     depth: Vec<u16>,
     scratch: Vec<ShadedVertex>,
-    bins: Vec<[u16; 2]>,
+    bins: Vec<u32>,
 }
 
 fn stats(mut v: Vec<f64>) -> (f64, f64) {
@@ -91,18 +122,19 @@ fn run<M: MeshSource>(name: &str, mesh: &M, params: &vdlod_raster::DrawParams) {
         color: vec![Rgb565(0); W * H],
         depth: vec![0; W * H],
         scratch: vec![ShadedVertex::default(); mesh.vertex_count()],
-        bins: vec![[0; 2]; mesh.triangles().len()],
+        bins: vec![0; 3 * mesh.triangles().len() + H + 1],
     };
-    let mut times = [Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new()];
+    let mut times: [Vec<f64>; 6] = Default::default();
     for _ in 0..rounds() {
         for (k, t) in times.iter_mut().enumerate() {
             let start = Instant::now();
             black_box(match k {
                 0 => whole(mesh, params, &mut buf),
                 1 => plain(mesh, params, &mut buf, 16),
-                2 => plain(mesh, params, &mut buf, 40),
-                3 => binned(mesh, params, &mut buf, 16),
-                _ => binned(mesh, params, &mut buf, 40),
+                2 => scanned(mesh, params, &mut buf, 16),
+                3 => scanned(mesh, params, &mut buf, 40),
+                4 => listed(mesh, params, &mut buf, 16),
+                _ => listed(mesh, params, &mut buf, 40),
             });
             t.push(start.elapsed().as_secs_f64() * 1e6);
         }
@@ -139,10 +171,10 @@ fn main() {
     let drawn = style(Shading::Gouraud, false);
     let params = drawn.params(&camera);
     println!(
-        "| scene | whole frame us (min / median) | 15 bands of 16 rows | 6 bands of 40 rows \
-         | 16 rows, binned | 40 rows, binned |"
+        "| scene | whole frame us (min / median) | 15 bands of 16 rows, unbinned \
+         | 16 rows, row bins | 40 rows, row bins | 16 rows, band lists | 40 rows, band lists |"
     );
-    println!("|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|");
     let cut_mesh = CutMesh::new(&cut, &h, false);
     run(
         &format!("bunny cut, {} triangles", cut.triangles().len()),

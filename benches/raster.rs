@@ -152,7 +152,7 @@ struct Bands {
     color: Vec<Rgba8>,
     depth: Vec<u32>,
     scratch: Vec<ShadedVertex>,
-    bins: Vec<[u16; 2]>,
+    bins: Vec<u32>,
 }
 
 impl Bands {
@@ -161,14 +161,14 @@ impl Bands {
             color: vec![BACKGROUND; width * BAND_ROWS],
             depth: vec![0; width * BAND_ROWS],
             scratch: vec![ShadedVertex::default(); mesh.positions.len()],
-            bins: vec![[0; 2]; mesh.triangles.len()],
+            bins: vec![0; 3 * mesh.triangles.len() + 64],
         }
     }
 
     fn draw(&mut self, scene: &Scene<'_>) {
         let (w, h) = (scene.frame.width(), scene.frame.height());
         let shaded = shade(&scene.mesh, &scene.params, w, h, &mut self.scratch).expect("shades");
-        let binned = shaded.bin(&mut self.bins).expect("bins");
+        let binned = shaded.bin(BAND_ROWS, &mut self.bins).expect("bins");
         for band in Window::bands(w, h, BAND_ROWS) {
             let mut t =
                 Target::window(&mut self.color, &mut self.depth, w, h, band, w).expect("band");

@@ -45,7 +45,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // Drawn in 16-row bands, stitched into a picture.
     let (w, h) = (camera.width, camera.height);
     let (mut color, mut depth) = (vec![Rgb565(0); w * 16], vec![0u16; w * 16]);
-    let mut bins = vec![[0u16; 2]; 5000];
+    let mut bins = vec![0u32; 10_000]; // rows and band lists for up to 5,000 triangles
     let mut scratch = vec![ShadedVertex::default(); cut.vertex_count()];
     let bands = Bands {
         color: &mut color,

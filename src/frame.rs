@@ -290,7 +290,7 @@ pub fn draw_mesh_textured<P: Pixel, D: Depth, M: MeshSource, T: Pixel>(
 }
 
 /// Band buffers: one colour and one depth buffer of `rows` full-width rows, reused for every
-/// band of a frame, and the triangles' row bins.
+/// band of a frame, and the triangles' bins.
 pub struct Bands<'b, P: Pixel, D: Depth> {
     /// Colour, at least `width * rows` pixels.
     pub color: &'b mut [P],
@@ -300,11 +300,12 @@ pub struct Bands<'b, P: Pixel, D: Depth> {
     pub rows: usize,
     /// What each band is cleared to before it is drawn.
     pub background: P,
-    /// Each triangle's rows, one entry per triangle slot of the cut (4 bytes each), so that a
-    /// band skips the triangles that miss it (see [`vdlod_raster::ShadedMesh::bin`]). (Without
-    /// bins every band re-reads every triangle's vertices: `vdlod_raster` can draw that way, at
-    /// 2.5 times the time of a whole-frame draw in 16-row bands of 320x240.)
-    pub bins: &'b mut [[u16; 2]],
+    /// Each triangle's rows, at least one entry per triangle slot of the cut (4 bytes each), so
+    /// that a band skips the triangles that miss it; with about one more per slot (and one per
+    /// band), each band reads only its own triangles (see [`vdlod_raster::ShadedMesh::bin`]).
+    /// (Without bins every band re-reads every triangle's vertices: `vdlod_raster` can draw that
+    /// way, at 2.5 times the time of a whole-frame draw in 16-row bands of 320x240.)
+    pub bins: &'b mut [u32],
 }
 
 /// Draws `cut` as `camera` sees it, band by band through `bands`, calling `flush` with each
@@ -328,13 +329,13 @@ pub struct Bands<'b, P: Pixel, D: Depth> {
 /// let camera = Orbit::peer(center.into(), radius, 36).viewport(64, 48).camera(0);
 /// vdlod::adapt(&mut cut, &h, &camera, &QRefine::new(1.0), &Budget::default())?;
 /// let (mut color, mut depth) = ([Rgb565(0); 64 * 16], [0u16; 64 * 16]);
-/// let mut rows = [[0u16; 2]; 128]; // one per triangle slot: each band skips what misses it
+/// let mut bins = [0u32; 2 * 128 + 3]; // two per triangle slot, one per band and one more
 /// let bands = Bands {
 ///     color: &mut color,
 ///     depth: &mut depth,
 ///     rows: 16,
 ///     background: Rgb565(0),
-///     bins: &mut rows,
+///     bins: &mut bins,
 /// };
 /// let mut scratch = [ShadedVertex::default(); 64];
 /// let mut lit = 0;
@@ -384,7 +385,7 @@ pub fn draw_mesh_bands<P: Pixel, D: Depth, M: MeshSource>(
     if rows == 0 {
         return Err(TargetError::ZeroSize.into());
     }
-    let binned = shade(mesh, &params, width, height, scratch)?.bin(bins)?;
+    let binned = shade(mesh, &params, width, height, scratch)?.bin(rows, bins)?;
     let mut stats = DrawStats::default();
     for band in Window::bands(width, height, rows) {
         let mut target = Target::window(color, depth, width, height, band, width)?;

@@ -64,19 +64,45 @@ fn whole_stats(mesh: &Mesh<'_>, params: &DrawParams) -> DrawStats {
     whole::<u32>(mesh, params).2
 }
 
+/// How a windowed draw finds each window's triangles.
+#[derive(Clone, Copy, Debug)]
+enum Bins {
+    /// Every window reads every triangle.
+    None,
+    /// Row bins only (one entry per triangle).
+    Rows,
+    /// Bins for bands of this many rows, with `entries` in all.
+    Lists { band_rows: usize, entries: usize },
+}
+
+impl Bins {
+    /// Bins for bands of `band_rows` rows with room to spare for the lists.
+    fn ample(mesh: &Mesh<'_>, band_rows: usize) -> Bins {
+        let entries = 8 * mesh.triangles.len() + H.div_ceil(band_rows) + 1;
+        Bins::Lists { band_rows, entries }
+    }
+}
+
 /// Draws the frame window by window through one buffer of `stride * rows` entries (with padding
-/// columns that must stay untouched), shading once, and stitches the windows.
+/// columns that must stay untouched), shading once, and stitches the windows. Also says whether
+/// the bins held band lists.
 fn windowed<D: Depth>(
     mesh: &Mesh<'_>,
     params: &DrawParams,
     windows: &[Window],
     stride: usize,
-    binned: bool,
-) -> (Vec<Rgba8>, Vec<D>) {
+    bins: Bins,
+) -> (Vec<Rgba8>, Vec<D>, bool) {
     let mut scratch = vec![ShadedVertex::default(); mesh.positions.len()];
-    let mut rows = vec![[0u16; 2]; mesh.triangles.len()];
+    let (band_rows, entries) = match bins {
+        Bins::None => (1, 0),
+        Bins::Rows => (16, mesh.triangles.len()),
+        Bins::Lists { band_rows, entries } => (band_rows, entries),
+    };
+    let mut space = vec![0u32; entries];
     let shaded = shade(mesh, params, W, H, &mut scratch).unwrap();
-    let binned = binned.then(|| shaded.bin(&mut rows).unwrap());
+    let binned = (entries > 0).then(|| shaded.bin(band_rows, &mut space).unwrap());
+    let listed = binned.is_some_and(|b| b.has_band_lists());
     let rows = windows.iter().map(|w| w.height).max().unwrap();
     let (mut color, mut depth) = (vec![BG; W * H], vec![D::CLEAR; W * H]);
     let sentinel = Rgba8([1, 2, 3, 4]);
@@ -108,7 +134,7 @@ fn windowed<D: Depth>(
             }
         }
     }
-    (color, depth)
+    (color, depth, listed)
 }
 
 #[test]
@@ -122,14 +148,75 @@ fn bands_stitch_to_the_whole_frame() {
         assert!(color.iter().filter(|&&c| c != BG).count() > W * H / 3);
         for rows in [1, 7, 16, 40, H] {
             let bands: Vec<Window> = Window::bands(W, H, rows).collect();
+            // Lists for these bands, for bands of 16 rows (windows within a band read its
+            // list, the others scan the rows), row bins, none.
+            let bins = [
+                Bins::ample(&mesh, rows),
+                Bins::ample(&mesh, 16),
+                Bins::Rows,
+                Bins::None,
+            ];
             for stride in [W, W + 3] {
-                for binned in [false, true] {
-                    let (c, d) = windowed::<u32>(&mesh, &p, &bands, stride, binned);
-                    let case = format!("rows {rows}, stride {stride}, wire {wire}, bins {binned}");
+                for bins in bins {
+                    let (c, d, listed) = windowed::<u32>(&mesh, &p, &bands, stride, bins);
+                    let case = format!("rows {rows}, stride {stride}, wire {wire}, {bins:?}");
+                    assert_eq!(listed, matches!(bins, Bins::Lists { .. }), "{case}");
                     assert!(c == color, "{case}");
                     assert!(d == depth, "{case}");
                 }
             }
+        }
+    }
+}
+
+/// Bins of every size the layouts switch at draw the same frame: row bins (one entry per
+/// triangle), pairs without band lists (two per triangle and one per band plus one, or more
+/// while the lists do not fit), and pairs with lists.
+#[test]
+fn bins_of_every_layout_draw_the_same_frame() {
+    let (m, mvp) = scene();
+    let mesh = m.as_raster_mesh();
+    // Back faces drawn too, and outlined: nearly every triangle meets a row.
+    let p = DrawParams {
+        cull_back_faces: false,
+        ..params(mvp, true)
+    };
+    let (color, depth, _) = whole::<u32>(&mesh, &p);
+    let n = mesh.triangles.len();
+    for band_rows in [1, 16] {
+        let bands: Vec<Window> = Window::bands(W, H, band_rows).collect();
+        let pairs = 2 * n + bands.len() + 1;
+        let draw =
+            |entries| windowed::<u32>(&mesh, &p, &bands, W, Bins::Lists { band_rows, entries });
+        let mut scratch = vec![ShadedVertex::default(); mesh.positions.len()];
+        let mut fits = |entries| {
+            let shaded = shade(&mesh, &p, W, H, &mut scratch).unwrap();
+            let mut space = vec![0u32; entries];
+            shaded.bin(band_rows, &mut space).unwrap().has_band_lists()
+        };
+        // The fewest entries that hold the lists, by bisection (the answer is monotone).
+        let (mut lo, mut hi) = (n, 8 * n);
+        assert!(fits(hi) && !fits(lo));
+        while hi - lo > 1 {
+            let mid = (lo + hi) / 2;
+            if fits(mid) {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        // Pairs without lists in between.
+        assert!(
+            lo >= pairs,
+            "{lo} entries, pairs from {pairs}, {band_rows} rows"
+        );
+        for entries in [n, pairs - 1, pairs, lo, hi] {
+            let (c, d, listed) = draw(entries);
+            assert_eq!(listed, entries >= hi, "{entries} entries, {band_rows} rows");
+            assert!(
+                c == color && d == depth,
+                "{entries} entries, {band_rows} rows"
+            );
         }
     }
 }
@@ -151,9 +238,9 @@ fn tiles_stitch_to_the_whole_frame_with_16_bit_depth() {
             });
         }
     }
-    for binned in [false, true] {
-        let (c, d) = windowed::<u16>(&mesh, &p, &tiles, 50, binned);
-        assert!(c == color && d == depth);
+    for bins in [Bins::ample(&mesh, 32), Bins::Rows, Bins::None] {
+        let (c, d, _) = windowed::<u16>(&mesh, &p, &tiles, 50, bins);
+        assert!(c == color && d == depth, "{bins:?}");
     }
 }
 
@@ -203,10 +290,14 @@ fn bad_windows_and_frames_are_typed_errors() {
         shade(&mesh, &p, 0, H, &mut scratch).err(),
         Some(DrawError::Frame(TargetError::ZeroSize))
     );
-    let mut rows = vec![[0u16; 2]; mesh.triangles.len() - 1];
+    let mut bins = vec![0u32; mesh.triangles.len() - 1];
     let shaded = shade(&mesh, &p, W, H, &mut scratch).unwrap();
     assert_eq!(
-        shaded.bin(&mut rows).err(),
+        shaded.bin(0, &mut bins).err(),
+        Some(DrawError::Frame(TargetError::ZeroSize))
+    );
+    assert_eq!(
+        shaded.bin(16, &mut bins).err(),
         Some(DrawError::BinsTooSmall {
             needed: mesh.triangles.len(),
             available: mesh.triangles.len() - 1
@@ -290,7 +381,10 @@ fn long_runs_of_empty_triangles_are_skipped_exactly() {
     assert!(color.iter().filter(|&&c| c != BG).count() > W * H / 4);
     for rows in [1, 16, H] {
         let bands: Vec<Window> = Window::bands(W, H, rows).collect();
-        let (c, d) = windowed::<u32>(&mesh, &p, &bands, W, true);
-        assert!(c == color && d == depth, "rows {rows}");
+        for bins in [Bins::ample(&mesh, rows), Bins::Rows] {
+            let (c, d, listed) = windowed::<u32>(&mesh, &p, &bands, W, bins);
+            assert_eq!(listed, matches!(bins, Bins::Lists { .. }), "rows {rows}");
+            assert!(c == color && d == depth, "rows {rows}, {bins:?}");
+        }
     }
 }

@@ -73,7 +73,7 @@ fn bands_through_the_facade_equal_the_whole_frame() {
         whole.clear(Rgba8([1, 2, 3, 255]));
         let stats = vdlod::draw(&mut whole, &cut, &h, &camera, &style, &mut scratch).unwrap();
         {
-            let mut rows = vec![[0u16; 2]; cut.triangles().len()];
+            let mut rows = vec![0u32; 2 * cut.triangles().len() + 8];
             let (mut c, mut d) = (vec![Rgba8::default(); 96 * 10], vec![0u16; 96 * 10]);
             let bands = Bands {
                 color: &mut c,
@@ -119,7 +119,7 @@ fn bad_cameras_and_band_buffers_are_typed_errors() {
     );
     let mut scratch = vec![ShadedVertex::default(); 4096];
     let (mut c, mut d) = (vec![Rgb565(0); 64 * 8], vec![0u16; 64 * 8]);
-    let mut bins = vec![[0u16; 2]; 8192];
+    let mut bins = vec![0u32; 8192];
     let mut bands = |rows: usize, len: usize, camera: &Camera| {
         let b = Bands {
             color: &mut c[..len],

@@ -209,7 +209,7 @@ fn bunny_cut_in_bands_rgb565_u16_depth() {
     let mut scratch = vec![ShadedVertex::default(); 2508];
     let (mut color, mut depth) = (vec![Rgb565(0); W * 16], vec![0u16; W * 16]);
     let mut pixels = Vec::with_capacity(W * H);
-    let mut bins = vec![[0u16; 2]; 5000];
+    let mut bins = vec![0u32; 5000]; // row bins only, as on the device
     for i in 0..=7 {
         let camera = orbit.camera(i);
         vdlod::adapt(&mut cut, &h, &camera, &QRefine::new(1.0), &budget).unwrap();
@@ -276,7 +276,7 @@ fn sphere_wavelet_cut() {
     check("sphere_wavelet_cut", &whole);
 
     let (mut color, mut depth) = (vec![Rgba8([0; 4]); W * 16], vec![0u32; W * 16]);
-    let mut bins = vec![[0u16; 2]; 4096];
+    let mut bins = vec![0u32; 8192]; // rows and band lists
     let mut scratch = vec![ShadedVertex::default(); cut.vertex_count()];
     let bands = Bands {
         color: &mut color,

@@ -7,12 +7,15 @@
 //! for, is drawn afterwards over the filled window. [`draw_indexed`] does both for a whole frame.
 //!
 //! A frame drawn in bands shades once and draws once per band. [`ShadedMesh::draw`] re-reads every
-//! triangle's three shaded vertices in every band; [`ShadedMesh::bin`] records each triangle's rows
-//! once (4 bytes per triangle) so that [`BinnedMesh::draw`] skips the triangles that miss a band.
-//! Triangles that span several bands are set up once per band, and the few that need clipping are
-//! clipped again in each.
+//! triangle's three shaded vertices in every band; [`ShadedMesh::bin`] culls once and records
+//! which rows each triangle meets (from 4 bytes per triangle, see `bins`) so that
+//! [`BinnedMesh::draw`] reads only the triangles that meet a band. Triangles that span several
+//! bands are set up once per band, and the few that need clipping are clipped again in each.
 
+mod bins;
 mod textured;
+
+pub use bins::BinnedMesh;
 
 use core::fmt;
 
@@ -276,19 +279,6 @@ pub struct ShadedMesh<'a, M: MeshSource> {
     frame: (usize, usize),
 }
 
-/// A [`ShadedMesh`] with its triangles binned by pixel row ([`ShadedMesh::bin`]), for a frame
-/// drawn in bands: each band skips the triangles that miss it after reading four bytes.
-#[derive(Debug)]
-pub struct BinnedMesh<'a, M: MeshSource> {
-    shaded: ShadedMesh<'a, M>,
-    rows: &'a [[u16; 2]],
-    stats: DrawStats,
-}
-
-/// First row of a [`ShadedMesh::bin`] entry in a run of triangles that meet no row; the entry's
-/// second value is the run's remaining length. (Rows are below [`crate::MAX_DIMENSION`].)
-const SKIP: u16 = u16::MAX;
-
 // By hand: a derive would ask `M: Copy`, and both hold only references and plain values.
 impl<M: MeshSource> Clone for ShadedMesh<'_, M> {
     fn clone(&self) -> Self {
@@ -297,29 +287,6 @@ impl<M: MeshSource> Clone for ShadedMesh<'_, M> {
 }
 
 impl<M: MeshSource> Copy for ShadedMesh<'_, M> {}
-
-impl<M: MeshSource> Clone for BinnedMesh<'_, M> {
-    fn clone(&self) -> Self {
-        *self
-    }
-}
-
-impl<M: MeshSource> Copy for BinnedMesh<'_, M> {}
-
-impl<M: MeshSource> BinnedMesh<'_, M> {
-    /// Draws the triangles that meet `target`'s window, which must be (a window of) the frame
-    /// the mesh was shaded for; returns the statistics of the whole frame, counted by
-    /// [`ShadedMesh::bin`].
-    pub fn draw<P: Pixel, D: Depth>(
-        &self,
-        target: &mut Target<'_, P, D>,
-    ) -> Result<DrawStats, DrawError> {
-        self.shaded.check_frame(target)?;
-        self.shaded
-            .draw_triangles::<P, D, true, _>(target, self.rows, &Plain);
-        Ok(self.stats)
-    }
-}
 
 /// Runs the vertex stage of `mesh` for a `width` by `height` frame into `scratch` (at least one
 /// [`ShadedVertex`] per vertex; it is overwritten).
@@ -383,102 +350,6 @@ pub fn shade<'a, M: MeshSource>(
 }
 
 impl<'a, M: MeshSource> ShadedMesh<'a, M> {
-    /// Bins the triangles by pixel row once, so that each band of a frame drawn in bands skips
-    /// the triangles that miss it after reading four bytes, instead of three shaded vertices.
-    /// `rows` needs one entry per triangle (4 bytes each) and holds each triangle's first and
-    /// last row, or, for a run of triangles that meet no row (facing away, or without a
-    /// wireframe covering no pixel centre's box), the run's remaining length, so that a band
-    /// steps over the run at once. The statistics of the whole frame are counted here, and
-    /// every draw returns them.
-    pub fn bin(self, rows: &'a mut [[u16; 2]]) -> Result<BinnedMesh<'a, M>, DrawError> {
-        let triangles = self.mesh.triangles();
-        if rows.len() < triangles.len() {
-            return Err(DrawError::BinsTooSmall {
-                needed: triangles.len(),
-                available: rows.len(),
-            });
-        }
-        let (params, scratch) = (self.params, self.vertices);
-        let facing = Facing::culling(params.cull_back_faces);
-        let last = self.frame.1 as i32 - 1;
-        let frame = Window::full(self.frame.0, self.frame.1);
-        // Without a wireframe, a triangle that covers no pixel centre's box draws nothing.
-        let outlined = params.wireframe.is_some();
-        const EMPTY: [u16; 2] = [1, 0];
-        let mut stats = DrawStats {
-            submitted: triangles.len() as u32,
-            ..DrawStats::default()
-        };
-        for (tri, row) in triangles.iter().zip(rows.iter_mut()) {
-            // Scalars until needed, as in the triangle loop.
-            let [i0, i1, i2] = tri.map(VertexIndex::to_u32);
-            let v = [
-                &scratch[i0 as usize],
-                &scratch[i1 as usize],
-                &scratch[i2 as usize],
-            ];
-            let union = v[0].outcode | v[1].outcode | v[2].outcode;
-            *row = EMPTY;
-            if union == 0 {
-                let xy = v.map(|v| [v.x, v.y]);
-                let area = signed_area2_xy(xy);
-                if facing.draws(area) {
-                    stats.rasterized += 1;
-                } else {
-                    stats.culled += 1;
-                    if facing == Facing::Front {
-                        continue; // neither filled nor outlined
-                    }
-                }
-                if !outlined && pixel_bounds(xy, &frame).is_none() {
-                    continue;
-                }
-                // Whole pixel rows: they hold the pixel centres filled and the wireframe's pixels.
-                let ys = v.map(|v| v.y >> SUBPIXEL_BITS);
-                let first = ys[0].min(ys[1]).min(ys[2]).max(0);
-                let end = ys[0].max(ys[1]).max(ys[2]).min(last);
-                if first <= end {
-                    *row = [first as u16, end as u16];
-                }
-            } else if needs_clipping(&v, union, &mut stats) {
-                for_each_clipped(
-                    &self.viewport,
-                    params,
-                    self.mesh,
-                    &[i0, i1, i2],
-                    [[0.0; 3]; 3],
-                    [[0.0; 2]; 3],
-                    union,
-                    |s, _| {
-                        if facing.draws(signed_area2(s)) {
-                            stats.rasterized += 1;
-                        } else {
-                            stats.culled += 1;
-                        }
-                    },
-                );
-                *row = [0, last as u16];
-            }
-        }
-        // Each run of triangles that meet no row holds its remaining length, so that a band steps
-        // over the run at once: the full-detail bunny on a small frame has five such triangles
-        // to each one drawn.
-        let mut run = 0u16;
-        for row in rows[..triangles.len()].iter_mut().rev() {
-            if row[0] > row[1] {
-                run = run.saturating_add(1);
-                *row = [SKIP, run];
-            } else {
-                run = 0;
-            }
-        }
-        Ok(BinnedMesh {
-            shaded: self,
-            rows,
-            stats,
-        })
-    }
-
     /// Draws the triangles into `target`, which must be (a window of) the frame the mesh was
     /// shaded for. The statistics are those of the whole frame, whatever the window.
     pub fn draw<P: Pixel, D: Depth>(
@@ -486,7 +357,7 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
         target: &mut Target<'_, P, D>,
     ) -> Result<DrawStats, DrawError> {
         self.check_frame(target)?;
-        Ok(self.draw_triangles::<P, D, false, _>(target, &[], &Plain))
+        Ok(self.draw_triangles(target, 0..self.mesh.triangles().len(), &Plain))
     }
 
     fn check_frame<P: Pixel, D: Depth>(&self, target: &Target<'_, P, D>) -> Result<(), DrawError> {
@@ -500,14 +371,13 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
         }
     }
 
-    /// The triangle loop and the wireframe pass; with `BINNED`, triangles whose `rows` miss the
-    /// target's window are skipped (two copies of the loop, so that a whole-frame draw pays
-    /// nothing for the bins, and a device that always bins carries one). `fill` fills each
-    /// triangle kept (see [`Fill`]).
-    fn draw_triangles<P: Pixel, D: Depth, const BINNED: bool, F: Fill<P, D>>(
+    /// The triangle loop and the wireframe pass over the triangles `order` yields (all of them,
+    /// or those a band's bins name), in draw order. `fill` fills each triangle kept (see
+    /// [`Fill`]).
+    fn draw_triangles<P: Pixel, D: Depth, F: Fill<P, D>>(
         &self,
         target: &mut Target<'_, P, D>,
-        rows: &[[u16; 2]],
+        order: impl Iterator<Item = usize> + Clone,
         fill: &F,
     ) -> DrawStats {
         let (mesh, params, scratch) = (self.mesh, self.params, self.vertices);
@@ -518,22 +388,8 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
             submitted: mesh.triangles().len() as u32,
             ..DrawStats::default()
         };
-        let (top, bottom) = (target.window.y, target.window.y + target.window.height - 1);
         let triangles = mesh.triangles();
-        let mut next = 0;
-        while next < triangles.len() {
-            let t = next;
-            next += 1;
-            if BINNED {
-                let [first, last] = rows[t].map(usize::from);
-                if first == usize::from(SKIP) {
-                    next = t + last.max(1);
-                    continue;
-                }
-                if (last < top) | (first > bottom) {
-                    continue;
-                }
-            }
+        for t in order.clone() {
             let tri = &triangles[t];
             // Indices as scalars and references, not copies: a culled triangle reads only
             // positions and outcodes (an index array here went through the stack, and reading
@@ -611,32 +467,24 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
                 });
             }
         }
-        self.draw_wireframe::<P, D, BINNED>(target, rows);
+        self.draw_wireframe(target, order);
         stats
     }
 
-    /// The wireframe overlay, when [`DrawParams::wireframe`] asks for it (binned as
-    /// [`ShadedMesh::draw_triangles`] is).
-    fn draw_wireframe<P: Pixel, D: Depth, const BINNED: bool>(
+    /// The wireframe overlay, when [`DrawParams::wireframe`] asks for it, over the triangles
+    /// `order` yields.
+    fn draw_wireframe<P: Pixel, D: Depth>(
         &self,
         target: &mut Target<'_, P, D>,
-        rows: &[[u16; 2]],
+        order: impl Iterator<Item = usize>,
     ) {
         let (mesh, params, scratch) = (self.mesh, self.params, self.vertices);
         let viewport = &self.viewport;
-        let (top, bottom) = (target.window.y, target.window.y + target.window.height - 1);
-        let misses = |t: usize| {
-            BINNED && {
-                let [first, last] = rows[t].map(usize::from);
-                last < top || first > bottom
-            }
-        };
         if let Some(wire) = params.wireframe {
             let color = P::from_rgb(wire[0], wire[1], wire[2]);
-            for (t, tri) in mesh.triangles().iter().enumerate() {
-                if misses(t) {
-                    continue;
-                }
+            let triangles = mesh.triangles();
+            for t in order {
+                let tri = &triangles[t];
                 let tri = &tri.map(VertexIndex::to_u32);
                 let v = tri.map(|i| scratch[i as usize]);
                 let union = v[0].outcode | v[1].outcode | v[2].outcode;

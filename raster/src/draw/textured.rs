@@ -52,7 +52,8 @@ impl<M: MeshSource> ShadedMesh<'_, M> {
         if !self.mesh.has_uvs() {
             return Err(DrawError::MissingUvs);
         }
-        Ok(self.draw_triangles::<P, D, false, _>(target, &[], &Textured(texture)))
+        let all = 0..self.mesh.triangles().len();
+        Ok(self.draw_triangles(target, all, &Textured(texture)))
     }
 }
 

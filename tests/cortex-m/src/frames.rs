@@ -140,7 +140,7 @@ impl fmt::Display for RunError {
 // it is `.bss`.
 static mut CUT: FirmwareCut = Cut::new();
 static mut SCRATCH: [ShadedVertex; VERTICES] = [ShadedVertex::ZERO; VERTICES];
-static mut BINS: [[u16; 2]; TRIANGLES] = [[0; 2]; TRIANGLES];
+static mut BINS: [u32; TRIANGLES] = [0; TRIANGLES];
 static mut BAND_COLOR: [Rgb565Be; WIDTH * BAND_ROWS] = [Rgb565Be([0; 2]); WIDTH * BAND_ROWS];
 static mut BAND_DEPTH: [u16; WIDTH * BAND_ROWS] = [0; WIDTH * BAND_ROWS];
 static TAKEN: AtomicBool = AtomicBool::new(false);
@@ -148,7 +148,7 @@ static TAKEN: AtomicBool = AtomicBool::new(false);
 /// What drawing needs besides the cut: the rasterizer's scratch, the row bins and one band.
 struct DrawBuffers {
     scratch: &'static mut [ShadedVertex; VERTICES],
-    bins: &'static mut [[u16; 2]; TRIANGLES],
+    bins: &'static mut [u32; TRIANGLES],
     color: &'static mut [Rgb565Be; WIDTH * BAND_ROWS],
     depth: &'static mut [u16; WIDTH * BAND_ROWS],
 }
