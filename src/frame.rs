@@ -304,7 +304,7 @@ pub struct Bands<'b, P: Pixel, D: Depth> {
     /// that a band skips the triangles that miss it; with about one more per slot (and one per
     /// band), each band reads only its own triangles (see [`vdlod_raster::ShadedMesh::bin`]).
     /// (Without bins every band re-reads every triangle's vertices: `vdlod_raster` can draw that
-    /// way, at 2.5 times the time of a whole-frame draw in 16-row bands of 320x240.)
+    /// way, at 2.3 times the time of a whole-frame draw in 16-row bands of 320x240.)
     pub bins: &'b mut [u32],
 }
 

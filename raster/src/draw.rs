@@ -135,7 +135,7 @@ pub enum DrawError {
     MissingUvs,
     /// The frame size given to [`shade`] is zero or too large.
     Frame(TargetError),
-    /// The row bins of [`ShadedMesh::bin`] are fewer than the triangles.
+    /// The bins given to [`ShadedMesh::bin`] are fewer than the triangles.
     BinsTooSmall {
         /// Triangles in the mesh.
         needed: usize,
@@ -176,7 +176,7 @@ impl fmt::Display for DrawError {
             DrawError::Frame(e) => write!(f, "{e}"),
             DrawError::BinsTooSmall { needed, available } => write!(
                 f,
-                "row bins hold {available} triangles, the mesh has {needed}"
+                "bins hold {available} entries, the mesh has {needed} triangles (one each at least)"
             ),
             DrawError::FrameMismatch { shaded, target } => write!(
                 f,
