@@ -50,7 +50,7 @@ fn angle(a: Vec3d, b: Vec3d) -> f64 {
 }
 
 pub(crate) fn finish(mesh: &InputMesh<'_>, mut e: Engine<'_>) -> Hierarchy {
-    let heap_pushes = e.pushed.len() as u64;
+    let heap_pushes = e.queue.pushes();
     e.release_work();
     let leaves = mesh.positions.len();
     let m = e.pos.len();

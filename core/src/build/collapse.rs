@@ -2,18 +2,18 @@
 //!
 //! Each collapse of an edge `a-b` creates a *new* vertex `p` (the merge-tree paper's renaming,
 //! §3.2), so every vertex id names one position for ever and the collapses form a forest. Costs
-//! live in a binary heap with lazy deletion: an entry whose endpoint has since been merged is
-//! skipped when popped, and the edges around a collapse are pushed again with fresh costs, which
+//! live in a heap with lazy deletion ([`CostQueue`]): an entry whose endpoint has since been
+//! merged is skipped when popped, and the edges around a collapse are pushed again with fresh costs, which
 //! keeps the whole build at O(n log n) for meshes of bounded vertex degree.
 
-use alloc::collections::{BTreeMap, BinaryHeap};
+use alloc::collections::BTreeMap;
 use alloc::vec;
 use alloc::vec::Vec;
-use core::cmp::Reverse;
 
 use super::closest::Surface;
 use super::flatten::{flatten, PlanarCollapse};
 use super::quadric::{place, Quadric};
+use super::queue::CostQueue;
 use super::vec3::{add, cross, dot, from_f32, len, normalize, scale, sub, Vec3d};
 use super::{BuildOptions, Cost, ErrorBound, InputMesh, Placement, NONE};
 
@@ -54,10 +54,8 @@ pub(crate) struct Engine<'o> {
     vverts: Vec<Vec<u32>>,
     pub alive: Vec<bool>,
     pub alive_count: usize,
-    /// (cost as `f32` bits, index into `pushed`): eight bytes an entry, so sifting the heap
-    /// touches half the memory it would with the edge inside.
-    heap: BinaryHeap<Reverse<(u32, u32)>>,
-    pub pushed: Pushed,
+    /// Edges by cost.
+    pub queue: CostQueue,
     deferred: Vec<(u32, u32)>,
     /// Edges found illegal, by endpoint: retried when a collapse changes that endpoint's ring
     /// (a map, since few vertices have any).
@@ -81,6 +79,9 @@ pub(crate) struct Engine<'o> {
     /// the input's border, where it turns by more than 30 degrees. Empty: no such rules.
     pub corners: Vec<bool>,
 }
+
+/// Room the cost queue keeps for a collapse's pushes (the new vertex's edges, and retries).
+const SPARE: usize = 64;
 
 /// `4 sqrt(3) area / (sum of squared edge lengths)`: 1 for an equilateral triangle, 0 for a
 /// degenerate one.
@@ -107,42 +108,6 @@ pub(crate) fn kept(opts: &BuildOptions, v: Vec3d, children: [Vec3d; 2]) -> Optio
 fn face_normal(p: &[Vec3d], f: [u32; 3]) -> Vec3d {
     let [a, b, c] = f.map(|i| p[i as usize]);
     cross(sub(b, a), sub(c, a))
-}
-
-/// Every edge ever pushed on the cost heap, in push order (the heap holds indices into it), in
-/// blocks of a fixed size: it only grows, and a vector grown by doubling held up to twice its
-/// length plus, while it moved, its old copy (the builder's peak memory was there).
-#[derive(Default)]
-pub(crate) struct Pushed {
-    blocks: Vec<Vec<(u32, u32)>>,
-    len: usize,
-}
-
-impl Pushed {
-    /// Edges per block.
-    const BLOCK: usize = 1 << 14;
-
-    fn push(&mut self, edge: (u32, u32)) {
-        match self.blocks.last_mut() {
-            Some(block) if block.len() < Self::BLOCK => block.push(edge),
-            _ => {
-                let mut block = Vec::with_capacity(Self::BLOCK);
-                block.push(edge);
-                self.blocks.push(block);
-            }
-        }
-        self.len += 1;
-    }
-
-    /// Edge `index` (an index the heap got from [`Pushed::len`]).
-    fn get(&self, index: u32) -> (u32, u32) {
-        let i = index as usize;
-        self.blocks[i / Self::BLOCK][i % Self::BLOCK]
-    }
-
-    pub fn len(&self) -> usize {
-        self.len
-    }
 }
 
 impl<'o> Engine<'o> {
@@ -196,8 +161,7 @@ impl<'o> Engine<'o> {
             alive: vfaces.iter().map(|f| !f.is_empty()).collect(),
             alive_count: 0,
             vfaces,
-            heap: BinaryHeap::new(),
-            pushed: Pushed::default(),
+            queue: CostQueue::default(),
             deferred: Vec::new(),
             rejected: BTreeMap::new(),
             collapses: Vec::new(),
@@ -233,6 +197,9 @@ impl<'o> Engine<'o> {
                 }
             }
         }
+        let edges = e.vverts.iter().map(Vec::len).sum::<usize>() / 2;
+        // Room for half as many again as the edges: the bunny's queue peaks at a third more.
+        e.queue.reserve(edges + edges / 2);
         for v in 0..n as u32 {
             for x in e.vverts[v as usize].clone() {
                 if v < x {
@@ -248,8 +215,7 @@ impl<'o> Engine<'o> {
     /// the collapse records and fans. Called once the last collapse is made, so that the
     /// hierarchy's own arrays do not add to the engine's at the build's peak.
     pub fn release_work(&mut self) {
-        self.heap = BinaryHeap::new();
-        self.pushed = Pushed::default();
+        self.queue = CostQueue::default();
         self.deferred = Vec::new();
         self.rejected = BTreeMap::new();
         self.vfaces = Vec::new();
@@ -391,11 +357,7 @@ impl<'o> Engine<'o> {
         } else {
             f32::MAX
         };
-        let Ok(index) = u32::try_from(self.pushed.len()) else {
-            return; // past 2^32 pushes an edge is simply not considered again
-        };
-        self.pushed.push((a, b));
-        self.heap.push(Reverse((key.to_bits(), index)));
+        self.queue.push(key.to_bits(), (a, b));
     }
 
     /// Whether collapsing `a-b` into `v` keeps the mesh a manifold of the same topology with no
@@ -498,7 +460,20 @@ impl<'o> Engine<'o> {
     /// Collapses the cheapest legal edge; `false` when none is left.
     pub fn step(&mut self) -> bool {
         loop {
-            let Some(Reverse((_, index))) = self.heap.pop() else {
+            // Entries of merged vertices would be skipped when popped: when the queue is about
+            // to grow they are dropped instead (the order of what is left does not change), and
+            // it grows, by half, only if that left it two thirds full. So the heap stays within
+            // about twice its live entries, in memory and in the cache misses of a sift.
+            let capacity = self.queue.capacity();
+            if capacity - self.queue.len() < SPARE {
+                let alive = &self.alive;
+                self.queue
+                    .retain(|(a, b)| alive[a as usize] && alive[b as usize]);
+                if 3 * (self.queue.len() + SPARE) > 2 * capacity {
+                    self.queue.reserve(capacity / 2 + SPARE);
+                }
+            }
+            let Some((a, b)) = self.queue.pop() else {
                 if self.deferred.is_empty() {
                     return false;
                 }
@@ -511,7 +486,6 @@ impl<'o> Engine<'o> {
                 }
                 continue;
             };
-            let (a, b) = self.pushed.get(index);
             if !self.alive[a as usize] || !self.alive[b as usize] {
                 continue;
             }
@@ -688,32 +662,6 @@ impl<'o> Engine<'o> {
                     self.push(x, y);
                 }
             }
-        }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::Pushed;
-
-    #[test]
-    fn pushed_edges_come_back_across_blocks() {
-        let mut p = Pushed::default();
-        let n = 2 * Pushed::BLOCK + 5;
-        for i in 0..n as u32 {
-            p.push((i, i.wrapping_mul(7)));
-        }
-        assert_eq!(p.len(), n);
-        assert_eq!(p.blocks.len(), 3);
-        assert!(p.blocks[..2].iter().all(|b| b.len() == Pushed::BLOCK));
-        for i in [
-            0,
-            1,
-            Pushed::BLOCK - 1,
-            Pushed::BLOCK,
-            2 * Pushed::BLOCK + 4,
-        ] {
-            assert_eq!(p.get(i as u32), (i as u32, (i as u32).wrapping_mul(7)));
         }
     }
 }

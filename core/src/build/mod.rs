@@ -46,6 +46,7 @@ pub(crate) mod collapse;
 pub(crate) mod flatten;
 mod input;
 mod quadric;
+mod queue;
 pub(crate) mod vec3;
 mod write;
 
