@@ -2,6 +2,7 @@
 //! bit-identical to the frame drawn whole, with `u32` and `u16` depth, clipping and wireframe.
 
 use glam::{Mat4, Vec3};
+use proptest::prelude::*;
 use vdlod_demo::mesh::{load_obj_bytes, IndexedMesh, BUNNY_NAME, BUNNY_OBJ};
 use vdlod_raster::{
     draw_indexed, shade, Depth, DrawError, DrawParams, DrawStats, Mesh, Rgb565, Rgb565Be, Rgba8,
@@ -386,5 +387,51 @@ fn long_runs_of_empty_triangles_are_skipped_exactly() {
             assert_eq!(listed, matches!(bins, Bins::Lists { .. }), "rows {rows}");
             assert!(c == color && d == depth, "rows {rows}, {bins:?}");
         }
+    }
+}
+
+fn coordinate() -> impl Strategy<Value = f32> {
+    prop_oneof![
+        8 => -3.0f32..3.0,
+        2 => -1e6f32..1e6,
+        1 => prop::num::f32::ANY,
+    ]
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(200))]
+
+    /// Any triangles, any camera, bands of any height and bins of every layout (row bins, pairs
+    /// without lists, lists): no panic, and the bands stitch to the whole frame bit for bit.
+    #[test]
+    fn random_triangles_in_bands_stitch_to_the_whole_frame(
+        pts in prop::collection::vec([coordinate(), coordinate(), coordinate()], 3..24),
+        eye in [-4.0f32..4.0, -4.0f32..4.0, 0.5f32..6.0],
+        wire in any::<bool>(),
+        cull in any::<bool>(),
+        band_rows in 1usize..=H,
+        layout in 0usize..4,
+    ) {
+        let m = pts.len() as u32;
+        let triangles: Vec<[u32; 3]> = (0..m - 2).map(|i| [i, i + 1, i + 2]).collect();
+        let mesh = Mesh { positions: &pts, triangles: &triangles, ..Mesh::default() };
+        let mvp = Mat4::perspective_rh(1.0, W as f32 / H as f32, 0.1, 50.0)
+            * Mat4::look_at_rh(Vec3::from(eye), Vec3::ZERO, Vec3::Y);
+        let p = DrawParams {
+            mvp,
+            shading: Shading::Flat,
+            cull_back_faces: cull,
+            wireframe: wire.then_some([250, 40, 40]),
+            ..DrawParams::default()
+        };
+        let (color, depth, _) = whole::<u32>(&mesh, &p);
+        let n = triangles.len();
+        let bands: Vec<Window> = Window::bands(W, H, band_rows).collect();
+        let pairs = 2 * n + bands.len() + 1;
+        let entries = [n, pairs - 1, pairs, pairs + n * bands.len()][layout];
+        let (c, d, listed) =
+            windowed::<u32>(&mesh, &p, &bands, W, Bins::Lists { band_rows, entries });
+        prop_assert!(listed || layout < 3);
+        prop_assert!(c == color && d == depth);
     }
 }
