@@ -1,6 +1,9 @@
 //! Band and tile rendering: a frame drawn window by window through small buffers, stitched, is
 //! bit-identical to the frame drawn whole, with `u32` and `u16` depth, clipping and wireframe.
 
+mod common;
+
+use common::coordinate;
 use glam::{Mat4, Vec3};
 use proptest::prelude::*;
 use vdlod_demo::mesh::{load_obj_bytes, IndexedMesh, BUNNY_NAME, BUNNY_OBJ};
@@ -388,14 +391,6 @@ fn long_runs_of_empty_triangles_are_skipped_exactly() {
             assert!(c == color && d == depth, "rows {rows}, {bins:?}");
         }
     }
-}
-
-fn coordinate() -> impl Strategy<Value = f32> {
-    prop_oneof![
-        8 => -3.0f32..3.0,
-        2 => -1e6f32..1e6,
-        1 => prop::num::f32::ANY,
-    ]
 }
 
 proptest! {

@@ -1,5 +1,8 @@
 //! Rasterizer behaviour: watertight coverage, clipping, overflow and hostile input.
 
+mod common;
+
+use common::coordinate;
 use glam::{Mat4, Vec3};
 use proptest::prelude::*;
 use vdlod_raster::edge::{fill_triangle, Facing, ScreenVertex, SUBPIXEL_ONE};
@@ -365,14 +368,6 @@ fn bad_meshes_are_typed_errors() {
             available: 2
         })
     );
-}
-
-fn coordinate() -> impl Strategy<Value = f32> {
-    prop_oneof![
-        8 => -3.0f32..3.0,
-        2 => -1e6f32..1e6,
-        1 => prop::num::f32::ANY,
-    ]
 }
 
 proptest! {

@@ -54,3 +54,14 @@ pub fn topology(triangles: &[[u32; 3]]) -> (i64, usize) {
     let chi = verts.len() as i64 - undirected.len() as i64 + triangles.len() as i64;
     (chi, loops)
 }
+
+/// A vertex coordinate for property tests of the rasterizer: mostly moderate, some huge, some
+/// anything at all (NaN and infinities included).
+pub fn coordinate() -> impl proptest::strategy::Strategy<Value = f32> {
+    use proptest::prelude::*;
+    prop_oneof![
+        8 => -3.0f32..3.0,
+        2 => -1e6f32..1e6,
+        1 => prop::num::f32::ANY,
+    ]
+}
