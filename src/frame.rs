@@ -301,8 +301,8 @@ pub struct Bands<'b, P: Pixel, D: Depth> {
     /// What each band is cleared to before it is drawn.
     pub background: P,
     /// Each triangle's rows, at least one entry per triangle slot of the cut (4 bytes each), so
-    /// that a band skips the triangles that miss it; with about one more per slot (and one per
-    /// band), each band reads only its own triangles (see [`vdlod_raster::ShadedMesh::bin`]).
+    /// that a band skips the triangles that miss it; with two to four per slot and one per band
+    /// plus one, each band reads only its own triangles (see [`vdlod_raster::ShadedMesh::bin`]).
     /// (Without bins every band re-reads every triangle's vertices: `vdlod_raster` can draw that
     /// way, at 2.3 times the time of a whole-frame draw in 16-row bands of 320x240.)
     pub bins: &'b mut [u32],

@@ -226,8 +226,10 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
     /// draw nothing at once. With at least two entries per triangle and one per band plus one,
     /// the triangles that draw something are kept as pairs of index and rows, and, when what
     /// is left holds one entry per band each of them meets, each band's own list in draw order,
-    /// so that a band reads only its triangles ([`BinnedMesh::has_band_lists`]). Three entries
-    /// per triangle hold the lists of any mesh whose triangles are a band tall or smaller. The
+    /// so that a band reads only its triangles ([`BinnedMesh::has_band_lists`]). Four entries
+    /// per triangle and one per band plus one always hold the lists when no triangle is taller
+    /// than a band (each meets two bands at most); a mesh whose triangles mostly face away or
+    /// fall between pixel centres needs far fewer. The
     /// statistics of the whole frame are counted here, and every draw returns them.
     ///
     /// ```
