@@ -390,16 +390,7 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
         };
         let triangles = mesh.triangles();
         for t in order.clone() {
-            let tri = &triangles[t];
-            // Indices as scalars and references, not copies: a culled triangle reads only
-            // positions and outcodes (an index array here went through the stack, and reading
-            // one index back from the wider store stalled every triangle).
-            let [i0, i1, i2] = tri.map(VertexIndex::to_u32);
-            let v = [
-                &scratch[i0 as usize],
-                &scratch[i1 as usize],
-                &scratch[i2 as usize],
-            ];
+            let ([i0, i1, i2], v) = corners(scratch, &triangles[t]);
             let union = v[0].outcode | v[1].outcode | v[2].outcode;
             let uvs = |mesh: &M| match F::TEXTURED {
                 true => [i0, i1, i2].map(|i| mesh.uv(i as usize)),
@@ -510,6 +501,24 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
             }
         }
     }
+}
+
+/// A triangle's vertex indices and its three shaded vertices. Scalars and references, not
+/// copies: a culled triangle reads only positions and outcodes (an index array in the triangle
+/// loop went through the stack, and reading one index back from the wider store stalled every
+/// triangle).
+#[inline(always)]
+fn corners<'s, I: VertexIndex>(
+    scratch: &'s [ShadedVertex],
+    tri: &[I; 3],
+) -> ([u32; 3], [&'s ShadedVertex; 3]) {
+    let [i0, i1, i2] = tri.map(VertexIndex::to_u32);
+    let v = [
+        &scratch[i0 as usize],
+        &scratch[i1 as usize],
+        &scratch[i2 as usize],
+    ];
+    ([i0, i1, i2], v)
 }
 
 /// Whether a triangle with a vertex outside the clipping volume (outcodes' union `union`, not 0)

@@ -15,7 +15,7 @@
 //! Either way a band draws its triangles in the frame's order, so the bands stitch to the whole
 //! frame bit for bit.
 
-use super::{for_each_clipped, Facing, Plain, VertexIndex, Window, SUBPIXEL_BITS};
+use super::{corners, for_each_clipped, Facing, Plain, Window, SUBPIXEL_BITS};
 use super::{needs_clipping, signed_area2_xy, DrawError, DrawStats, ShadedMesh};
 use crate::edge::{pixel_bounds, signed_area2};
 use crate::mesh::MeshSource;
@@ -373,13 +373,7 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
             ..DrawStats::default()
         };
         for (t, tri) in triangles.iter().enumerate() {
-            // Scalars until needed, as in the triangle loop.
-            let [i0, i1, i2] = tri.map(VertexIndex::to_u32);
-            let v = [
-                &scratch[i0 as usize],
-                &scratch[i1 as usize],
-                &scratch[i2 as usize],
-            ];
+            let ([i0, i1, i2], v) = corners(scratch, tri);
             let union = v[0].outcode | v[1].outcode | v[2].outcode;
             if union == 0 {
                 let xy = v.map(|v| [v.x, v.y]);
