@@ -329,7 +329,8 @@ pub struct Bands<'b, P: Pixel, D: Depth> {
 /// let camera = Orbit::peer(center.into(), radius, 36).viewport(64, 48).camera(0);
 /// vdlod::adapt(&mut cut, &h, &camera, &QRefine::new(1.0), &Budget::default())?;
 /// let (mut color, mut depth) = ([Rgb565(0); 64 * 16], [0u16; 64 * 16]);
-/// let mut bins = [0u32; 2 * 128 + 3]; // two per triangle slot, one per band and one more
+/// // Four per triangle slot and one per band plus one: room for every band's list.
+/// let mut bins = [0u32; 4 * 128 + 4];
 /// let bands = Bands {
 ///     color: &mut color,
 ///     depth: &mut depth,

@@ -3,8 +3,9 @@
 //! Each collapse of an edge `a-b` creates a *new* vertex `p` (the merge-tree paper's renaming,
 //! §3.2), so every vertex id names one position for ever and the collapses form a forest. Costs
 //! live in a heap with lazy deletion ([`CostQueue`]): an entry whose endpoint has since been
-//! merged is skipped when popped, and the edges around a collapse are pushed again with fresh costs, which
-//! keeps the whole build at O(n log n) for meshes of bounded vertex degree.
+//! merged is skipped when popped (or dropped in bulk, [`Engine::step`]), and the edges around a
+//! collapse are pushed again with fresh costs, which keeps the whole build at O(n log n) for
+//! meshes of bounded vertex degree.
 
 use alloc::collections::BTreeMap;
 use alloc::vec;
@@ -56,6 +57,8 @@ pub(crate) struct Engine<'o> {
     pub alive_count: usize,
     /// Edges by cost.
     pub queue: CostQueue,
+    /// [`CostQueue::pushes`] at the queue's last purge of merged vertices' entries.
+    purged_at: u64,
     deferred: Vec<(u32, u32)>,
     /// Edges found illegal, by endpoint: retried when a collapse changes that endpoint's ring
     /// (a map, since few vertices have any).
@@ -178,6 +181,7 @@ impl<'o> Engine<'o> {
             alive_count: 0,
             vfaces,
             queue: CostQueue::default(),
+            purged_at: 0,
             deferred: Vec::new(),
             rejected: BTreeMap::new(),
             collapses: Vec::new(),
@@ -480,14 +484,18 @@ impl<'o> Engine<'o> {
             // the root that misses the cache at every level: they are dropped in one sequential
             // pass instead (the order of what is left does not change) when the queue holds more
             // than five entries per live vertex (a closed mesh has three edges per vertex; five
-            // took 11% of the bunny's build instructions off, four and seven did less), and when
-            // it is about to grow; it grows, by half, only if that left it two thirds full.
-            let capacity = self.queue.capacity();
-            let stale = self.queue.len() > PER_VERTEX * self.alive_count + 1024;
-            if stale || capacity - self.queue.len() < SPARE {
+            // took 11% of the bunny's build instructions off, four and seven did less) and a
+            // third of them came since the last purge (so a queue of live entries past that
+            // count is not passed over again every step), and when it is about to grow; it
+            // grows, by half, only if that left it two thirds full.
+            let (len, capacity) = (self.queue.len(), self.queue.capacity());
+            let since = self.queue.pushes() - self.purged_at;
+            let stale = len > PER_VERTEX * self.alive_count + 1024 && 3 * since > len as u64;
+            if stale || capacity - len < SPARE {
                 let alive = &self.alive;
                 self.queue
                     .retain(|(a, b)| alive[a as usize] && alive[b as usize]);
+                self.purged_at = self.queue.pushes();
                 if 3 * (self.queue.len() + SPARE) > 2 * capacity {
                     self.queue.reserve(capacity / 2 + SPARE);
                 }

@@ -89,6 +89,13 @@ fn unpack_rows(entry: u32) -> (usize, usize) {
     ((entry & 0xffff) as usize, (entry >> 16) as usize)
 }
 
+/// Whether an entry's rows meet `top..=bottom` (without a branch).
+#[inline(always)]
+fn meets(entry: u32, top: usize, bottom: usize) -> bool {
+    let (first, last) = unpack_rows(entry);
+    (last >= top) & (first <= bottom)
+}
+
 /// The band of a row, by a multiplication instead of a division: for rows below 2^16 and band
 /// heights up to 2^16, `row * m / 2^32` with `m = 2^32 / band_rows + 1` is `row / band_rows`
 /// exactly (the error of `m`, below 1, times `row` stays below `2^32 / band_rows`).
@@ -109,6 +116,12 @@ impl BandOf {
     #[inline(always)]
     fn row(self, row: u16) -> usize {
         ((u64::from(row) * self.m) >> 32) as usize
+    }
+
+    /// The bands of an entry's first and last rows.
+    #[inline(always)]
+    fn span(self, entry: u32) -> (usize, usize) {
+        (self.row(entry as u16), self.row((entry >> 16) as u16))
     }
 }
 
@@ -135,7 +148,7 @@ impl Iterator for RowScan<'_> {
                 continue;
             }
             self.next = t + 1;
-            if (last >= self.top) & (first <= self.bottom) {
+            if meets(entry, self.top, self.bottom) {
                 return Some(t);
             }
         }
@@ -166,10 +179,9 @@ impl Iterator for BandOrder<'_> {
         match self {
             BandOrder::List(list) => list.next().map(|&t| t as usize),
             BandOrder::Rows(rows) => rows.next(),
-            BandOrder::Pairs { pairs, top, bottom } => pairs.find_map(|pair| {
-                let (first, last) = unpack_rows(pair[1]);
-                ((last >= *top) & (first <= *bottom)).then_some(pair[0] as usize)
-            }),
+            BandOrder::Pairs { pairs, top, bottom } => {
+                pairs.find_map(|pair| meets(pair[1], *top, *bottom).then_some(pair[0] as usize))
+            }
         }
     }
 }
@@ -320,10 +332,11 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
         let mut len = 0;
         let stats = self.for_each_row_span(|t, first, last| {
             // In bounds: `rest` holds two entries per triangle.
+            let rows = pack_rows(first, last);
             rest[len] = t as u32;
-            rest[len + 1] = pack_rows(first, last);
+            rest[len + 1] = rows;
             len += 2;
-            let (a, b) = (band_of.row(first), band_of.row(last));
+            let (a, b) = band_of.span(rows);
             starts[a] = starts[a].wrapping_add(1);
             starts[b + 1] = starts[b + 1].wrapping_sub(1);
         });
@@ -332,14 +345,15 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
         for start in starts.iter_mut() {
             count = count.wrapping_add(*start);
             *start = total as u32;
-            total += count as usize;
+            // Saturating: a total past `u32::MAX` does not fit, and must not wrap into fitting.
+            total = total.saturating_add(count as usize);
         }
         let fits = total <= entries.len() && u32::try_from(total).is_ok();
         let lists = fits.then(|| {
             // Each band's start moves to its end (the next band's start) as it is dealt to ...
             for pair in pairs.chunks_exact(2) {
-                let (first, last) = unpack_rows(pair[1]);
-                for start in &mut starts[first / band_rows..=last / band_rows] {
+                let (a, b) = band_of.span(pair[1]);
+                for start in &mut starts[a..=b] {
                     entries[*start as usize] = pair[0];
                     *start += 1;
                 }
