@@ -4,9 +4,9 @@
 //! and Hoppe's `adapt_refinement` ("View-dependent refinement of progressive meshes", 1997): one
 //! pass over the active vertices asks the [`Policy`] about each (a vertex whose digest proves,
 //! through the policy's [`crate::policy::Envelope`], that it wants no split is decided without
-//! reading the file; without geomorphs, a vertex or pair whose answer provably cannot have changed
-//! since an anchor frame, the camera having moved less than the margin the anchor measured, is
-//! not asked at all: [`FrameStats::settled`]), then
+//! reading the file; a vertex or pair whose answer provably cannot have changed since it was last
+//! asked, the camera having moved less than the margin measured then, is not asked at all:
+//! [`FrameStats::settled`]), then
 //!
 //! 1. **coarsen**: sibling pairs whose parent the policy no longer needs are collapsed where
 //!    Hoppe's condition allows; a collapse lists the pair it makes and the pairs around it whose
@@ -67,7 +67,8 @@
 //! # }
 //! ```
 
-use crate::cut::steady::Mode;
+use crate::cut::expiry::{Renew, REBASE};
+use crate::cut::margin::lesser;
 use crate::cut::NIL;
 use crate::cut::{
     Cut, Pair, PairFans, Refused, SlotIndex, BLENDING, BLOCKED, COLLAPSING, FIRST_CHILD, SETTLED,
@@ -136,8 +137,8 @@ pub struct FrameStats {
     pub budget_ecols: u32,
     /// Vertices with a geomorph running.
     pub blending: u32,
-    /// Vertices skipped because their answers could not have changed since an anchor frame
-    /// (see [`Cut::adapt`]; the frame is the same as if they had been asked).
+    /// Vertices skipped because their answers could not have changed since they were last
+    /// asked (see [`Cut::adapt`]; the frame is the same as if they had been asked).
     pub settled: u32,
     /// Vertices asked this frame (all active ones but the settled, unless
     /// [`Budget::max_visits`] binds; 0 from the wavelet cut, which asks wavelets).
@@ -251,10 +252,10 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         self.geomorph_frames = frames;
     }
 
-    /// Whether frames skip the vertices whose answers cannot have changed since an anchor frame
-    /// (on by default). The frames are the same either way; only their time differs.
+    /// Whether frames skip the vertices whose answers cannot have changed since they were last
+    /// asked (on by default). The frames are the same either way; only their time differs.
     pub fn set_settling(&mut self, on: bool) {
-        self.steady.set_on(on);
+        self.motion.set_on(on);
     }
 
     /// The regulated error threshold (1 after [`Cut::reset`] unless
@@ -365,8 +366,8 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         // A policy that reads only the bounding sphere is answered from the digest's copy of it:
         // the same floats the record decodes to, so the same demand, without reading the file.
         let sphere_only = policy.sphere_only() && !policy.judges_triangles();
-        // Settled vertices are skipped while the anchor holds; otherwise an anchor frame marks
-        // them anew (see `crate::cut::steady`).
+        // Settled vertices are skipped until their expiry; every vertex asked is marked anew
+        // (see `crate::cut::expiry`).
         let model = h.bounding_sphere();
         // The walk: positions 0..len of the active list from slot `start`, wrapping round; the
         // first `visits` are the window, past it only vertices in a geomorph are asked.
@@ -389,17 +390,23 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             len
         };
         let steady_envelope = if windowed { None } else { envelope };
-        let mode = self.steady.begin(view, steady_envelope, t, blends, model);
-        let skip = mode == Mode::Skip;
-        // On an anchor frame, the margins its settled vertices must have.
-        let anchor = (mode == Mode::Anchor).then(|| self.steady.margins(upper, t, SLACK, model));
+        let settling = self
+            .motion
+            .begin(view, steady_envelope, (t, SLACK), blends, model);
+        match settling.map(|m| m.renew) {
+            Some(Renew::Forget) => self.v.unsettle_all(),
+            Some(Renew::Rebase) => self.v.rebase(settling.map_or(0, |m| m.now), REBASE),
+            _ => {}
+        }
+        // Without settling no mark is trusted (they may be stale) and none is made.
+        let now = settling.map_or(u32::MAX, |m| m.now);
         // Batch lists, built without branches (each item is written, and counted when it
         // belongs): the vertices still to decide, those of them the bound could not decide
         // ("slow"), and those that judge a pair (by place in the first list).
         let mut listed = [0usize; BATCH];
         let mut slow = [0usize; BATCH];
         let mut pairs = [0usize; BATCH];
-        let mut quiet = [false; BATCH];
+        let mut margin = [f32::NAN; BATCH];
         let mut bounds = [Bounds::default(); BATCH];
         let mut demands = [Demand::NONE; BATCH];
         let mut parents = [NONE; BATCH];
@@ -424,7 +431,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 if place >= visits && flags & (BLENDING | COLLAPSING) == 0 {
                     continue;
                 }
-                if skip && flags & SETTLED != 0 {
+                if flags & SETTLED != 0 && self.v.expiry(i) >= now {
                     frame.stats.settled += 1;
                     continue;
                 }
@@ -449,9 +456,12 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                     Some(d) => d.error <= t,
                     None => (s * s * upper * SLACK <= t * d2) & zone.beyond_near(d2, radius, SLACK),
                 };
-                let alone = (flags & (BLENDING | COLLAPSING) == 0)
-                    & ((self.v.mate(i) == NIL) | (calm & (flags & FIRST_CHILD == 0)));
+                let mate = self.v.mate(i);
+                let still = flags & (BLENDING | COLLAPSING) == 0;
+                let alone = still & ((mate == NIL) | (calm & (flags & FIRST_CHILD == 0)));
                 let done = wants_none & alone;
+                // Marked below: alone, or a first child with its pair (not in a geomorph).
+                let markable = alone | (still & (flags & FIRST_CHILD != 0) & (mate != NIL));
                 let visible = match sphere {
                     Some(d) => d.visible,
                     None => blends && view.sphere_visible(center, radius),
@@ -461,24 +471,39 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 } else {
                     flags
                 };
-                if let Some(m) = &anchor {
-                    // Wants no split wherever the eye gets (or, answered from its sphere, is a
-                    // leaf, which never splits); with geomorphs also seen (or not) wherever the
-                    // frustum gets, as in the frame before, since that flag decides whether a
-                    // change blends.
-                    quiet[n] = (if wants_none {
-                        self.steady.stays_unwanted(m, s, (center, radius), d2)
+                margin[n] = f32::NEG_INFINITY;
+                if let Some(m) = settling.filter(|m| markable && m.measures(flags, i)) {
+                    // How far the camera may move while it wants no split (answered from its
+                    // sphere, a leaf never splits); with geomorphs also while it is seen (or
+                    // not) as in the frame before, since that flag decides whether a change
+                    // blends.
+                    let seen = if blends || (wants_none && m.margins.culls()) {
+                        m.margins.visibility(center, radius)
                     } else {
-                        sphere_only && !h.is_parent(self.v.node[i])
-                    }) && (!blends
-                        || (self.steady.stays_visible(m, center, radius) == Some(visible)
-                            && (flags & VISIBLE != 0) == visible));
+                        (None, f32::NAN)
+                    };
+                    let own = if wants_none {
+                        m.margins.unwanted(s, radius, d2, seen).within()
+                    } else if sphere_only && !h.is_parent(self.v.node[i]) {
+                        f32::INFINITY
+                    } else {
+                        f32::NAN
+                    };
+                    margin[n] = match (blends, seen) {
+                        (false, _) => own,
+                        (true, (Some(v), room)) if v == visible && (flags & VISIBLE != 0) == v => {
+                            lesser(own, room)
+                        }
+                        (true, _) => f32::NAN,
+                    };
+                }
+                if settling.is_some() {
                     next_flags &= !SETTLED;
-                    if alone && quiet[n] {
-                        next_flags |= SETTLED;
-                    }
                 }
                 self.v.flags[i] = next_flags;
+                if let Some(m) = settling.filter(|_| alone) {
+                    self.v.mark(i, m.mark(margin[n]));
+                }
                 listed[n] = i;
                 slow[ns] = n;
                 bounds[n].center = center;
@@ -518,14 +543,10 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 np += judges as usize;
                 // A first child whose pair is marked illegal settles on its own answer (a
                 // collapse that clears the mark on either child clears this one too).
-                if anchor.is_some()
-                    && quiet[k]
-                    && !judges
-                    && (flags & FIRST_CHILD != 0)
-                    && (m != NIL)
-                    && flags & (BLENDING | COLLAPSING) == 0
+                if let Some(s) =
+                    settling.filter(|_| !judges & (flags & FIRST_CHILD != 0) & (m != NIL))
                 {
-                    self.v.flags[i] |= SETTLED;
+                    self.v.mark(i, s.mark(margin[k]));
                 }
             }
             let pairs = &pairs[..np];
@@ -548,11 +569,16 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                     h.bounds_at(records[k])
                 };
             }
-            if let Some(m) = &anchor {
+            if let Some(m) = &settling {
                 for &k in pairs {
-                    if quiet[k] && self.steady.stays_wanted(m, &parent_bounds[k], t, SLACK) {
-                        self.v.flags[listed[k]] |= SETTLED;
-                    }
+                    // Not measured (restless, not its turn), or already too small: no need.
+                    let room = if margin[k] >= 2.0 * m.step {
+                        let wanted = m.margins.wanted(&parent_bounds[k], (t, SLACK), (m.step, 4));
+                        lesser(margin[k], wanted.within())
+                    } else {
+                        margin[k]
+                    };
+                    self.v.mark(listed[k], m.mark(room));
                 }
             }
             // 4. The decisions, in slot order. Without geomorphs they touch nothing but the
@@ -581,13 +607,6 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                     }
                 }
             }
-        }
-        if anchor.is_some() {
-            let settled = self.v.flags[..self.v.len()]
-                .iter()
-                .filter(|&&f| f & SETTLED != 0)
-                .count();
-            self.steady.anchored(settled, self.v.len());
         }
     }
 

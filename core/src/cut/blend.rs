@@ -127,12 +127,13 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             collapsing,
             left: frames,
         };
-        self.v.flags[s] &= !(BLENDING | COLLAPSING);
         if frames == 0 {
             self.free_blend(s);
             return false;
         }
+        // Read before the flags are cleared: the tag is the blend entry only while they are set.
         let k = self.v.blend(s) as usize;
+        self.v.flags[s] &= !(BLENDING | COLLAPSING);
         if let Some(b) = self.blends.as_mut_slice().get_mut(k) {
             *b = entry;
         } else {
@@ -185,8 +186,9 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         if b.left > 0 {
             return;
         }
-        self.v.flags[s] &= !BLENDING;
-        if !b.collapsing {
+        if b.collapsing {
+            self.v.flags[s] &= !BLENDING;
+        } else {
             self.free_blend(s);
         }
     }

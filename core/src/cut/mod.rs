@@ -14,8 +14,9 @@
 //!
 //! The rooms: [`slot`] (index widths and the queue arena), `store` (vertex and triangle
 //! records), `fan` (walks around a vertex), `judge` (policies that judge triangles), `split`,
-//! `collapse`, `blend` (geomorph state and the vertex output), `steady` (which vertices a frame
-//! may skip), `check` (the invariants).
+//! `collapse`, `blend` (geomorph state and the vertex output), `margin` (how far the camera may
+//! move before an answer changes), `expiry` (which vertices a frame may skip), `check` (the
+//! invariants).
 //!
 //! # Memory
 //!
@@ -29,15 +30,15 @@
 //!
 //! | per | bytes | what |
 //! |---|---|---|
-//! | vertex slot | `4 + 3i + 3 + 8` (21 with `u16`) | node, fan triangle, mate, blend entry; triangle count (`u16`) and flags (`u8`); the node's [`crate::format::Digest`] (quantized position and two bound codes: most frames decide a vertex from it without reading the file) |
+//! | vertex slot | `4 + 3i + 3 + 8` (21 with `u16`) | node, fan triangle, mate, tag (blend entry while blending, expiry while settled); triangle count (`u16`) and flags (`u8`); the node's [`crate::format::Digest`] (quantized position and two bound codes: most frames decide a vertex from it without reading the file) |
 //! | triangle slot | `6i + 4 + i` (18 with `u16`) | corners, neighbours, id; one node-map entry |
 //! | queue entry | `4 + 8 + 12 + 28 = 52` | forcing stack, split heap, collapse pairs, blend arena |
 //!
-//! plus 176 bytes of lengths, settings, the walk's position and the anchor frame of the settled
-//! vertices (`steady`).
+//! plus 172 bytes of lengths, settings, the walk's position and the terms the settled
+//! vertices were marked under (`expiry`).
 //! With the recommended `F = 2 V` and `Q = V / 8` that is 21 + 36 + 6.5 = 63.5 bytes per vertex
 //! slot, **31.75 bytes per triangle of capacity** with `u16` (48.75 with `u32`), 31.90 for a
-//! 1,000-triangle cut. A cut for a 10,000-triangle budget, `Cut<5000, 10000, 625>`, is 317,676
+//! 1,000-triangle cut. A cut for a 10,000-triangle budget, `Cut<5000, 10000, 625>`, is 317,672
 //! bytes. The queues only bound how much one frame can do: when one overflows, the rest
 //! waits for the next frame and [`crate::adapt::FrameStats`] says so.
 //!
@@ -81,11 +82,12 @@ use crate::nodemap::NodeMap;
 mod blend;
 mod check;
 mod collapse;
+pub(crate) mod expiry;
 mod fan;
 mod judge;
+pub(crate) mod margin;
 pub mod slot;
 mod split;
-pub(crate) mod steady;
 mod store;
 
 pub(crate) use blend::Blend;
@@ -95,14 +97,14 @@ pub use fan::MAX_FAN;
 pub(crate) use fan::{Fan, PairFans};
 pub use slot::SlotIndex;
 
+use expiry::Motion;
 use slot::Arena;
-pub(crate) use steady::Steady;
 use store::{Triangles, Vertices};
 
 // The documented figure, checked when the crate is compiled for any target (CI builds it for
 // x86_64 and a 32-bit Cortex-M): a cut of 10,240 triangle slots with the recommended
-// capacities is 325,296 bytes, at most 32 bytes per triangle of capacity.
-const _: () = assert!(Cut::<5120, 10240, 640>::BYTES == 325_296);
+// capacities is 325,292 bytes, at most 32 bytes per triangle of capacity.
+const _: () = assert!(Cut::<5120, 10240, 640>::BYTES == 325_292);
 const _: () = assert!(Cut::<5120, 10240, 640>::BYTES <= 32 * 10240);
 
 /// A slot that holds nothing (no neighbour across a border edge, no incident triangle).
@@ -121,9 +123,13 @@ pub(crate) const BLENDING: u8 = 8;
 pub(crate) const COLLAPSING: u8 = 16;
 /// Vertex flag: the node is its parent's first child (the one a pair is looked at from).
 pub(crate) const FIRST_CHILD: u8 = 32;
-/// Vertex flag: its answer (and, for a first child, its pair's) cannot change while the camera
-/// stays near the anchor frame's (see `steady`); cleared by anything that changes its family.
+/// Vertex flag: its answer (and, for a first child, its pair's) cannot change until the camera
+/// has moved as far as its expiry says (see `expiry`); cleared by anything that changes its
+/// family.
 pub(crate) const SETTLED: u8 = 64;
+/// Vertex flag: when last measured, its answers' margins covered under two of the camera's
+/// steps, so most asks do not measure them again (see `expiry`).
+pub(crate) const RESTLESS: u8 = 128;
 
 /// Why the cut could not be set up.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -225,8 +231,8 @@ pub struct Cut<const V: usize, const F: usize, const Q: usize, I: SlotIndex = u1
     pub(crate) raise_wait: u8,
     /// The regulated error threshold; 0 before [`Cut::reset`] (which makes it 1).
     pub(crate) threshold: f32,
-    /// The anchor frame of the vertices marked `SETTLED`.
-    pub(crate) steady: Steady,
+    /// The camera's motion since the vertices marked `SETTLED` were marked.
+    pub(crate) motion: Motion,
     /// Where the next frame's walk starts when [`crate::adapt::Budget::max_visits`] binds.
     pub(crate) walk: u32,
 }
@@ -328,7 +334,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             geomorph_frames: 0,
             raise_wait: 0,
             threshold: 0.0,
-            steady: Steady::ZERO,
+            motion: Motion::ZERO,
             walk: 0,
         }
     }
@@ -424,7 +430,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         self.pairs.clear();
         self.blends.clear();
         self.threshold = 1.0;
-        self.steady.clear();
+        self.motion.clear();
         self.walk = 0;
     }
 

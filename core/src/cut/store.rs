@@ -2,16 +2,19 @@
 //! the only code that appends, moves or drops a record.
 //!
 //! A vertex record is 21 bytes with 16-bit slots: its node (`u32`), one triangle of its fan, its
-//! triangle count, its sibling's slot when both are active ("mate"), its geomorph's entry in the
-//! blend arena, a flag byte, and the node's 8-byte [`Digest`] (quantized position and two bound
-//! codes), with which the per-frame pass skips most vertices without reading the file. Normals,
+//! triangle count, its sibling's slot when both are active ("mate"), a tag (its geomorph's
+//! entry in the blend arena while it blends, the motion at which its answers expire while it
+//! is settled: it is never both), a flag byte, and the node's 8-byte [`Digest`] (quantized
+//! position and two bound codes), with which the per-frame pass skips most vertices without
+//! reading the file. Normals,
 //! colours and the rest of the bounds are not stored: they are read from the hierarchy in place
 //! ([`super::Cut::vertex`]), except for vertices in a geomorph. A
 //! triangle record is 16 bytes: three corner slots, the three neighbouring triangles' slots
 //! (across edges `t[k] -> t[k + 1]`) and its id in the hierarchy's numbering.
 
+use super::expiry::Mark;
 use super::slot::{load3, store3, SlotIndex};
-use super::{NIL, SETTLED};
+use super::{BLENDING, COLLAPSING, NIL, RESTLESS, SETTLED};
 use crate::format::Digest;
 
 /// The vertex records.
@@ -25,7 +28,8 @@ pub(crate) struct Vertices<const V: usize, I: SlotIndex> {
     /// the cut safe from hierarchies crafted to contradict the mesh).
     pub degree: [u16; V],
     mate: [I; V],
-    blend: [I; V],
+    /// The blend entry while `BLENDING` or `COLLAPSING`, the expiry while `SETTLED`.
+    tag: [I; V],
     pub flags: [u8; V],
     /// What the per-frame pass needs of the node without reading the file (see [`Digest`]).
     pub digest: [Digest; V],
@@ -39,7 +43,7 @@ impl<const V: usize, I: SlotIndex> Vertices<V, I> {
             fan: [I::ZERO; V],
             degree: [0; V],
             mate: [I::ZERO; V],
-            blend: [I::ZERO; V],
+            tag: [I::ZERO; V],
             flags: [0; V],
             digest: [Digest::ZERO; V],
         }
@@ -92,16 +96,67 @@ impl<const V: usize, I: SlotIndex> Vertices<V, I> {
         }
     }
 
-    /// The vertex's entry in the blend arena, or `NIL`.
+    /// The vertex's entry in the blend arena, or `NIL` (not blending).
     #[inline(always)]
     pub fn blend(&self, s: usize) -> u32 {
-        self.blend.get(s).map_or(NIL, |b| b.load())
+        match (self.tag.get(s), self.flags.get(s)) {
+            (Some(b), Some(f)) if f & (BLENDING | COLLAPSING) != 0 => b.load(),
+            _ => NIL,
+        }
     }
 
+    /// Makes `b` slot `s`'s blend entry (the caller sets `BLENDING`); it is no longer settled.
     #[inline(always)]
     pub fn set_blend(&mut self, s: usize, b: u32) {
-        if let Some(x) = self.blend.get_mut(s) {
+        if let (Some(x), Some(f)) = (self.tag.get_mut(s), self.flags.get_mut(s)) {
             *x = I::store(b);
+            *f &= !SETTLED;
+        }
+    }
+
+    /// The motion at which slot `s`'s answers expire, when it is settled (`s` in range).
+    #[inline(always)]
+    pub fn expiry(&self, s: usize) -> u32 {
+        self.tag[s].index() as u32
+    }
+
+    /// Marks slot `s` as its measured margins say: settled until the motion passes the
+    /// expiry (below `u16::MAX`), unless it is in a geomorph (asked every frame, and its tag
+    /// is its blend entry), or restless.
+    #[inline(always)]
+    pub fn mark(&mut self, s: usize, mark: Mark) {
+        if let (Some(x), Some(f)) = (self.tag.get_mut(s), self.flags.get_mut(s)) {
+            match mark {
+                Mark::Settled(until) if *f & (BLENDING | COLLAPSING) == 0 => {
+                    *x = I::store(until);
+                    *f = (*f & !RESTLESS) | SETTLED;
+                }
+                Mark::Settled(_) => {}
+                Mark::Restless => *f |= RESTLESS,
+            }
+        }
+    }
+
+    /// Clears every vertex's settled and restless marks.
+    pub fn unsettle_all(&mut self) {
+        let len = self.len();
+        self.flags[..len]
+            .iter_mut()
+            .for_each(|f| *f &= !(SETTLED | RESTLESS));
+    }
+
+    /// Lowers every live expiry by `by` after the motion count was lowered as much to `now`;
+    /// clears the marks that expired.
+    pub fn rebase(&mut self, now: u32, by: u32) {
+        let len = self.len();
+        for (f, x) in self.flags[..len].iter_mut().zip(&mut self.tag[..len]) {
+            if *f & SETTLED == 0 {
+                continue;
+            }
+            match (x.index() as u32).checked_sub(by) {
+                Some(e) if e >= now => *x = I::store(e),
+                _ => *f &= !SETTLED,
+            }
         }
     }
 
@@ -116,7 +171,7 @@ impl<const V: usize, I: SlotIndex> Vertices<V, I> {
         self.fan[s] = I::store(NIL);
         self.degree[s] = 0;
         self.mate[s] = I::store(NIL);
-        self.blend[s] = I::store(NIL);
+        self.tag[s] = I::store(NIL);
         self.flags[s] = flags;
         self.len += 1;
         Some(s as u32)
@@ -128,7 +183,7 @@ impl<const V: usize, I: SlotIndex> Vertices<V, I> {
         self.fan[to] = self.fan[from];
         self.degree[to] = self.degree[from];
         self.mate[to] = self.mate[from];
-        self.blend[to] = self.blend[from];
+        self.tag[to] = self.tag[from];
         self.flags[to] = self.flags[from];
         self.digest[to] = self.digest[from];
     }

@@ -11,7 +11,7 @@
 //! removal for each change, and the emission again of the tiles those changes touch (see
 //! the `emit` module: the mesh, its vertex slots and the triangles' order outlive the frame).
 //!
-//! Frame-to-frame coherence as the vertex cut has it (`crate::cut::steady`, on unless
+//! Frame-to-frame coherence (`steady`, on unless
 //! [`WaveletCut::set_settling`] turns it off): when the policy describes how its demand moves
 //! with the view, an anchor frame proves, for each wavelet it asks, how far the eye and the
 //! frustum may move before the answer could change; while the camera stays within that, later
@@ -76,8 +76,8 @@
 //! ```
 
 use crate::adapt::{Budget, FrameStats};
+use crate::cut::margin::Margins;
 use crate::cut::slot::{Arena, SlotIndex};
-use crate::cut::steady::{Margins, Mode, Steady};
 use crate::cut::NIL;
 use crate::nodemap::NodeMap;
 use crate::policy::{dot, sub, Bounds, Demand, Policy, View};
@@ -86,6 +86,9 @@ use super::format::SemiRegularView;
 use super::lattice::{Point, DIRECTIONS};
 
 mod emit;
+mod steady;
+
+use steady::{Mode, Steady};
 
 /// Why a cut cannot hold a semi-regular mesh.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -245,7 +248,7 @@ pub struct WaveletCut<
     /// The previous frame's view (valid with `has_previous`).
     previous: View,
     has_previous: bool,
-    /// Frame-to-frame coherence, as the vertex cut has it (`crate::cut::steady`): the anchor
+    /// Frame-to-frame coherence (`steady`): the anchor
     /// frame, and per wavelet whether its answer provably holds while the anchor does
     /// (`settled`: a member with nothing to do, or a candidate the policy does not want) and,
     /// for a member, whether none of its children out of the set is wanted (`quiet`).
@@ -864,8 +867,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         let anchor = (mode == Mode::Anchor).then(|| {
             self.settled.iter_mut().for_each(|w| *w = 0);
             self.quiet.iter_mut().for_each(|w| *w = 0);
-            let upper = envelope.map_or(f32::INFINITY, |e| e.upper);
-            self.steady.margins(upper, t, SLACK, model)
+            self.steady.margins(t, SLACK, model)
         });
 
         // Coarsen: a member none of whose children stays leaves when unwanted (blending unless

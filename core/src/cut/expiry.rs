@@ -1,0 +1,319 @@
+//! The vertex cut's frame-to-frame coherence: a settled vertex carries the camera motion at
+//! which its answers expire, and frames skip it until the camera has moved that far.
+//!
+//! A camera moves a little each frame, and most of a cut's answers do not change: a vertex far
+//! from wanting a split still wants none, a pair whose parent is well in view and far over the
+//! threshold is still wanted. When the policy describes how its demand depends on the view
+//! ([`crate::policy::Envelope`]), each vertex the walk asks also gets the margins of its
+//! answers (`super::margin`): how far the eye may move and the frustum's planes sway before
+//! they could change. The cut counts the camera's motion since the marks were made, each
+//! frame's step being the larger of the eye's movement and the planes' sway over the model's
+//! bounding sphere (both distances, so the sum of the steps bounds how far either has gone),
+//! rounded up to whole quanta of a 4096th of the model's radius. A vertex whose margin covers
+//! at least two of the camera's last steps is marked settled with the count at which it
+//! expires; frames skip it until the count passes that. A vertex far from any change is asked
+//! again only after the camera has moved most of the way to it; one near a change is asked
+//! every frame, and since measuring its margins would not pay, it is marked restless and
+//! measures them one frame in four. There are no anchor frames, so no frame costs more than
+//! its neighbours.
+//!
+//! Skipping changes no decision: every skipped answer is proven the same as asking would give
+//! (with a relative slack far above float rounding), so frames are the same with or without
+//! it, only faster. A change of the policy's envelope, the threshold or geomorphs on or off, a
+//! frame that skips nothing by design (a window of the active list) or a jump of the camera
+//! forgets every mark.
+//!
+//! The expiry shares its 16-bit field with the vertex's blend entry (`super::store`): a vertex
+//! in a geomorph is asked every frame, so it is never settled. With geomorphs a vertex settles
+//! only when whether it is seen (which decides whether a change around it blends) provably
+//! stays what it was in the frame before. Only for policies that do not judge triangles. Any
+//! operation that changes a vertex's family (its sibling link, its node, its pair's illegal
+//! mark on either child) clears its mark.
+
+use super::margin::{planes, sway, Margins, Planes};
+use super::RESTLESS;
+use crate::policy::{dot, sub, Envelope, View};
+
+/// Quanta of motion per unit of the model's bounding radius.
+const QUANTA_PER_RADIUS: f32 = 4096.0;
+/// When the count reaches this, it and every live expiry are lowered by it.
+pub(crate) const REBASE: u32 = 1 << 15;
+/// The longest margin kept, in quanta: expiries stay below `2 REBASE - 1`, which a 16-bit slot
+/// field holds besides its all-ones `NIL`.
+const CAP: u32 = REBASE - 2;
+/// A longer single step (a jump of the camera) forgets every mark.
+const JUMP: f32 = (1 << 14) as f32;
+
+/// What the cut does with its marks before a frame's walk.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Renew {
+    /// They hold.
+    Keep,
+    /// They are stale: clear every mark.
+    Forget,
+    /// The count was lowered by [`REBASE`]: lower every live expiry as much, clear the
+    /// expired ones.
+    Rebase,
+}
+
+/// What an asked vertex's measured margins make of it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Mark {
+    /// Skipped until the motion count passes this.
+    Settled(u32),
+    /// The margins cover under two steps of the camera (or are unproven): the next asks
+    /// measure them only in turn, one frame in [`TURN`].
+    Restless,
+}
+
+/// A restless vertex's margins are measured one frame in this many (staggered by slot).
+const TURN: u32 = 4;
+
+/// One frame's settling: the count, the margins' terms, and how to turn a margin into an
+/// expiry.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Settling {
+    /// The camera's motion so far, in quanta: a settled vertex whose expiry is below it is
+    /// asked.
+    pub now: u32,
+    pub margins: Margins,
+    /// What to do with the marks first.
+    pub renew: Renew,
+    /// The camera's last step (model units, at least a quantum): the along-axis spheroid
+    /// margins are tried at multiples of it.
+    pub step: f32,
+    quantum: f32,
+    /// Frames since the marks were made (wrapping), for the restless vertices' turns.
+    tick: u32,
+}
+
+impl Settling {
+    /// Whether an asked vertex with `flags` at `slot` measures its margins this frame: always,
+    /// unless it is restless and it is not its turn.
+    #[inline(always)]
+    pub fn measures(&self, flags: u8, slot: usize) -> bool {
+        flags & RESTLESS == 0 || self.tick.wrapping_add(slot as u32).is_multiple_of(TURN)
+    }
+
+    /// The mark of a vertex whose answers' margin is `margin` (model units; `-inf` when not
+    /// measured, NaN when unproven).
+    #[inline(always)]
+    pub fn mark(&self, margin: f32) -> Mark {
+        if margin >= 2.0 * self.step {
+            Mark::Settled(self.now + ((margin / self.quantum) as u32).min(CAP))
+        } else {
+            Mark::Restless
+        }
+    }
+}
+
+/// The camera's motion since the settled marks were made, and the terms they were made under.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Motion {
+    /// Never skip (see `Cut::set_settling`).
+    off: bool,
+    /// Whether the marks were made under the terms below.
+    valid: bool,
+    now: u32,
+    quantum: f32,
+    eye: [f32; 3],
+    planes: Planes,
+    envelope: Envelope,
+    threshold: f32,
+    blends: bool,
+    tick: u8,
+}
+
+impl Motion {
+    /// No marks (all zeros).
+    pub const ZERO: Motion = Motion {
+        off: false,
+        valid: false,
+        now: 0,
+        quantum: 0.0,
+        eye: [0.0; 3],
+        planes: [[0.0; 4]; 5],
+        envelope: Envelope::ZERO,
+        threshold: 0.0,
+        blends: false,
+        tick: 0,
+    };
+
+    /// Starts a frame seen from `view` with threshold `t` and the cut's bound slack `slack`,
+    /// every node centre within the sphere `model`: counts the camera's step and says what the
+    /// marks need, or `None` (no skipping, no marking) when the policy has no `envelope` or
+    /// skipping is off.
+    pub fn begin(
+        &mut self,
+        view: &View,
+        envelope: Option<Envelope>,
+        (t, slack): (f32, f32),
+        blends: bool,
+        model: ([f32; 3], f32),
+    ) -> Option<Settling> {
+        let Some(envelope) = envelope.filter(|_| !self.off) else {
+            self.valid = false;
+            return None;
+        };
+        let now = planes(view);
+        let moved = sub(view.eye, self.eye);
+        let moved = libm::sqrtf(dot(moved, moved));
+        let swayed = if envelope.frustum {
+            sway(&self.planes, &now, model)
+        } else {
+            0.0
+        };
+        let step = moved.max(swayed);
+        let quanta = libm::ceilf(step / self.quantum);
+        let same =
+            self.valid && envelope == self.envelope && t == self.threshold && blends == self.blends;
+        let renew = if !(same && quanta <= JUMP) {
+            self.now = 0;
+            let q = model.1 / QUANTA_PER_RADIUS;
+            // A degenerate model settles nothing (every margin is under an infinite quantum).
+            self.quantum = if q > 0.0 && q.is_finite() {
+                q
+            } else {
+                f32::INFINITY
+            };
+            Renew::Forget
+        } else {
+            self.now += quanta as u32;
+            if self.now >= REBASE {
+                self.now -= REBASE;
+                Renew::Rebase
+            } else {
+                Renew::Keep
+            }
+        };
+        *self = Motion {
+            valid: true,
+            tick: self.tick.wrapping_add(1),
+            eye: view.eye,
+            planes: now,
+            envelope,
+            threshold: t,
+            blends,
+            ..*self
+        };
+        let reach = CAP as f32 * self.quantum;
+        Some(Settling {
+            now: self.now,
+            margins: Margins::new(view.eye, now, envelope, (t, slack), model, reach),
+            renew,
+            step: if step > self.quantum {
+                step
+            } else {
+                self.quantum
+            },
+            quantum: self.quantum,
+            tick: u32::from(self.tick),
+        })
+    }
+
+    /// Forgets the marks (a new hierarchy, or a frame that did not mark).
+    pub fn clear(&mut self) {
+        self.valid = false;
+    }
+
+    /// Turns skipping on or off (it starts on).
+    pub fn set_on(&mut self, on: bool) {
+        self.off = !on;
+        self.valid = false;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const MODEL: ([f32; 3], f32) = ([0.0; 3], 4096.0);
+    const ENVELOPE: Envelope = Envelope {
+        upper: 1.0,
+        frustum: true,
+        ..Envelope::ZERO
+    };
+
+    fn view(x: f32) -> View {
+        View::look_at(
+            [x, 0.0, 10_000.0],
+            [0.0; 3],
+            [0.0, 1.0, 0.0],
+            1.0,
+            1.0,
+            480.0,
+        )
+    }
+
+    fn begin(m: &mut Motion, x: f32, t: f32) -> Settling {
+        m.begin(&view(x), Some(ENVELOPE), (t, 1.0), false, MODEL)
+            .expect("an envelope settles")
+    }
+
+    #[test]
+    fn the_count_follows_the_eye_and_the_planes() {
+        let mut m = Motion::ZERO;
+        // The first frame forgets whatever was there; a quantum is a unit here.
+        let first = begin(&mut m, 0.0, 1.0);
+        assert_eq!((first.renew, first.now), (Renew::Forget, 0));
+        // A still camera does not count.
+        assert_eq!(begin(&mut m, 0.0, 1.0).now, 0);
+        // The eye moves 2.5: at least three quanta (the planes sway at least as much).
+        let moved = begin(&mut m, 2.5, 1.0);
+        assert_eq!(moved.renew, Renew::Keep);
+        assert!(moved.now >= 3, "{}", moved.now);
+        // Another threshold, a jump, or a frame without settling forget.
+        assert_eq!(begin(&mut m, 2.5, 2.0).renew, Renew::Forget);
+        assert_eq!(begin(&mut m, 1e9, 2.0).renew, Renew::Forget);
+        assert!(m
+            .begin(&view(0.0), None, (2.0, 1.0), false, MODEL)
+            .is_none());
+        assert_eq!(begin(&mut m, 1e9, 2.0).renew, Renew::Forget);
+        m.set_on(false);
+        assert!(m
+            .begin(&view(0.0), Some(ENVELOPE), (2.0, 1.0), false, MODEL)
+            .is_none());
+    }
+
+    #[test]
+    fn the_count_rebases_before_it_outgrows_the_tags() {
+        let mut m = Motion::ZERO;
+        begin(&mut m, 0.0, 1.0);
+        let mut x = 0.0;
+        let mut last = 0;
+        for _ in 0..100 {
+            x += 1000.0;
+            let s = begin(&mut m, x, 1.0);
+            assert!(s.now < REBASE);
+            if s.renew == Renew::Rebase {
+                assert!(s.now < last);
+                return;
+            }
+            assert_eq!(s.renew, Renew::Keep);
+            assert!(s.now > last);
+            last = s.now;
+        }
+        panic!("never rebased");
+    }
+
+    #[test]
+    fn margins_under_two_steps_make_a_vertex_restless() {
+        let mut m = Motion::ZERO;
+        begin(&mut m, 0.0, 1.0);
+        let s = begin(&mut m, 10.0, 1.0);
+        assert!(s.step >= 10.0);
+        assert_eq!(s.mark(1.5 * s.step), Mark::Restless);
+        assert_eq!(s.mark(f32::NAN), Mark::Restless);
+        assert_eq!(s.mark(f32::NEG_INFINITY), Mark::Restless);
+        assert_eq!(s.mark(100.0), Mark::Settled(s.now + 100));
+        // The longest margin kept still fits a 16-bit tag besides its NIL.
+        let Mark::Settled(far) = s.mark(f32::INFINITY) else {
+            panic!("an infinite margin settles");
+        };
+        assert!(far < u32::from(u16::MAX));
+        // A restless vertex measures one frame in four, staggered by slot.
+        let turns = (0..8).filter(|&slot| s.measures(RESTLESS, slot)).count();
+        assert_eq!(turns, 2);
+        assert!((0..8).all(|slot| s.measures(0, slot)));
+    }
+}

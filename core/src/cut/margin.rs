@@ -1,0 +1,417 @@
+//! How far the camera may move before a policy's answer about a vertex could change.
+//!
+//! A policy that describes how its demand depends on the view ([`Envelope`]) lets a cut prove,
+//! from one frame's view, that an answer stays the same while the eye moves less than some
+//! distance and the frustum's planes sway less than some distance over the model's bounding
+//! sphere (see [`sway`]). This module computes those distances, the *margins*, for the three
+//! answers the cuts reuse: a vertex wants no split ([`Margins::unwanted`]), a sphere is in or
+//! out of the frustum ([`Margins::visibility`]), and a parent is still wanted
+//! ([`Margins::wanted`]). The wavelet cut compares them with the reach of an anchor frame
+//! (`crate::wavelet`'s `steady`); the vertex cut turns them into a per-vertex expiry (`super::expiry`).
+//!
+//! Every margin leaves a relative slack far above float rounding, and a margin that cannot be
+//! proven (a NaN anywhere) is never positive.
+
+use crate::policy::{dot, sub, Bounds, Envelope, View};
+
+/// Relative slack on every margin, far above float rounding.
+pub(crate) const SLACK: f32 = 1e-4;
+
+/// A frustum's planes as `(n, d)` (left, right, bottom, top, near).
+pub(crate) type Planes = [[f32; 4]; 5];
+
+/// The planes of `view`.
+pub(crate) fn planes(view: &View) -> Planes {
+    core::array::from_fn(|i| view.plane(i).unwrap_or([0.0; 4]))
+}
+
+/// How far any point within `radius` of `center` moves relative to any plane between `a` and
+/// `b`: `max_i |n_a - n_b| radius + |(n_a - n_b) . center + d_a - d_b|`. A distance: the sway
+/// from `a` to `c` is at most the sway from `a` to `b` plus that from `b` to `c`.
+pub(crate) fn sway(a: &Planes, b: &Planes, (center, radius): ([f32; 3], f32)) -> f32 {
+    let mut most = 0.0f32;
+    for (p, q) in a.iter().zip(b) {
+        let dn = [p[0] - q[0], p[1] - q[1], p[2] - q[2]];
+        let shift = libm::sqrtf(dot(dn, dn)) * radius + libm::fabsf(dot(dn, center) + p[3] - q[3]);
+        most = most.max(shift);
+    }
+    most
+}
+
+/// The smaller of `a` and `b`, NaN when either is (an unproven term fails a conjunction).
+#[inline(always)]
+pub(crate) fn lesser(a: f32, b: f32) -> f32 {
+    if a < b || a.is_nan() {
+        a
+    } else {
+        b
+    }
+}
+
+/// Margins of an answer that holds while *either* the eye moves at most `eye` *or* the planes
+/// sway at most `sway` (a vertex out of the frustum wants nothing however near the eye comes).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Either {
+    pub eye: f32,
+    pub sway: f32,
+}
+
+/// Margins of an answer that holds while the eye moves at most `eye` *and* the planes sway at
+/// most `sway`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Both {
+    pub eye: f32,
+    pub sway: f32,
+}
+
+impl Either {
+    /// Whether the answer holds for an eye within `reach` and planes within `sway`.
+    #[inline(always)]
+    pub fn holds(self, reach: f32, sway: f32) -> bool {
+        self.eye >= reach || self.sway >= sway
+    }
+
+    /// The one distance both the eye and the planes may move (NaN-free: an unproven term is
+    /// ignored, since the other alone suffices).
+    #[inline(always)]
+    pub fn within(self) -> f32 {
+        self.eye.max(self.sway)
+    }
+}
+
+impl Both {
+    /// Whether the answer holds for an eye within `reach` and planes within `sway`.
+    #[inline(always)]
+    pub fn holds(self, reach: f32, sway: f32) -> bool {
+        self.eye >= reach && self.sway >= sway
+    }
+
+    /// The one distance both the eye and the planes may move (NaN when either is unproven).
+    #[inline(always)]
+    pub fn within(self) -> f32 {
+        lesser(self.eye, self.sway)
+    }
+}
+
+/// One frame's terms for the margins: its eye and planes, the policy's envelope, and the
+/// constants every vertex shares (square roots once per frame, not once per vertex).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Margins {
+    eye: [f32; 3],
+    /// The planes transposed, `lanes[k][i]` component `k` of plane `i`, as [`View`] keeps them
+    /// (three unused lanes that never cull: `n = 0`, `d = MAX`), so the tests run as vector
+    /// operations.
+    lanes: [[f32; 8]; 4],
+    envelope: Envelope,
+    /// A vertex whose spheroid radius is at most `s` wants no split while at least `s scale`
+    /// from the eye.
+    scale: f32,
+    /// Float rounding on any distance from an eye within the largest reach asked of a node
+    /// centre.
+    slop: f32,
+    /// `slop` plus rounding on each plane's distances, by lane.
+    plane_slop: [f32; 8],
+}
+
+impl Margins {
+    /// The terms of a frame seen from `eye` with `planes`, for a policy with `envelope`, the
+    /// threshold `t` and the cut's bound slack `slack`, every node centre within the sphere
+    /// `model`, for margins up to `reach` (the slop covers distances from anywhere within it).
+    pub fn new(
+        eye: [f32; 3],
+        planes: Planes,
+        envelope: Envelope,
+        (t, slack): (f32, f32),
+        model: ([f32; 3], f32),
+        reach: f32,
+    ) -> Margins {
+        let to = sub(model.0, eye);
+        let farthest = libm::sqrtf(dot(to, to)) + model.1;
+        let slop = SLACK * (farthest + reach);
+        let mut lanes = [[0.0f32; 8]; 4];
+        lanes[3] = [f32::MAX; 8];
+        let mut plane_slop = [slop; 8];
+        for (i, p) in planes.iter().enumerate() {
+            for (k, lane) in lanes.iter_mut().enumerate() {
+                lane[i] = p[k];
+            }
+            plane_slop[i] = slop + SLACK * libm::fabsf(p[3]);
+        }
+        Margins {
+            eye,
+            lanes,
+            envelope,
+            scale: libm::sqrtf(envelope.upper * slack * (1.0 + SLACK) / t),
+            slop,
+            plane_slop,
+        }
+    }
+
+    /// How far the eye may move while a vertex of spheroid radius `s` and bounding radius
+    /// `radius`, at `d` from the eye, keeps its bound `s^2 upper / d^2` at most `t / slack` and
+    /// its sphere beyond the envelope's near zone: `d - max(s sqrt(upper slack / t), near +
+    /// radius)`, less float slop.
+    #[inline(always)]
+    pub fn quiet(&self, s: f32, radius: f32, d: f32) -> f32 {
+        let near = self.envelope.near;
+        let zone = if near > 0.0 {
+            (near + radius) * (1.0 + SLACK)
+        } else {
+            0.0
+        };
+        d - (s * self.scale).max(zone) - self.slop
+    }
+
+    /// Whether a sphere at `center` of `radius` is in the frustum (`Some(true)`) or out of it
+    /// (`Some(false)`) with room to spare, and how far the planes may sway before that could
+    /// change; `(None, NaN)` when neither is proven.
+    #[inline(always)]
+    pub fn visibility(&self, center: [f32; 3], radius: f32) -> (Option<bool>, f32) {
+        let [x, y, z, d] = &self.lanes;
+        let (mut inside, mut outside, mut nan) = (f32::INFINITY, f32::NEG_INFINITY, false);
+        for i in 0..8 {
+            let dist = x[i] * center[0] + y[i] * center[1] + z[i] * center[2] + d[i] + radius;
+            nan |= dist.is_nan();
+            inside = inside.min(dist - self.plane_slop[i]);
+            outside = outside.max(-dist - self.plane_slop[i]);
+        }
+        if nan {
+            (None, f32::NAN)
+        } else if inside >= 0.0 {
+            (Some(true), inside / (1.0 + SLACK))
+        } else if outside > 0.0 {
+            (Some(false), outside / (1.0 + SLACK))
+        } else {
+            (None, f32::NAN)
+        }
+    }
+
+    /// Whether the envelope culls by the frustum (so that [`Margins::unwanted`] wants the
+    /// sphere's [`Margins::visibility`]).
+    #[inline(always)]
+    pub fn culls(&self) -> bool {
+        self.envelope.frustum
+    }
+
+    /// The margins of "wants no split" for a vertex that wants none (spheroid radius `s`,
+    /// bounding radius `radius` at `d2` from the eye, `seen` its sphere's
+    /// [`Margins::visibility`] when the envelope [`Margins::culls`]): it stays quiet
+    /// ([`Margins::quiet`]), or the envelope culls by the frustum and the sphere stays out of it
+    /// (a culled vertex's error is 0).
+    #[inline(always)]
+    pub fn unwanted(&self, s: f32, radius: f32, d2: f32, seen: (Option<bool>, f32)) -> Either {
+        let out = match (self.envelope.frustum, seen) {
+            (true, (Some(false), m)) => m,
+            _ => f32::NEG_INFINITY,
+        };
+        Either {
+            eye: self.quiet(s, radius, libm::sqrtf(d2)),
+            sway: out,
+        }
+    }
+
+    /// The margins of "still wanted" for a parent with bounds `b`, threshold `t` and the cut's
+    /// bound slack `slack`: seen (with margin from every culling plane), facing the eye, and its
+    /// error over `t * slack` wherever the eye gets: the spheroid's lower bound where the eye
+    /// is farthest from the centre and nearest the axis while the sphere may be beyond the
+    /// near zone, the near error while it may be inside. The spheroid's across-axis term is
+    /// solved exactly; its along-axis term is tried at `step` times 1, 4, 16, ... (`levels`
+    /// of them) and gives the largest that holds.
+    pub fn wanted(&self, b: &Bounds, (t, slack): (f32, f32), (step, levels): (f32, u32)) -> Both {
+        let e = &self.envelope;
+        let sway = match (e.frustum, self.visibility(b.center, b.radius)) {
+            (false, _) => f32::INFINITY,
+            (true, (Some(true), m)) => m,
+            (true, _) => f32::NAN,
+        };
+        let r = sub(b.center, self.eye);
+        let d = libm::sqrtf(dot(r, r));
+        let rn = dot(r, b.axis);
+        // Not facing away (`s <= 0` or `s <= (d - shift) cone_sin`, `s = rn - radius + shift`,
+        // the shift being the reach plus slop): either holds for shifts up to its bound.
+        let facing = if e.back_face {
+            let cs = b.cone_sin.max(0.0);
+            (b.radius - rn).max((d * cs - rn + b.radius) / (1.0 + cs)) - self.slop
+        } else {
+            f32::INFINITY
+        };
+        let k = t * slack * (1.0 + SLACK);
+        let spheroid = self.spheroid(b, (d, rn), k, (step, levels));
+        // Where the sphere can get relative to the near zone (`d - radius < near`): provably
+        // inside for shifts below `edge / (1 + SLACK) - d`, provably outside up to
+        // `d - edge (1 + SLACK)`.
+        let edge = e.near + b.radius;
+        let error = if e.near > 0.0 {
+            if e.near_error > k {
+                (edge / (1.0 + SLACK) - d - self.slop).max(spheroid)
+            } else {
+                lesser(spheroid, d - edge * (1.0 + SLACK) - self.slop)
+            }
+        } else {
+            spheroid
+        };
+        Both {
+            eye: lesser(facing, error),
+            sway,
+        }
+    }
+
+    /// How far the eye may move while the spheroid's lower bound, `max(b2 far^2, a2 p^2)
+    /// lower / far^4` with `far` the eye's greatest distance from the centre and `p` its least
+    /// from the axis (less what rounding can take from the policy's own sum), stays over `k`;
+    /// `-inf` when it never is.
+    fn spheroid(&self, b: &Bounds, (d, rn): (f32, f32), k: f32, (step, levels): (f32, u32)) -> f32 {
+        let lower = self.envelope.lower;
+        // (Also when `lower` is NaN.)
+        if lower.partial_cmp(&0.0) != Some(core::cmp::Ordering::Greater) {
+            return f32::NEG_INFINITY;
+        }
+        let most = b.a2.max(b.b2);
+        // Across the axis: `(b2 - SLACK most) lower far^2 > k far^4` while `far^2 < (b2 -
+        // SLACK most) lower / k`.
+        let across = (b.b2 - SLACK * most) * lower / k;
+        let mut margin = if across > 0.0 {
+            libm::sqrtf(across) / (1.0 + SLACK) - d - self.slop
+        } else {
+            f32::NEG_INFINITY
+        };
+        // Along the axis: `(a2 p^2 - SLACK most far^2) lower > k far^4`, which only gets
+        // harder as the shift grows.
+        let axial = libm::sqrtf((d * d - rn * rn).max(0.0));
+        let holds = |reach: f32| {
+            let shift = reach + self.slop;
+            let far = d + shift;
+            let p = (axial - shift).max(0.0);
+            (b.a2 * p * p - SLACK * most * far * far) * lower > k * far * far * far * far
+        };
+        let mut reach = step;
+        for _ in 0..levels {
+            if reach > margin {
+                if !holds(reach) {
+                    break;
+                }
+                margin = reach;
+            }
+            reach *= 4.0;
+        }
+        margin
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn view() -> View {
+        View::look_at([0.0, 0.0, 5.0], [0.0; 3], [0.0, 1.0, 0.0], 1.0, 1.0, 480.0)
+    }
+
+    fn margins(envelope: Envelope) -> Margins {
+        let v = view();
+        Margins::new(
+            v.eye,
+            planes(&v),
+            envelope,
+            (1.0, 1.0),
+            ([0.0; 3], 1.0),
+            1.0,
+        )
+    }
+
+    #[test]
+    fn a_quiet_vertex_stays_quiet_until_the_eye_reaches_its_zone() {
+        let m = margins(Envelope {
+            upper: 1.0,
+            near: 1.0,
+            near_error: 2.0,
+            ..Envelope::ZERO
+        });
+        // 5 from the eye, radius 0.5: the zone's edge is 1.5 away, the bound's 0.2.
+        let q = m.quiet(0.2, 0.5, 5.0);
+        assert!(q < 3.5 && q > 3.49, "{q}");
+        // Already inside: no margin.
+        assert!(m.quiet(0.2, 0.5, 1.0) < 0.0);
+    }
+
+    #[test]
+    fn visibility_margins_are_the_distances_to_the_planes() {
+        let m = margins(Envelope {
+            frustum: true,
+            ..Envelope::ZERO
+        });
+        let (inside, room) = m.visibility([0.0; 3], 0.1);
+        assert_eq!(inside, Some(true));
+        assert!(room > 0.5 && room < 5.0, "{room}");
+        let (outside, room) = m.visibility([0.0, 0.0, 10.0], 0.1);
+        assert_eq!(outside, Some(false));
+        assert!(room > 4.0, "{room}");
+        // A sphere moved by less than its margin keeps its state: sweep one across the left
+        // and right planes and check every margin against where the state changes.
+        let xs: [f32; 401] = core::array::from_fn(|i| -4.0 + 0.02 * i as f32);
+        let states = xs.map(|x| m.visibility([x, 0.0, 0.0], 0.1));
+        assert!(states.iter().any(|s| s.0 == Some(true)));
+        assert!(states.iter().any(|s| s.0 == Some(false)));
+        for (a, (state, room)) in xs.iter().zip(&states) {
+            for (b, other) in xs.iter().zip(&states) {
+                if (a - b).abs() < *room {
+                    assert_eq!(other.0, *state, "{a} -> {b} within {room}");
+                }
+            }
+        }
+        // A NaN proves nothing.
+        assert_eq!(m.visibility([f32::NAN, 0.0, 0.0], 0.1).0, None);
+    }
+
+    #[test]
+    fn either_and_both_combine_as_named() {
+        let e = Either {
+            eye: 1.0,
+            sway: 3.0,
+        };
+        assert!(e.holds(2.0, 2.0) && !e.holds(2.0, 4.0));
+        assert_eq!(e.within(), 3.0);
+        let b = Both {
+            eye: 1.0,
+            sway: 3.0,
+        };
+        assert!(b.holds(1.0, 3.0) && !b.holds(2.0, 2.0));
+        assert_eq!(b.within(), 1.0);
+        assert!(Both {
+            eye: f32::NAN,
+            sway: 1.0
+        }
+        .within()
+        .is_nan());
+        assert!(Both {
+            eye: 1.0,
+            sway: f32::NAN
+        }
+        .within()
+        .is_nan());
+    }
+
+    #[test]
+    fn a_parent_inside_the_near_zone_stays_wanted_until_it_may_leave_it() {
+        let m = margins(Envelope {
+            frustum: true,
+            near: 10.0,
+            near_error: 2.0,
+            ..Envelope::ZERO
+        });
+        let b = Bounds {
+            center: [0.0; 3],
+            radius: 0.1,
+            ..Bounds::default()
+        };
+        let w = m.wanted(&b, (1.0, 1.0), (0.1, 1));
+        // The sphere's edge is 10.1 from the centre, the eye 5 from it.
+        assert!(w.eye > 5.0 && w.eye < 5.1, "{w:?}");
+        assert!(w.sway > 0.0, "{w:?}");
+        // Out of the frustum: never proven wanted.
+        let aside = Bounds {
+            center: [0.0, 0.0, 10.0],
+            ..b
+        };
+        assert!(m.wanted(&aside, (1.0, 1.0), (0.1, 1)).within().is_nan());
+    }
+}
