@@ -412,29 +412,40 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         let mut parents = [NONE; BATCH];
         let mut records = [Record::default(); BATCH];
         let mut parent_bounds = [Bounds::default(); BATCH];
-        let mut next = 0;
-        while next < end {
+        let slot = |place: usize| {
+            if start + place < len {
+                start + place
+            } else {
+                start + place - len
+            }
+        };
+        // The places still to ask are found a word at a time without branches (a quarter or
+        // fewer of them are asked on a moving orbit, in no pattern a branch predictor learns);
+        // with a window, one at a time, since a geomorph started on a mate during the walk
+        // makes a vertex past the window one to ask.
+        let word = if windowed { 1 } else { 64 };
+        let (mut next, mut base, mut pending) = (0, 0, 0u64);
+        while next < end || pending != 0 {
             // 1. The digests, until the batch holds `BATCH` vertices still to decide. A vertex
             // the bound decides that has no pair to judge and no geomorph is done with here:
             // only its visibility flag moves (computed only with geomorphs, the one use of it).
             let mut n = 0;
             let mut ns = 0;
-            while n < BATCH && next < end {
-                let place = next;
-                next += 1;
-                let i = if start + place < len {
-                    start + place
-                } else {
-                    start + place - len
-                };
+            while n < BATCH {
+                if pending == 0 {
+                    if next >= end {
+                        break;
+                    }
+                    let count = (end - next).min(word);
+                    let (asked, settled) = self.asked((next, count), slot, visits, now);
+                    frame.stats.settled += settled;
+                    (base, pending) = (next, asked);
+                    next += count;
+                    continue;
+                }
+                let i = slot(base + pending.trailing_zeros() as usize);
+                pending &= pending - 1;
                 let flags = self.v.flags[i];
-                if place >= visits && flags & (BLENDING | COLLAPSING) == 0 {
-                    continue;
-                }
-                if flags & SETTLED != 0 && self.v.expiry(i) >= now {
-                    frame.stats.settled += 1;
-                    continue;
-                }
                 frame.stats.visited += 1;
                 let digest = &self.v.digest[i];
                 let center = h.digest_center(digest);
@@ -608,6 +619,36 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 }
             }
         }
+    }
+
+    /// Which of the `count` places from `first` of the walk (slot `slot(place)`) are asked
+    /// this frame, as bits: all but those past the window of `visits` in no geomorph and the
+    /// settled ones whose expiry the count `now` has not passed; and how many were settled.
+    #[inline(always)]
+    fn asked(
+        &self,
+        (first, count): (usize, usize),
+        slot: impl Fn(usize) -> usize,
+        visits: usize,
+        now: u32,
+    ) -> (u64, u32) {
+        if first + count <= visits && first + count <= self.v.len() && slot(first) == first {
+            // In the window and in slot order (always, without a window): only the settled are
+            // skipped.
+            let skipped = self.v.settled_until(first, count, now);
+            let all = u64::MAX >> (64 - count.clamp(1, 64));
+            return (!skipped & all, skipped.count_ones());
+        }
+        let (mut asked, mut settled) = (0u64, 0u32);
+        for k in 0..count {
+            let i = slot(first + k);
+            let flags = self.v.flags[i];
+            let outside = (first + k >= visits) & (flags & (BLENDING | COLLAPSING) == 0);
+            let skips = (flags & SETTLED != 0) & (self.v.expiry(i) >= now);
+            asked |= u64::from(!outside & !skips) << k;
+            settled += u32::from(!outside & skips);
+        }
+        (asked, settled)
     }
 
     /// Slot `i`'s own decisions (see [`Cut::evaluate`]) with its demand `d`: its blend advances,
