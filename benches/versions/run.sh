@@ -3,8 +3,8 @@
 # version's `vdlod-core` is compiled as its own crate, each builds its own bunny hierarchy, and
 # every version adapts the same views of the peer orbit (QRefine, no budget, no geomorphs) in
 # blocks of 8 frames, the order rotating, so the machine's slow phases hit them alike. Prints,
-# per tolerance, each version's median microseconds and mean triangles, and the median of the
-# per-frame time ratios against this checkout; then the same for the first frame (orbit frame 0
+# per tolerance, each version's median and mean microseconds and mean triangles, the median of
+# the per-frame time ratios against this checkout and the ratio of total times; then the same for the first frame (orbit frame 0
 # refined from the base mesh, 20 rounds, each version in turn).
 #
 #   benches/versions/run.sh COMMIT... [-- TOLERANCES [REVOLUTIONS]]

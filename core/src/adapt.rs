@@ -67,7 +67,7 @@
 //! # }
 //! ```
 
-use crate::cut::expiry::{Renew, REBASE};
+use crate::cut::expiry::{Renew, Tally, REBASE};
 use crate::cut::margin::lesser;
 use crate::cut::NIL;
 use crate::cut::{
@@ -393,13 +393,15 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         let settling = self
             .motion
             .begin(view, steady_envelope, (t, SLACK), blends, model);
-        match settling.map(|m| m.renew) {
+        match settling.as_ref().map(|m| m.renew) {
             Some(Renew::Forget) => self.v.unsettle_all(),
-            Some(Renew::Rebase) => self.v.rebase(settling.map_or(0, |m| m.now), REBASE),
+            Some(Renew::Rebase) => self
+                .v
+                .rebase(settling.as_ref().map_or(0, |m| m.now), REBASE),
             _ => {}
         }
         // Without settling no mark is trusted (they may be stale) and none is made.
-        let now = settling.map_or(u32::MAX, |m| m.now);
+        let now = settling.as_ref().map_or(u32::MAX, |m| m.now);
         // Batch lists, built without branches (each item is written, and counted when it
         // belongs): the vertices still to decide, those of them the bound could not decide
         // ("slow"), and those that judge a pair (by place in the first list).
@@ -419,12 +421,13 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 start + place - len
             }
         };
-        // The places still to ask are found a word at a time without branches (a quarter or
+        // The places still to ask are found a machine word at a time without branches (a quarter or
         // fewer of them are asked on a moving orbit, in no pattern a branch predictor learns);
         // with a window, one at a time, since a geomorph started on a mate during the walk
         // makes a vertex past the window one to ask.
-        let word = if windowed { 1 } else { 64 };
-        let (mut next, mut base, mut pending) = (0, 0, 0u64);
+        let word = if windowed { 1 } else { usize::BITS as usize };
+        let mut tally = Tally::default();
+        let (mut next, mut base, mut pending) = (0, 0, 0usize);
         while next < end || pending != 0 {
             // 1. The digests, until the batch holds `BATCH` vertices still to decide. A vertex
             // the bound decides that has no pair to judge and no geomorph is done with here:
@@ -483,7 +486,10 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                     flags
                 };
                 margin[n] = f32::NEG_INFINITY;
-                if let Some(m) = settling.filter(|m| markable && m.measures(flags, i)) {
+                if let Some(m) = settling
+                    .as_ref()
+                    .filter(|m| markable && m.measures(flags, i))
+                {
                     // How far the camera may move while it wants no split (answered from its
                     // sphere, a leaf never splits); with geomorphs also while it is seen (or
                     // not) as in the frame before, since that flag decides whether a change
@@ -512,8 +518,10 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                     next_flags &= !SETTLED;
                 }
                 self.v.flags[i] = next_flags;
-                if let Some(m) = settling.filter(|_| alone) {
-                    self.v.mark(i, m.mark(margin[n]));
+                if let Some(m) = settling.as_ref().filter(|_| alone) {
+                    let mark = m.mark(margin[n]);
+                    tally.count(margin[n], mark);
+                    self.v.mark(i, mark);
                 }
                 listed[n] = i;
                 slow[ns] = n;
@@ -554,10 +562,13 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 np += judges as usize;
                 // A first child whose pair is marked illegal settles on its own answer (a
                 // collapse that clears the mark on either child clears this one too).
-                if let Some(s) =
-                    settling.filter(|_| !judges & (flags & FIRST_CHILD != 0) & (m != NIL))
+                if let Some(s) = settling
+                    .as_ref()
+                    .filter(|_| !judges & (flags & FIRST_CHILD != 0) & (m != NIL))
                 {
-                    self.v.mark(i, s.mark(margin[k]));
+                    let mark = s.mark(margin[k]);
+                    tally.count(margin[k], mark);
+                    self.v.mark(i, mark);
                 }
             }
             let pairs = &pairs[..np];
@@ -589,7 +600,9 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                     } else {
                         margin[k]
                     };
-                    self.v.mark(listed[k], m.mark(room));
+                    let mark = m.mark(room);
+                    tally.count(room, mark);
+                    self.v.mark(listed[k], mark);
                 }
             }
             // 4. The decisions, in slot order. Without geomorphs they touch nothing but the
@@ -619,6 +632,8 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 }
             }
         }
+        self.motion
+            .tally(tally.measured, tally.settled, frame.stats.settled);
     }
 
     /// Which of the `count` places from `first` of the walk (slot `slot(place)`) are asked
@@ -631,21 +646,21 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         slot: impl Fn(usize) -> usize,
         visits: usize,
         now: u32,
-    ) -> (u64, u32) {
+    ) -> (usize, u32) {
         if first + count <= visits && first + count <= self.v.len() && slot(first) == first {
             // In the window and in slot order (always, without a window): only the settled are
             // skipped.
             let skipped = self.v.settled_until(first, count, now);
-            let all = u64::MAX >> (64 - count.clamp(1, 64));
+            let all = usize::MAX >> (usize::BITS as usize - count.clamp(1, usize::BITS as usize));
             return (!skipped & all, skipped.count_ones());
         }
-        let (mut asked, mut settled) = (0u64, 0u32);
+        let (mut asked, mut settled) = (0usize, 0u32);
         for k in 0..count {
             let i = slot(first + k);
             let flags = self.v.flags[i];
             let outside = (first + k >= visits) & (flags & (BLENDING | COLLAPSING) == 0);
             let skips = (flags & SETTLED != 0) & (self.v.expiry(i) >= now);
-            asked |= u64::from(!outside & !skips) << k;
+            asked |= usize::from(!outside & !skips) << k;
             settled += u32::from(!outside & skips);
         }
         (asked, settled)

@@ -14,8 +14,10 @@
 //! expires; frames skip it until the count passes that. A vertex far from any change is asked
 //! again only after the camera has moved most of the way to it; one near a change is asked
 //! every frame, and since measuring its margins would not pay, it is marked restless and
-//! measures them one frame in four. There are no anchor frames, so no frame costs more than
-//! its neighbours.
+//! measures them one frame in four; after a frame whose measures settled under an eighth of
+//! the vertices or that skipped fewer vertices than it measured (a camera that moves far each
+//! frame), every vertex measures one frame in 16.
+//! There are no anchor frames, so no frame costs more than its neighbours.
 //!
 //! Skipping changes no decision: every skipped answer is proven the same as asking would give
 //! (with a relative slack far above float rounding), so frames are the same with or without
@@ -66,8 +68,27 @@ pub(crate) enum Mark {
     Restless,
 }
 
+/// How many vertices a frame measured, and how many of them it settled.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct Tally {
+    pub measured: u32,
+    pub settled: u32,
+}
+
+impl Tally {
+    /// Counts a mark made from `margin` (`-inf`: not measured).
+    #[inline(always)]
+    pub fn count(&mut self, margin: f32, mark: Mark) {
+        self.measured += u32::from(margin != f32::NEG_INFINITY);
+        self.settled += u32::from(matches!(mark, Mark::Settled(_)));
+    }
+}
+
 /// A restless vertex's margins are measured one frame in this many (staggered by slot).
 const TURN: u32 = 4;
+/// After a frame that settled under an eighth of what it measured, every vertex measures one
+/// frame in this many.
+const SPARSE_TURN: u32 = 16;
 
 /// One frame's settling: the count, the margins' terms, and how to turn a margin into an
 /// expiry.
@@ -85,14 +106,22 @@ pub(crate) struct Settling {
     quantum: f32,
     /// Frames since the marks were made (wrapping), for the restless vertices' turns.
     tick: u32,
+    /// The last frame settled under an eighth of the vertices it measured.
+    sparse: bool,
 }
 
 impl Settling {
     /// Whether an asked vertex with `flags` at `slot` measures its margins this frame: always,
-    /// unless it is restless and it is not its turn.
+    /// unless it is restless and it is not its turn (one frame in [`TURN`]); after a frame
+    /// whose measures settled too few to pay, only in its turn (one frame in [`SPARSE_TURN`]).
     #[inline(always)]
     pub fn measures(&self, flags: u8, slot: usize) -> bool {
-        flags & RESTLESS == 0 || self.tick.wrapping_add(slot as u32).is_multiple_of(TURN)
+        let turn = self.tick.wrapping_add(slot as u32);
+        if self.sparse {
+            turn.is_multiple_of(SPARSE_TURN)
+        } else {
+            flags & RESTLESS == 0 || turn.is_multiple_of(TURN)
+        }
     }
 
     /// The mark of a vertex whose answers' margin is `margin` (model units; `-inf` when not
@@ -122,6 +151,7 @@ pub(crate) struct Motion {
     threshold: f32,
     blends: bool,
     tick: u8,
+    sparse: bool,
 }
 
 impl Motion {
@@ -137,6 +167,7 @@ impl Motion {
         threshold: 0.0,
         blends: false,
         tick: 0,
+        sparse: false,
     };
 
     /// Starts a frame seen from `view` with threshold `t` and the cut's bound slack `slack`,
@@ -208,7 +239,16 @@ impl Motion {
             },
             quantum: self.quantum,
             tick: u32::from(self.tick),
+            sparse: self.sparse,
         })
+    }
+
+    /// After a frame that measured the margins of `measured` vertices, settled `settled` of them
+    /// and skipped `skipped`: when it settled under one in eight or skipped fewer than it
+    /// measured (a camera that moves far each frame: measuring costs more than it saves), the
+    /// next frame measures every vertex only in its sparse turn.
+    pub fn tally(&mut self, measured: u32, settled: u32, skipped: u32) {
+        self.sparse = settled.saturating_mul(8) < measured || skipped < measured;
     }
 
     /// Forgets the marks (a new hierarchy, or a frame that did not mark).
@@ -315,5 +355,24 @@ mod tests {
         let turns = (0..8).filter(|&slot| s.measures(RESTLESS, slot)).count();
         assert_eq!(turns, 2);
         assert!((0..8).all(|slot| s.measures(0, slot)));
+    }
+
+    #[test]
+    fn a_frame_whose_measures_do_not_pay_makes_the_next_measure_sparsely() {
+        let mut m = Motion::ZERO;
+        begin(&mut m, 0.0, 1.0);
+        let measuring = |m: &mut Motion| {
+            let s = begin(m, 1.0, 1.0);
+            (0..64).filter(|&slot| s.measures(0, slot)).count()
+        };
+        assert_eq!(measuring(&mut m), 64);
+        // Settled under an eighth of what it measured.
+        m.tally(100, 10, 1_000);
+        assert_eq!(measuring(&mut m), 4);
+        // Skipped fewer than it measured.
+        m.tally(100, 50, 90);
+        assert_eq!(measuring(&mut m), 4);
+        m.tally(100, 50, 1_000);
+        assert_eq!(measuring(&mut m), 64);
     }
 }

@@ -137,15 +137,15 @@ impl<const V: usize, I: SlotIndex> Vertices<V, I> {
         }
     }
 
-    /// Which of the `count` (at most 64) slots from `first` (in range) are settled with an
+    /// Which of the `count` (at most `usize::BITS`) slots from `first` (in range) are settled with an
     /// expiry the motion count `now` has not passed, as bits.
     #[inline(always)]
-    pub fn settled_until(&self, first: usize, count: usize, now: u32) -> u64 {
+    pub fn settled_until(&self, first: usize, count: usize, now: u32) -> usize {
         let flags = &self.flags[first..first + count];
         let tags = &self.tag[first..first + count];
-        let mut bits = 0u64;
+        let mut bits = 0usize;
         for (k, (f, x)) in flags.iter().zip(tags).enumerate() {
-            bits |= u64::from((f & SETTLED != 0) & (x.index() as u32 >= now)) << k;
+            bits |= usize::from((f & SETTLED != 0) & (x.index() as u32 >= now)) << k;
         }
         bits
     }
