@@ -594,7 +594,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             if let Some(m) = &settling {
                 for &k in pairs {
                     // Not measured (restless, not its turn), or already too small: no need.
-                    let room = if margin[k] >= 2.0 * m.step {
+                    let room = if margin[k] >= m.step {
                         let wanted = m.margins.wanted(&parent_bounds[k], (t, SLACK), (m.step, 4));
                         lesser(margin[k], wanted.within())
                     } else {

@@ -10,7 +10,7 @@
 //! frame's step being the larger of the eye's movement and the planes' sway over the model's
 //! bounding sphere (both distances, so the sum of the steps bounds how far either has gone),
 //! rounded up to whole quanta of a 4096th of the model's radius. A vertex whose margin covers
-//! at least two of the camera's last steps is marked settled with the count at which it
+//! at least the camera's last step is marked settled with the count at which it
 //! expires; frames skip it until the count passes that. A vertex far from any change is asked
 //! again only after the camera has moved most of the way to it; one near a change is asked
 //! every frame, and since measuring its margins would not pay, it is marked restless and
@@ -63,7 +63,7 @@ pub(crate) enum Renew {
 pub(crate) enum Mark {
     /// Skipped until the motion count passes this.
     Settled(u32),
-    /// The margins cover under two steps of the camera (or are unproven): the next asks
+    /// The margins cover less than a step of the camera (or are unproven): the next asks
     /// measure them only in turn, one frame in [`TURN`].
     Restless,
 }
@@ -128,7 +128,7 @@ impl Settling {
     /// measured, NaN when unproven).
     #[inline(always)]
     pub fn mark(&self, margin: f32) -> Mark {
-        if margin >= 2.0 * self.step {
+        if margin >= self.step {
             Mark::Settled(self.now + ((margin / self.quantum) as u32).min(CAP))
         } else {
             Mark::Restless
@@ -337,12 +337,12 @@ mod tests {
     }
 
     #[test]
-    fn margins_under_two_steps_make_a_vertex_restless() {
+    fn margins_under_a_step_make_a_vertex_restless() {
         let mut m = Motion::ZERO;
         begin(&mut m, 0.0, 1.0);
         let s = begin(&mut m, 10.0, 1.0);
         assert!(s.step >= 10.0);
-        assert_eq!(s.mark(1.5 * s.step), Mark::Restless);
+        assert_eq!(s.mark(0.9 * s.step), Mark::Restless);
         assert_eq!(s.mark(f32::NAN), Mark::Restless);
         assert_eq!(s.mark(f32::NEG_INFINITY), Mark::Restless);
         assert_eq!(s.mark(100.0), Mark::Settled(s.now + 100));

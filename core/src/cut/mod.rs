@@ -127,7 +127,7 @@ pub(crate) const FIRST_CHILD: u8 = 32;
 /// has moved as far as its expiry says (see `expiry`); cleared by anything that changes its
 /// family.
 pub(crate) const SETTLED: u8 = 64;
-/// Vertex flag: when last measured, its answers' margins covered under two of the camera's
+/// Vertex flag: when last measured, its answers' margins covered less than one of the camera's
 /// steps, so most asks do not measure them again (see `expiry`).
 pub(crate) const RESTLESS: u8 = 128;
 
