@@ -421,10 +421,10 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 start + place - len
             }
         };
-        // The places still to ask are found a machine word at a time without branches (a quarter or
-        // fewer of them are asked on a moving orbit, in no pattern a branch predictor learns);
-        // with a window, one at a time, since a geomorph started on a mate during the walk
-        // makes a vertex past the window one to ask.
+        // The places still to ask are found a machine word at a time without branches (a
+        // quarter or fewer of them are asked on a moving orbit, in no pattern a branch
+        // predictor learns); with a window, one at a time, since a geomorph started on a mate
+        // during the walk makes a vertex past the window one to ask.
         let word = if windowed { 1 } else { usize::BITS as usize };
         let mut tally = Tally::default();
         let (mut next, mut base, mut pending) = (0, 0, 0usize);

@@ -3,7 +3,8 @@
 //! are (a median alone hides a slow frame in five).
 //!
 //! ```text
-//! cargo run --release -p vdlod-demo --example orbit_adapt -- [TOLERANCE [GEOMORPH [ROUNDS [on|off]]]]
+//! cargo run --release -p vdlod-demo --example orbit_adapt -- \
+//!     [TOLERANCE [GEOMORPH [ROUNDS [on|off]]]]
 //! ```
 //!
 //! Tolerance in pixels (1), geomorph frames (0), rounds of two revolutions of 200 frames (3),

@@ -7,7 +7,8 @@
 //! answers the cuts reuse: a vertex wants no split ([`Margins::unwanted`]), a sphere is in or
 //! out of the frustum ([`Margins::visibility`]), and a parent is still wanted
 //! ([`Margins::wanted`]). The wavelet cut compares them with the reach of an anchor frame
-//! (`crate::wavelet`'s `steady`); the vertex cut turns them into a per-vertex expiry (`super::expiry`).
+//! (`crate::wavelet`'s `steady`); the vertex cut turns them into a per-vertex expiry
+//! (`super::expiry`).
 //!
 //! Every margin leaves a relative slack far above float rounding, and a margin that cannot be
 //! proven (a NaN anywhere) is never positive.

@@ -137,8 +137,8 @@ impl<const V: usize, I: SlotIndex> Vertices<V, I> {
         }
     }
 
-    /// Which of the `count` (at most `usize::BITS`) slots from `first` (in range) are settled with an
-    /// expiry the motion count `now` has not passed, as bits.
+    /// Which of the `count` (at most `usize::BITS`) slots from `first` (in range) are settled
+    /// with an expiry the motion count `now` has not passed, as bits.
     #[inline(always)]
     pub fn settled_until(&self, first: usize, count: usize, now: u32) -> usize {
         let flags = &self.flags[first..first + count];

@@ -20,29 +20,29 @@ use crate::policy::{dot, sub, Bounds, Envelope, View};
 /// cover: the anchor holds for about this many frames of steady motion.
 const STEPS: f32 = 4.0;
 
-/// What a frame does with the settled vertices.
+/// What a frame does with the settled wavelets.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum Mode {
-    /// Asks every vertex; the `SETTLED` flags mean nothing.
+    /// Asks every wavelet; the settled bits mean nothing.
     Off,
-    /// Asks every vertex and marks the settled ones.
+    /// Asks every wavelet and marks the settled ones.
     Anchor,
-    /// Skips the settled vertices.
+    /// Skips the settled wavelets.
     Skip,
 }
 
-/// The anchor frame and the margins its settled vertices have (see the module documentation).
+/// The anchor frame and the margins its settled wavelets have (see the module documentation).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Steady {
     /// Whether an anchor was set since the cut was reset.
     set: bool,
     /// Never skip (see `Cut::set_settling`).
     off: bool,
-    /// Whether the vertices' `SETTLED` flags were set against the anchor.
+    /// Whether the wavelets' settled bits were set against the anchor.
     valid: bool,
     /// Frames since the anchor.
     frames: u16,
-    /// Frames left without anchoring: the last anchor settled too few vertices to pay for
+    /// Frames left without anchoring: the last anchor settled too few wavelets to pay for
     /// itself (the camera moves too far per frame).
     idle: u16,
     /// Whether geomorphs were on at the anchor (settling then also proved visibility).
@@ -74,7 +74,7 @@ impl Steady {
         sway: 0.0,
     };
 
-    /// Starts a frame seen from `view` with threshold `t`: skips the settled vertices when the
+    /// Starts a frame seen from `view` with threshold `t`: skips the settled wavelets when the
     /// anchor holds (same `envelope`, threshold and geomorphs on or off, eye within the reach,
     /// planes within the sway over the bounding sphere `model`), else anchors here when it can
     /// (`envelope` known), else asks everything.
@@ -172,7 +172,11 @@ impl Steady {
         (center, radius): ([f32; 3], f32),
         d2: f32,
     ) -> bool {
-        let seen = m.visibility(center, radius);
+        let seen = if m.culls() {
+            m.visibility(center, radius)
+        } else {
+            (None, f32::NAN)
+        };
         m.unwanted(s, radius, d2, seen).holds(self.reach, self.sway)
     }
 
