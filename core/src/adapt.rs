@@ -649,9 +649,12 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
     ) -> (usize, u32) {
         if first + count <= visits && first + count <= self.v.len() && slot(first) == first {
             // In the window and in slot order (always, without a window): only the settled are
-            // skipped.
-            let skipped = self.v.settled_until(first, count, now);
+            // skipped (none without settling).
             let all = usize::MAX >> (usize::BITS as usize - count.clamp(1, usize::BITS as usize));
+            if now == u32::MAX {
+                return (all, 0);
+            }
+            let skipped = self.v.settled_until(first, count, now);
             return (!skipped & all, skipped.count_ones());
         }
         let (mut asked, mut settled) = (0usize, 0u32);
