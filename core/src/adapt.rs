@@ -67,7 +67,7 @@
 //! # }
 //! ```
 
-use crate::cut::expiry::{Renew, Tally, REBASE};
+use crate::cut::expiry::{Renew, Settling, Tally, REBASE};
 use crate::cut::margin::lesser;
 use crate::cut::NIL;
 use crate::cut::{
@@ -393,12 +393,12 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         let settling = self
             .motion
             .begin(view, steady_envelope, (t, SLACK), blends, model);
-        match settling.as_ref().map(|m| m.renew) {
-            Some(Renew::Forget) => self.v.unsettle_all(),
-            Some(Renew::Rebase) => self
-                .v
-                .rebase(settling.as_ref().map_or(0, |m| m.now), REBASE),
-            _ => {}
+        if let Some(m) = &settling {
+            match m.renew {
+                Renew::Forget => self.v.unsettle_all(),
+                Renew::Rebase => self.v.rebase(m.now, REBASE),
+                Renew::Keep => {}
+            }
         }
         // Without settling no mark is trusted (they may be stale) and none is made.
         let now = settling.as_ref().map_or(u32::MAX, |m| m.now);
@@ -519,9 +519,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 }
                 self.v.flags[i] = next_flags;
                 if let Some(m) = settling.as_ref().filter(|_| alone) {
-                    let mark = m.mark(margin[n]);
-                    tally.count(margin[n], mark);
-                    self.v.mark(i, mark);
+                    self.mark(i, m, margin[n], &mut tally);
                 }
                 listed[n] = i;
                 slow[ns] = n;
@@ -566,9 +564,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                     .as_ref()
                     .filter(|_| !judges & (flags & FIRST_CHILD != 0) & (m != NIL))
                 {
-                    let mark = s.mark(margin[k]);
-                    tally.count(margin[k], mark);
-                    self.v.mark(i, mark);
+                    self.mark(i, s, margin[k], &mut tally);
                 }
             }
             let pairs = &pairs[..np];
@@ -600,9 +596,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                     } else {
                         margin[k]
                     };
-                    let mark = m.mark(room);
-                    tally.count(room, mark);
-                    self.v.mark(listed[k], mark);
+                    self.mark(listed[k], m, room, &mut tally);
                 }
             }
             // 4. The decisions, in slot order. Without geomorphs they touch nothing but the
@@ -634,6 +628,15 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         }
         self.motion
             .tally(tally.measured, tally.settled, frame.stats.settled);
+    }
+
+    /// Marks slot `i` as the margin `margin` of its answers says (see [`Settling::mark`]), and
+    /// counts it in `tally`.
+    #[inline(always)]
+    fn mark(&mut self, i: usize, settling: &Settling, margin: f32, tally: &mut Tally) {
+        let mark = settling.mark(margin);
+        tally.count(margin, mark);
+        self.v.mark(i, mark);
     }
 
     /// Which of the `count` places from `first` of the walk (slot `slot(place)`) are asked
