@@ -143,8 +143,23 @@ impl<const V: usize, I: SlotIndex> Vertices<V, I> {
     pub fn settled_until(&self, first: usize, count: usize, now: u32) -> usize {
         let flags = &self.flags[first..first + count];
         let tags = &self.tag[first..first + count];
+        // Eight slots at a time: a byte of 0 or 1 each (the SETTLED bits shifted down, and the
+        // expiries compared), gathered into eight bits by one multiplication (byte `i` lands
+        // on bit `56 + i`, and no two products share a bit); the rest one at a time.
+        const ONES: u64 = 0x0101_0101_0101_0101;
         let mut bits = 0usize;
-        for (k, (f, x)) in flags.iter().zip(tags).enumerate() {
+        let (fs, xs) = (flags.chunks_exact(8), tags.chunks_exact(8));
+        let rest = fs.remainder().iter().zip(xs.remainder());
+        for (c, (f, x)) in fs.zip(xs).enumerate() {
+            let f = u64::from_le_bytes(core::array::from_fn(|k| f[k]));
+            let late = u64::from_le_bytes(core::array::from_fn(|k| {
+                u8::from(x[k].index() as u32 >= now)
+            }));
+            let lanes = (f >> SETTLED.trailing_zeros()) & ONES & late;
+            bits |= ((lanes.wrapping_mul(0x0102_0408_1020_4080) >> 56) as usize) << (8 * c);
+        }
+        for (k, (f, x)) in rest.enumerate() {
+            let k = count / 8 * 8 + k;
             bits |= usize::from((f & SETTLED != 0) & (x.index() as u32 >= now)) << k;
         }
         bits
@@ -315,5 +330,47 @@ impl<const F: usize, I: SlotIndex> Triangles<F, I> {
 
     pub fn pop(&mut self) {
         self.len = self.len.saturating_sub(1);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The word-at-a-time settled bits are the per-slot test, for every start and length,
+    /// whatever the other flags and the expiries.
+    #[test]
+    fn settled_bits_are_each_slots_own_test() {
+        let mut v = Vertices::<200, u16>::new();
+        let mut x = 0x9E37_79B9u32;
+        let mut random = move || {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            x
+        };
+        for s in 0..200 {
+            v.push(s, random() as u8);
+            if random() % 3 != 0 {
+                v.mark(s as usize, Mark::Settled(random() % 400));
+            }
+        }
+        for first in 0..70 {
+            for count in 0..=(usize::BITS as usize).min(200 - first) {
+                for now in [0, 1, 150, 399, 400] {
+                    let mut want = 0usize;
+                    for k in 0..count {
+                        let s = first + k;
+                        let settled = v.flags[s] & SETTLED != 0 && v.expiry(s) >= now;
+                        want |= usize::from(settled) << k;
+                    }
+                    assert_eq!(
+                        v.settled_until(first, count, now),
+                        want,
+                        "{first} {count} {now}"
+                    );
+                }
+            }
+        }
     }
 }
