@@ -69,6 +69,7 @@
 
 use crate::cut::expiry::{Renew, Settling, Tally, REBASE};
 use crate::cut::margin::lesser;
+use crate::cut::split::Split;
 use crate::cut::NIL;
 use crate::cut::{
     Cut, Pair, PairFans, Refused, SlotIndex, BLENDING, BLOCKED, COLLAPSING, FIRST_CHILD, SETTLED,
@@ -958,39 +959,41 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             let before = self.v.len();
             let mut tris = self.t.len() as u32;
             let mut spent = frame.ops;
-            // The nodes split (forced ones first): their children are evaluated next (past 64
+            // The splits done (forced ones first): their children are evaluated next (past 64
             // forced splits, the rest wait for the next frame's pass).
-            let mut split = [0u32; 64];
-            let mut logged = 0usize;
-            let result = self.force_split(h, v, blend, &mut |node, added| {
-                if !budget.admits(tris, added) {
-                    Err(Refused::Budget)
-                } else if spent >= budget.max_ops {
-                    Err(Refused::Ops)
-                } else {
-                    tris += added;
-                    spent += 1;
-                    if let Some(slot) = split.get_mut(logged) {
-                        *slot = node;
-                        logged += 1;
+            let mut done_splits = heapless::Vec::<Split, 64>::new();
+            let result = self.force_split_at(
+                h,
+                (v, s),
+                blend,
+                &mut |_, added| {
+                    if !budget.admits(tris, added) {
+                        Err(Refused::Budget)
+                    } else if spent >= budget.max_ops {
+                        Err(Refused::Ops)
+                    } else {
+                        tris += added;
+                        spent += 1;
+                        Ok(())
                     }
-                    Ok(())
-                }
-            });
+                },
+                &mut |split| {
+                    let _ = done_splits.push(split);
+                },
+            );
             let done = (self.v.len() - before) as u32;
             frame.stats.vsplits += done;
             frame.stats.forced += done.saturating_sub(result.is_ok() as u32);
             frame.ops += done;
-            for &node in &split[..logged] {
-                if self.is_active(node) {
-                    continue; // refused after all
-                }
-                for c in h.children(node) {
-                    let Some(cs) = self.slot(c) else {
+            for split in &done_splits {
+                for k in 0..2 {
+                    let (c, cs, record) = (split.children[k], split.slots[k], split.records[k]);
+                    // A later split of the chain may have split the child too (its first child
+                    // then holds the slot).
+                    if self.v.node.get(cs as usize) != Some(&c) {
                         continue;
-                    };
+                    }
                     // Located once: its bounds and whether it splits.
-                    let record = h.record(c);
                     let d = self.judged(h, cs as usize, &h.bounds_at(record), view, policy);
                     let flags = &mut self.v.flags[cs as usize];
                     *flags = (*flags & !VISIBLE) | kept(d.visible, frames > 0) as u8;

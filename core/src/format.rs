@@ -1065,7 +1065,14 @@ impl<'a> HierarchyView<'a> {
     #[inline]
     #[must_use]
     pub fn digest(&self, i: u32) -> Digest {
-        let r = self.record_bytes(i);
+        self.digest_at(self.record(i))
+    }
+
+    /// [`HierarchyView::digest`] of a located record.
+    #[inline]
+    #[must_use]
+    pub fn digest_at(&self, at: Record) -> Digest {
+        let r = self.record_bytes_at(at);
         let q = |k: usize| u16::from_le_bytes([r[2 * k], r[2 * k + 1]]);
         Digest {
             position: [q(0), q(1), q(2)],

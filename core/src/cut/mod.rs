@@ -76,7 +76,7 @@
 
 use core::fmt;
 
-use crate::format::{HierarchyView, NONE};
+use crate::format::{HierarchyView, Record, NONE};
 use crate::nodemap::NodeMap;
 
 mod blend;
@@ -87,7 +87,7 @@ mod fan;
 mod judge;
 pub(crate) mod margin;
 pub mod slot;
-mod split;
+pub(crate) mod split;
 mod store;
 
 pub(crate) use blend::Blend;
@@ -552,10 +552,15 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
     /// Links slots `first` and `second`, just given a split's two children (in the order
     /// [`HierarchyView::split`] lists them), as mates: what [`Cut::link_family`] finds for each,
     /// without looking up their parent or each other (both records are adjacent in the file).
-    fn link_children(&mut self, h: &HierarchyView<'_>, [first, second]: [u32; 2]) {
+    fn link_children(
+        &mut self,
+        h: &HierarchyView<'_>,
+        [first, second]: [u32; 2],
+        records: [Record; 2],
+    ) {
         let (a, b) = (first as usize, second as usize);
-        self.v.digest[a] = h.digest(self.v.node[a]);
-        self.v.digest[b] = h.digest(self.v.node[b]);
+        self.v.digest[a] = h.digest_at(records[0]);
+        self.v.digest[b] = h.digest_at(records[1]);
         self.v.flags[a] |= FIRST_CHILD;
         self.v.flags[b] &= !FIRST_CHILD;
         self.v.set_mate(a, second);

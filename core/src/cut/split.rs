@@ -4,7 +4,15 @@
 use super::fan::Fan;
 use super::slot::SlotIndex;
 use super::{next3, Cut, Refused, NIL};
-use crate::format::{HierarchyView, NONE};
+use crate::format::{HierarchyView, Record, NONE};
+
+/// A split done: its children's ids, slots and records.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Split {
+    pub children: [u32; 2],
+    pub slots: [u32; 2],
+    pub records: [Record; 2],
+}
 
 /// Everything a legal split needs, found while proving it legal.
 pub(crate) struct SplitPlan {
@@ -24,7 +32,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
     pub fn split(&mut self, h: &HierarchyView<'_>, node: u32) -> Result<[u32; 2], Refused> {
         let mut moved = Fan::new();
         let plan = self.split_legal(h, node, &mut moved)?;
-        Ok(self.apply_split(h, node, &plan, &moved, 0))
+        Ok(self.apply_split(h, node, &plan, &moved, 0).0)
     }
 
     /// Proves the split of `node` legal: it is active, its neighbour triangles are all around
@@ -37,6 +45,17 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         moved: &mut Fan,
     ) -> Result<SplitPlan, Refused> {
         let ps = self.slot(node).ok_or(Refused::NotActive)?;
+        self.split_legal_at(h, node, ps, moved)
+    }
+
+    /// [`Cut::split_legal`] of the node at slot `ps`.
+    fn split_legal_at(
+        &self,
+        h: &HierarchyView<'_>,
+        node: u32,
+        ps: u32,
+        moved: &mut Fan,
+    ) -> Result<SplitPlan, Refused> {
         let s = h.split(node);
         if s.children[0] == NONE {
             return Err(Refused::NoSuchOperation);
@@ -143,7 +162,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
 
     /// Performs a split [`Cut::split_legal`] approved; with `frames > 0` the children start at
     /// the parent's current (blended) position, normal and colour and blend to their own over
-    /// that many frames. Returns the children's slots.
+    /// that many frames. Returns the children's slots and records.
     pub(crate) fn apply_split(
         &mut self,
         h: &HierarchyView<'_>,
@@ -151,7 +170,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         plan: &SplitPlan,
         moved: &Fan,
         frames: u16,
-    ) -> [u32; 2] {
+    ) -> ([u32; 2], [Record; 2]) {
         let SplitPlan {
             parent: ps,
             neighbours: ns,
@@ -169,9 +188,10 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             // happen; should it, the parent comes back rather than the cut breaking.
             debug_assert!(false, "room for a split's second child was proven");
             self.rename_vertex(h, ps as usize, node);
-            return [ps, ps];
+            return ([ps, ps], [h.record(node); 2]);
         };
-        self.link_children(h, [ps, c1s]);
+        let records = [h.record(c0), h.record(c1)];
+        self.link_children(h, [ps, c1s], records);
         if let Some(from) = start {
             self.start_blend_from(ps as usize, &from, frames, false);
             self.start_blend_from(c1s as usize, &from, frames, false);
@@ -206,7 +226,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         self.point_edge(ns[3], c1s, wr, fr);
         self.v.set_fan(ps as usize, fl);
         self.v.set_fan(c1s as usize, fl);
-        [ps, c1s]
+        ([ps, c1s], records)
     }
 
     /// Points the edge `a -> b` of triangle `f` (if `f` is a triangle with that edge) at `to`.
@@ -230,13 +250,26 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         frames: u16,
         allow: &mut dyn FnMut(u32, u32) -> Result<(), Refused>,
     ) -> Result<u32, Refused> {
-        if !self.is_active(node) {
-            return Err(Refused::NotActive);
-        }
+        let slot = self.slot(node).ok_or(Refused::NotActive)?;
+        self.force_split_at(h, (node, slot), frames, allow, &mut |_| {})
+    }
+
+    /// [`Cut::force_split`] of `node` at slot `slot`, telling `split` of each split done (the
+    /// node, its children and their slots).
+    pub(crate) fn force_split_at(
+        &mut self,
+        h: &HierarchyView<'_>,
+        (node, slot): (u32, u32),
+        frames: u16,
+        allow: &mut dyn FnMut(u32, u32) -> Result<(), Refused>,
+        split: &mut dyn FnMut(Split),
+    ) -> Result<u32, Refused> {
         self.stack.clear();
         self.stack.push(node).map_err(|_| Refused::Capacity)?;
         let mut done = 0;
         let mut moved = Fan::new();
+        // The slot of the node on top of the stack, when known.
+        let mut known = Some(slot);
         // Each round splits once or pushes a coarser node; bounded for crafted files.
         let mut rounds = 0u32;
         let limit = h.nodes().saturating_mul(4).saturating_add(64);
@@ -245,30 +278,45 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             if rounds > limit {
                 return Err(Refused::Inconsistent);
             }
-            if !self.is_active(v) {
+            let Some(vs) = known.take().or_else(|| self.slot(v)) else {
                 // Either split already (by an earlier forced split), or coarser than the cut
                 // here: then its first active ancestor goes first.
                 let mut a = h.parent(v);
                 let mut steps = 0;
-                while a != NONE && !self.is_active(a) {
+                let ancestor = loop {
+                    if a == NONE {
+                        break None;
+                    }
+                    if let Some(s) = self.slot(a) {
+                        break Some(s);
+                    }
                     a = h.parent(a);
                     steps += 1;
                     if steps > h.nodes() {
                         return Err(Refused::Inconsistent);
                     }
-                }
-                if a == NONE {
-                    self.stack.pop();
-                } else {
-                    self.stack.push(a).map_err(|_| Refused::Capacity)?;
+                };
+                match ancestor {
+                    None => {
+                        self.stack.pop();
+                    }
+                    Some(s) => {
+                        self.stack.push(a).map_err(|_| Refused::Capacity)?;
+                        known = Some(s);
+                    }
                 }
                 continue;
-            }
-            match self.split_legal(h, v, &mut moved) {
+            };
+            match self.split_legal_at(h, v, vs, &mut moved) {
                 Ok(plan) => {
                     let added = if plan.wings[1] != NIL { 2 } else { 1 };
                     allow(v, added)?;
-                    self.apply_split(h, v, &plan, &moved, frames);
+                    let (slots, records) = self.apply_split(h, v, &plan, &moved, frames);
+                    split(Split {
+                        children: plan.children,
+                        slots,
+                        records,
+                    });
                     done += 1;
                     self.stack.pop();
                     if v == node {
