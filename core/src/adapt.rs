@@ -428,6 +428,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         // during the walk makes a vertex past the window one to ask.
         let word = if windowed { 1 } else { usize::BITS as usize };
         let mut tally = Tally::default();
+        let mut visited = 0u32;
         let (mut next, mut base, mut pending) = (0, 0, 0usize);
         while next < end || pending != 0 {
             // 1. The digests, until the batch holds `BATCH` vertices still to decide. A vertex
@@ -449,8 +450,8 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 }
                 let i = slot(base + pending.trailing_zeros() as usize);
                 pending &= pending - 1;
+                visited += 1;
                 let flags = self.v.flags[i];
-                frame.stats.visited += 1;
                 let digest = &self.v.digest[i];
                 let center = h.digest_center(digest);
                 let s = h.length(digest.spheroid);
@@ -627,6 +628,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 }
             }
         }
+        frame.stats.visited += visited;
         self.motion
             .tally(tally.measured, tally.settled, frame.stats.settled);
     }
