@@ -215,6 +215,24 @@ fn pair_error(d: Demand) -> f32 {
     }
 }
 
+/// The bounds in `record` that a policy reads: only the sphere for one answered from spheres
+/// (`sphere_only`: no normal to decode), all of them otherwise.
+#[inline(always)]
+fn bounds_read(h: &HierarchyView<'_>, record: Record, sphere_only: bool) -> Bounds {
+    if sphere_only {
+        h.sphere_at(record)
+    } else {
+        h.bounds_at(record)
+    }
+}
+
+/// Whether `policy` reads nothing of a vertex but its bounding sphere, for vertices and pairs
+/// alike (see [`Policy::sphere_only`]).
+#[inline(always)]
+fn reads_spheres<P: Policy>(policy: &P) -> bool {
+    policy.sphere_only() && !policy.judges_triangles()
+}
+
 /// A vertex's flags after a frame in which it was `visible` or not, with geomorphs on
 /// (`blends`) or off: `VISIBLE` moves to `WAS_VISIBLE`. Only geomorphs read them (whether a
 /// change blends), so a frame without them stores "not seen" ([`kept`]): the flags of a
@@ -366,7 +384,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         let zone = envelope.unwrap_or(Envelope::ZERO);
         // A policy that reads only the bounding sphere is answered from the digest's copy of it:
         // the same floats the record decodes to, so the same demand, without reading the file.
-        let sphere_only = policy.sphere_only() && !policy.judges_triangles();
+        let sphere_only = reads_spheres(policy);
         // Settled vertices are skipped until their expiry; every vertex asked is marked anew
         // (see `crate::cut::expiry`).
         let model = h.bounding_sphere();
@@ -583,11 +601,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             }
             core::hint::black_box(touched);
             for &k in pairs {
-                parent_bounds[k] = if sphere_only {
-                    h.sphere_at(records[k])
-                } else {
-                    h.bounds_at(records[k])
-                };
+                parent_bounds[k] = bounds_read(h, records[k], sphere_only);
             }
             if let Some(m) = &settling {
                 for &k in pairs {
@@ -868,7 +882,8 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         };
         let p = h.parent(self.v.node[first]);
         let pair = (first, self.v.mate(first) as usize);
-        let error = pair_error(self.judged_pair(h, pair, &h.bounds(p), view, policy));
+        let bounds = bounds_read(h, h.record(p), reads_spheres(policy));
+        let error = pair_error(self.judged_pair(h, pair, &bounds, view, policy));
         if error <= frame.threshold {
             self.list_pair(error, p, first, &mut frame.stats);
         }
@@ -920,7 +935,8 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         for i in 0..self.v.len() {
             if let Some(p) = self.pair_parent(h, i) {
                 let pair = (i, self.v.mate(i) as usize);
-                let e = pair_error(self.judged_pair(h, pair, &h.bounds(p), view, policy));
+                let bounds = bounds_read(h, h.record(p), reads_spheres(policy));
+                let e = pair_error(self.judged_pair(h, pair, &bounds, view, policy));
                 if !self.list_pair(e, p, i, stats) {
                     break;
                 }
