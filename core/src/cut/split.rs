@@ -254,8 +254,8 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         self.force_split_at(h, (node, slot), frames, allow, &mut |_| {})
     }
 
-    /// [`Cut::force_split`] of `node` at slot `slot`, telling `split` of each split done (the
-    /// node, its children and their slots).
+    /// [`Cut::force_split`] of `node` at slot `slot`, telling `split` of each split done (its
+    /// children's ids, slots and records).
     pub(crate) fn force_split_at(
         &mut self,
         h: &HierarchyView<'_>,
