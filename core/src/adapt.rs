@@ -433,6 +433,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         let mut parents = [NONE; BATCH];
         let mut records = [Record::default(); BATCH];
         let mut parent_bounds = [Bounds::default(); BATCH];
+        let mut lone = [false; BATCH];
         let slot = |place: usize| {
             if start + place < len {
                 start + place
@@ -538,10 +539,13 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                     next_flags &= !SETTLED;
                 }
                 self.v.flags[i] = next_flags;
-                if let Some(m) = settling.as_ref().filter(|_| alone) {
+                // A vertex whose record is read is marked once its facing is known (stage 2).
+                let slow_one = !wants_none & sphere.is_none();
+                if let Some(m) = settling.as_ref().filter(|_| alone & !slow_one) {
                     self.mark(i, m, margin[n], &mut tally);
                 }
                 listed[n] = i;
+                lone[n] = alone;
                 slow[ns] = n;
                 bounds[n].center = center;
                 bounds[n].radius = radius;
@@ -549,7 +553,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                     visible,
                     error: 0.0,
                 });
-                ns += (!wants_none & sphere.is_none()) as usize;
+                ns += slow_one as usize;
                 n += !done as usize;
             }
             let (listed, slow) = (&listed[..n], &slow[..ns]);
@@ -563,6 +567,18 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             for &k in slow {
                 bounds[k] = h.bounds_at(records[k]);
                 demands[k] = self.judged(h, listed[k], &bounds[k], view, policy);
+                if let Some(m) = &settling {
+                    // Its bound could not say it wants no split, but a normal cone that stays
+                    // turned away does (a culled vertex wants nothing): most such vertices are
+                    // the coarse ones on the far side. Measured ones only; with geomorphs its
+                    // visibility would have to stay too.
+                    if !blends && margin[k] != f32::NEG_INFINITY {
+                        margin[k] = margin[k].max(m.margins.averted(&bounds[k]));
+                    }
+                    if lone[k] {
+                        self.mark(listed[k], m, margin[k], &mut tally);
+                    }
+                }
             }
             // 3. The parent of a pair matters unless the first child is to be split or both
             // were found illegal to collapse (see `decide`).

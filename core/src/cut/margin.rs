@@ -226,6 +226,24 @@ impl Margins {
         }
     }
 
+    /// How far the eye may move while the normal cone of bounds `b` stays turned away from it
+    /// (Hoppe's `oriented_away` with the apex moved towards the eye by the radius, as the
+    /// envelope's back-face test: `rn - radius > d cone_sin`, `rn` the eye-to-centre vector
+    /// along the axis, `d` its length), so that the vertex stays culled and wants nothing;
+    /// `-inf` when the envelope does not cull back faces, negative or NaN when unproven.
+    #[inline(always)]
+    pub fn averted(&self, b: &Bounds) -> f32 {
+        if !self.envelope.back_face {
+            return f32::NEG_INFINITY;
+        }
+        let r = sub(b.center, self.eye);
+        let d = libm::sqrtf(dot(r, r));
+        // The test squares the sine: its sign does not matter.
+        let cs = libm::fabsf(b.cone_sin);
+        // An eye moved by `e` shortens `rn` and lengthens `d` by at most `|e|` each.
+        (dot(r, b.axis) - b.radius - d * cs) / (1.0 + cs) / (1.0 + SLACK) - self.slop
+    }
+
     /// The margins of "still wanted" for a parent with bounds `b`, threshold `t` and the cut's
     /// bound slack `slack`: seen (with margin from every culling plane), facing the eye, and its
     /// error over `t * slack` wherever the eye gets: the spheroid's lower bound where the eye
@@ -409,6 +427,61 @@ mod tests {
         }
         .within()
         .is_nan());
+    }
+
+    #[test]
+    fn a_turned_away_cone_stays_culled_while_the_eye_moves_less_than_its_margin() {
+        use crate::policy::{BackFace, Policy};
+        let m = margins(Envelope {
+            back_face: true,
+            ..Envelope::ZERO
+        });
+        // Facing away from the eye at z = 5, within a cone of half-angle asin 0.3.
+        let b = Bounds {
+            center: [0.0; 3],
+            radius: 0.2,
+            axis: [0.0, 0.0, -1.0],
+            cone_sin: 0.3,
+            ..Bounds::default()
+        };
+        let room = m.averted(&b);
+        // 5 - 0.2 - 5 * 0.3 = 3.3 over 1.3.
+        assert!(room > 2.5 && room < 2.54, "{room}");
+        let culled = |eye: [f32; 3]| {
+            let v = View::look_at(eye, [0.0; 3], [0.0, 1.0, 0.0], 1.0, 1.0, 480.0);
+            !BackFace.demand(&b, &v).visible
+        };
+        // Every eye within the margin, in 26 directions and at 20 distances, still sees it
+        // turned away; far enough round to its front it is seen.
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                for dz in -1..=1 {
+                    let dir = [dx as f32, dy as f32, dz as f32];
+                    let len = libm::sqrtf(dot(dir, dir));
+                    if len == 0.0 {
+                        continue;
+                    }
+                    for k in 1..=20 {
+                        let t = room * k as f32 / 20.0 / len;
+                        let eye = [dir[0] * t, dir[1] * t, 5.0 + dir[2] * t];
+                        assert!(culled(eye), "{eye:?} within {room}");
+                    }
+                }
+            }
+        }
+        assert!(!culled([0.0, 0.0, -5.0]));
+        // Seen now, or not culling back faces, or NaN: no margin.
+        let front = Bounds {
+            axis: [0.0, 0.0, 1.0],
+            ..b
+        };
+        assert!(m.averted(&front) < 0.0);
+        assert_eq!(margins(Envelope::ZERO).averted(&b), f32::NEG_INFINITY);
+        let nan = Bounds {
+            cone_sin: f32::NAN,
+            ..b
+        };
+        assert!(m.averted(&nan).is_nan());
     }
 
     #[test]
