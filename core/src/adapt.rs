@@ -1012,7 +1012,13 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                     }
                 },
                 &mut |split| {
-                    let _ = done_splits.push(split);
+                    // Past 64, a split's children are not judged now: they are new, so
+                    // unsettled, and next frame's pass asks them (nothing is lost, only a
+                    // frame's delay for a chain that long).
+                    if done_splits.is_full() {
+                        return;
+                    }
+                    done_splits.push(split).ok();
                 },
             );
             let done = (self.v.len() - before) as u32;
