@@ -521,7 +521,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                         (None, f32::NAN)
                     };
                     let own = if wants_none {
-                        m.margins.unwanted(s, radius, d2, seen).within()
+                        m.margins.unwanted(s, radius, d2, seen).within(m.scale)
                     } else if sphere_only && !h.is_parent(self.v.node[i]) {
                         f32::INFINITY
                     } else {
@@ -530,7 +530,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                     margin[n] = match (blends, seen) {
                         (false, _) => own,
                         (true, (Some(v), room)) if v == visible && (flags & VISIBLE != 0) == v => {
-                            lesser(own, room)
+                            lesser(own, room * m.scale)
                         }
                         (true, _) => f32::NAN,
                     };
@@ -624,7 +624,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                     // Not measured (restless, not its turn), or already too small: no need.
                     let room = if margin[k] >= m.step {
                         let wanted = m.margins.wanted(&parent_bounds[k], (t, SLACK), (m.step, 4));
-                        lesser(margin[k], wanted.within())
+                        lesser(margin[k], wanted.within(m.scale))
                     } else {
                         margin[k]
                     };

@@ -8,7 +8,8 @@
 //! answers (`super::margin`): how far the eye may move and the frustum's planes sway before
 //! they could change. The cut counts the camera's motion since the marks were made, each
 //! frame's step being the larger of the eye's movement and the planes' sway over the model's
-//! bounding sphere (both distances, so the sum of the steps bounds how far either has gone),
+//! bounding sphere, the sway weighed by a scale measured from the camera's own motion (both
+//! distances, so the sum of the steps bounds how far either has gone; see `SwayScale`),
 //! rounded up to whole quanta of a 4096th of the model's radius. A vertex whose margin covers
 //! at least the camera's last step is marked settled with the count at which it
 //! expires; frames skip it until the count passes that. A vertex far from any change is asked
@@ -100,9 +101,12 @@ pub(crate) struct Settling {
     pub margins: Margins,
     /// What to do with the marks first.
     pub renew: Renew,
-    /// The camera's last step (model units, at least a quantum): the along-axis spheroid
-    /// margins are tried at multiples of it.
+    /// The camera's last step (model units, at least a quantum; the planes' sway counted at
+    /// `scale`): the along-axis spheroid margins are tried at multiples of it.
     pub step: f32,
+    /// Eye units per unit of the planes' sway (see [`SwayScale`]): a sway margin counts as
+    /// `scale` times its length.
+    pub scale: f32,
     quantum: f32,
     /// Frames since the marks were made (wrapping), for the restless vertices' turns.
     tick: u32,
@@ -152,10 +156,73 @@ pub(crate) struct Motion {
     blends: bool,
     tick: u8,
     sparse: bool,
+    /// Eye units per unit of the planes' sway in the count (see [`SwayScale`]).
+    scale: f32,
+    /// The motion since the scale was last checked.
+    seen: SwayScale,
+    /// Whether this count has had its first check.
+    checked: bool,
+}
+
+/// How the count weighs the planes' sway against the eye's movement.
+///
+/// A step counts `max(eye movement, scale x planes' sway)`, and a margin of sway counts
+/// `scale` times its length, so that a mark still expires before the eye has moved as far as
+/// its eye margin *and* before the planes have swayed as far as its sway margin, for any fixed
+/// positive `scale`. With `scale` 1 a camera circling a model at twice its radius spends its
+/// vertices' plane margins twice as fast as the planes move (they turn about the model's
+/// centre, sweeping its radius, while the eye travels the orbit's); the scale is therefore the
+/// ratio of the two measured over the last frames. It changes only with the marks, which were
+/// made under the old one: [`SwayScale::FIRST`] frames into the cut's motion, and every
+/// [`SwayScale::EVERY`] frames after, when the ratio measured since has moved more than
+/// [`SwayScale::DRIFT`] from the scale, the count forgets its marks and takes it. Frames are
+/// the same under any scale; only how many vertices they skip differs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct SwayScale {
+    moved: f32,
+    swayed: f32,
+    frames: u8,
+}
+
+impl SwayScale {
+    /// Nothing measured.
+    const ZERO: SwayScale = SwayScale {
+        moved: 0.0,
+        swayed: 0.0,
+        frames: 0,
+    };
+    /// Frames into a new count when the scale is first checked.
+    const FIRST: u8 = 8;
+    /// Frames between later checks.
+    const EVERY: u8 = 128;
+    /// A measured ratio within this factor of the scale keeps it.
+    const DRIFT: f32 = 1.5;
+    /// The scale stays within `1/LIMIT..=LIMIT` (positive and finite, so that an infinite
+    /// margin stays infinite and a missing one missing).
+    const LIMIT: f32 = 64.0;
+
+    /// Adds a frame's step.
+    fn add(&mut self, moved: f32, swayed: f32) {
+        self.moved += moved;
+        self.swayed += swayed;
+        self.frames = self.frames.wrapping_add(1);
+    }
+
+    /// The ratio measured, when the eye or the planes moved at all.
+    fn ratio(&self) -> Option<f32> {
+        let ratio = self.moved / self.swayed;
+        // 0/0 is NaN, which the comparison refuses.
+        (ratio >= 0.0).then(|| ratio.clamp(1.0 / Self::LIMIT, Self::LIMIT))
+    }
+}
+
+/// Whether a measured ratio `r` has moved more than [`SwayScale::DRIFT`] from `scale`.
+fn drifted(scale: f32, r: f32) -> bool {
+    r > scale * SwayScale::DRIFT || r * SwayScale::DRIFT < scale
 }
 
 impl Motion {
-    /// No marks (all zeros).
+    /// No marks, no motion seen.
     pub const ZERO: Motion = Motion {
         off: false,
         valid: false,
@@ -168,6 +235,9 @@ impl Motion {
         blends: false,
         tick: 0,
         sparse: false,
+        scale: 1.0,
+        seen: SwayScale::ZERO,
+        checked: false,
     };
 
     /// Starts a frame seen from `view` with threshold `t` and the cut's bound slack `slack`,
@@ -194,12 +264,30 @@ impl Motion {
         } else {
             0.0
         };
-        let step = moved.max(swayed);
-        let quanta = libm::ceilf(step / self.quantum);
+        // The step as the count weighs it (see `SwayScale`).
+        let step = |scale: f32| moved.max(scale * swayed);
         let same =
             self.valid && envelope == self.envelope && t == self.threshold && blends == self.blends;
-        let renew = if !(same && quanta <= JUMP) {
+        let continues = same && libm::ceilf(step(self.scale) / self.quantum) <= JUMP;
+        if continues && envelope.frustum {
+            self.seen.add(moved, swayed);
+        }
+        let due = self.seen.frames
+            == if self.checked {
+                SwayScale::EVERY
+            } else {
+                SwayScale::FIRST
+            };
+        let drifted = self.seen.ratio().filter(|&r| due && drifted(self.scale, r));
+        if due {
+            self.seen = SwayScale::ZERO;
+            self.checked = true;
+        }
+        let renew = if !continues || drifted.is_some() {
             self.now = 0;
+            if let Some(scale) = drifted {
+                self.scale = scale;
+            }
             let q = model.1 / QUANTA_PER_RADIUS;
             // A degenerate model settles nothing (every margin is under an infinite quantum).
             self.quantum = if q > 0.0 && q.is_finite() {
@@ -209,7 +297,7 @@ impl Motion {
             };
             Renew::Forget
         } else {
-            self.now += quanta as u32;
+            self.now += libm::ceilf(step(self.scale) / self.quantum) as u32;
             if self.now >= REBASE {
                 self.now -= REBASE;
                 Renew::Rebase
@@ -217,6 +305,7 @@ impl Motion {
                 Renew::Keep
             }
         };
+        let step = step(self.scale);
         *self = Motion {
             valid: true,
             tick: self.tick.wrapping_add(1),
@@ -238,6 +327,7 @@ impl Motion {
                 self.quantum
             },
             quantum: self.quantum,
+            scale: self.scale,
             tick: u32::from(self.tick),
             sparse: self.sparse,
         })
@@ -266,6 +356,7 @@ impl Motion {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::cut::margin::Either;
 
     const MODEL: ([f32; 3], f32) = ([0.0; 3], 4096.0);
     const ENVELOPE: Envelope = Envelope {
@@ -374,5 +465,67 @@ mod tests {
         assert_eq!(measuring(&mut m), 4);
         m.tally(100, 50, 1_000);
         assert_eq!(measuring(&mut m), 64);
+    }
+
+    /// A camera circling the model at twice its radius, looking at its centre: the eye
+    /// travels twice as far as the planes sway over the model.
+    fn circling(frame: u32) -> View {
+        let a = frame as f32 * 0.01;
+        let eye = [
+            2.0 * 4096.0 * libm::sinf(a),
+            0.0,
+            2.0 * 4096.0 * libm::cosf(a),
+        ];
+        View::look_at(eye, [0.0; 3], [0.0, 1.0, 0.0], 1.0, 1.0, 480.0)
+    }
+
+    #[test]
+    fn the_sway_scale_follows_the_camera_and_marks_still_expire_in_time() {
+        let mut m = Motion::ZERO;
+        let frame = |m: &mut Motion, f: u32| {
+            m.begin(&circling(f), Some(ENVELOPE), (1.0, 1.0), false, MODEL)
+                .expect("an envelope settles")
+        };
+        // Until the first check the scale is 1; at it the marks are forgotten and the scale
+        // becomes the measured ratio, about 2.
+        let mut f = 0;
+        while frame(&mut m, f).renew != Renew::Forget || f == 0 {
+            assert_eq!(m.scale, 1.0);
+            f += 1;
+        }
+        assert_eq!(f, u32::from(SwayScale::FIRST));
+        assert!((1.8..2.2).contains(&m.scale), "{}", m.scale);
+        // A vertex whose answer holds while the planes sway less than `room` is marked with
+        // `room` counted at the scale; it stays settled no longer than the planes take to sway
+        // that far, but about twice as long as under a scale of 1.
+        let room = 2000.0;
+        f += 1;
+        let marked = frame(&mut m, f);
+        let at = planes(&circling(f));
+        let Mark::Settled(until) = marked.mark(
+            Either {
+                eye: 0.0,
+                sway: room,
+            }
+            .within(marked.scale),
+        ) else {
+            panic!("a margin of many steps settles");
+        };
+        let mut settled = 0;
+        loop {
+            f += 1;
+            let s = frame(&mut m, f);
+            assert_ne!(s.renew, Renew::Forget);
+            if s.now > until {
+                break;
+            }
+            assert!(sway(&at, &planes(&circling(f)), MODEL) <= room, "frame {f}");
+            settled += 1;
+        }
+        let per_frame = sway(&planes(&circling(0)), &planes(&circling(1)), MODEL);
+        assert!(
+            settled as f32 > 1.8 * room / (2.0 * per_frame),
+            "{settled} frames"
+        );
     }
 }

@@ -82,11 +82,12 @@ impl Either {
         self.eye >= reach || self.sway >= sway
     }
 
-    /// The one distance both the eye and the planes may move (NaN-free: an unproven term is
-    /// ignored, since the other alone suffices).
+    /// The one distance the eye may move, the planes' sway counted at `scale` times its length
+    /// (see `super::expiry`'s sway scale); NaN-free: an unproven term is ignored, since the
+    /// other alone suffices.
     #[inline(always)]
-    pub fn within(self) -> f32 {
-        self.eye.max(self.sway)
+    pub fn within(self, scale: f32) -> f32 {
+        self.eye.max(self.sway * scale)
     }
 }
 
@@ -97,10 +98,11 @@ impl Both {
         self.eye >= reach && self.sway >= sway
     }
 
-    /// The one distance both the eye and the planes may move (NaN when either is unproven).
+    /// The one distance the eye may move, the planes' sway counted at `scale` times its length
+    /// (NaN when either term is unproven).
     #[inline(always)]
-    pub fn within(self) -> f32 {
-        lesser(self.eye, self.sway)
+    pub fn within(self, scale: f32) -> f32 {
+        lesser(self.eye, self.sway * scale)
     }
 }
 
@@ -408,24 +410,29 @@ mod tests {
             sway: 3.0,
         };
         assert!(e.holds(2.0, 2.0) && !e.holds(2.0, 4.0));
-        assert_eq!(e.within(), 3.0);
+        assert_eq!(e.within(1.0), 3.0);
+        // Planes that sway half as fast as the eye moves: three of sway last six of the count.
+        assert_eq!(e.within(2.0), 6.0);
+        assert_eq!(e.within(0.25), 1.0);
         let b = Both {
             eye: 1.0,
             sway: 3.0,
         };
         assert!(b.holds(1.0, 3.0) && !b.holds(2.0, 2.0));
-        assert_eq!(b.within(), 1.0);
+        assert_eq!(b.within(1.0), 1.0);
+        assert_eq!(b.within(0.25), 0.75);
+        assert_eq!(b.within(2.0), 1.0);
         assert!(Both {
             eye: f32::NAN,
             sway: 1.0
         }
-        .within()
+        .within(1.0)
         .is_nan());
         assert!(Both {
             eye: 1.0,
             sway: f32::NAN
         }
-        .within()
+        .within(1.0)
         .is_nan());
     }
 
@@ -506,6 +513,6 @@ mod tests {
             center: [0.0, 0.0, 10.0],
             ..b
         };
-        assert!(m.wanted(&aside, (1.0, 1.0), (0.1, 1)).within().is_nan());
+        assert!(m.wanted(&aside, (1.0, 1.0), (0.1, 1)).within(1.0).is_nan());
     }
 }
