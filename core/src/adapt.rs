@@ -520,10 +520,13 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                     } else {
                         (None, f32::NAN)
                     };
-                    let own = if wants_none {
-                        m.margins.unwanted(s, radius, d2, seen).within(m.scale)
-                    } else if sphere_only && !h.is_parent(self.v.node[i]) {
+                    // A leaf never splits, whatever it is asked (a parent's bounding radius
+                    // is not 0 but where its whole region is a point: looked up then).
+                    let leaf = digest.radius == 0 && !h.is_parent(self.v.node[i]);
+                    let own = if leaf {
                         f32::INFINITY
+                    } else if wants_none {
+                        m.margins.unwanted(s, radius, d2, seen).within(m.scale)
                     } else {
                         f32::NAN
                     };
