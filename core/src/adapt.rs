@@ -434,6 +434,8 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         let mut records = [Record::default(); BATCH];
         let mut parent_bounds = [Bounds::default(); BATCH];
         let mut lone = [false; BATCH];
+        // Pairs whose parent is proven wanted (by its margins).
+        let mut kept = [false; BATCH];
         let slot = |place: usize| {
             if start + place < len {
                 start + place
@@ -622,12 +624,18 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             for &k in pairs {
                 parent_bounds[k] = bounds_read(h, records[k], sphere_only);
             }
+            for &k in pairs {
+                kept[k] = false;
+            }
             if let Some(m) = &settling {
                 for &k in pairs {
                     // Not measured (restless, not its turn), or already too small: no need.
                     let room = if margin[k] >= m.step {
                         let wanted = m.margins.wanted(&parent_bounds[k], (t, SLACK), (m.step, 4));
-                        lesser(margin[k], wanted.within(m.scale))
+                        let wanted = wanted.within(m.scale);
+                        // Still wanted from where the eye is now: the pair stays.
+                        kept[k] = wanted >= 0.0;
+                        lesser(margin[k], wanted)
                     } else {
                         margin[k]
                     };
@@ -640,7 +648,9 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 for (k, &i) in listed.iter().enumerate() {
                     self.decide(h, i, demands[k], frame);
                 }
-                for &k in pairs {
+                // A pair whose parent was just proven wanted is left as it is, as judging it
+                // would (without geomorphs nothing blends back).
+                for &k in pairs.iter().filter(|&&k| !kept[k]) {
                     self.decide_pair(
                         h,
                         view,
