@@ -77,6 +77,13 @@ impl<const M: usize, I: SlotIndex> NodeMap<M, I> {
         self.len = 0;
     }
 
+    /// Empties the map and lends its whole table as scratch; [`NodeMap::reset`] clears it after.
+    pub fn scratch(&mut self) -> &mut [I; M] {
+        self.len = 0;
+        self.span = M as u32;
+        &mut self.table
+    }
+
     /// Entries the map takes at most (7/8 of its table).
     pub fn capacity(&self) -> usize {
         M / 8 * 7 + M % 8 * 7 / 8

@@ -86,6 +86,7 @@ pub(crate) mod expiry;
 mod fan;
 mod judge;
 pub(crate) mod margin;
+mod renumber;
 pub mod slot;
 pub(crate) mod split;
 mod store;

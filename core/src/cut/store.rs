@@ -220,6 +220,28 @@ impl<const V: usize, I: SlotIndex> Vertices<V, I> {
     pub fn pop(&mut self) {
         self.len = self.len.saturating_sub(1);
     }
+
+    /// Exchanges records `a` and `b` (both in range), references to them unchanged.
+    pub fn swap(&mut self, a: usize, b: usize) {
+        self.node.swap(a, b);
+        self.fan.swap(a, b);
+        self.degree.swap(a, b);
+        self.mate.swap(a, b);
+        self.tag.swap(a, b);
+        self.flags.swap(a, b);
+        self.digest.swap(a, b);
+    }
+
+    /// Renumbers every record's mate and fan triangle (`NIL` stays `NIL`).
+    pub fn renumber_links(&mut self, vertex: impl Fn(u32) -> u32, triangle: impl Fn(u32) -> u32) {
+        let n = self.len();
+        for m in &mut self.mate[..n] {
+            *m = I::store(vertex(m.load()));
+        }
+        for f in &mut self.fan[..n] {
+            *f = I::store(triangle(f.load()));
+        }
+    }
 }
 
 /// The triangle records.
@@ -330,6 +352,24 @@ impl<const F: usize, I: SlotIndex> Triangles<F, I> {
 
     pub fn pop(&mut self) {
         self.len = self.len.saturating_sub(1);
+    }
+
+    /// Exchanges records `f` and `g` (both in range), references to them unchanged.
+    pub fn swap(&mut self, f: usize, g: usize) {
+        self.corners.swap(f, g);
+        self.adj.swap(f, g);
+        self.id.swap(f, g);
+    }
+
+    /// Renumbers every record's corners and neighbours (`NIL` stays `NIL`).
+    pub fn renumber_links(&mut self, vertex: impl Fn(u32) -> u32, triangle: impl Fn(u32) -> u32) {
+        let n = self.len();
+        for c in self.corners[..n].iter_mut().flatten() {
+            *c = I::store(vertex(c.load()));
+        }
+        for a in self.adj[..n].iter_mut().flatten() {
+            *a = I::store(triangle(a.load()));
+        }
     }
 }
 

@@ -275,6 +275,71 @@ mod adapt {
         assert_eq!(first, run());
     }
 
+    /// Renumbering changes slots only: the same nodes, triangles and blended positions, and the
+    /// frames after it the same as without it (but for which restless vertices are asked), with
+    /// and without geomorphs; the vertices are in node order after it and the triangles in the
+    /// order of their first corner.
+    #[test]
+    fn renumbering_keeps_the_cut_and_the_frames_after_it() {
+        let bytes = sphere_bytes();
+        let h = HierarchyView::parse(&bytes).unwrap();
+        let policy = (Frustum, (BackFace, ScreenError::new(0.5)));
+        let (mut plain, mut renumbered): (Box<Mid>, Box<Mid>) = (Cut::boxed(), Cut::boxed());
+        let by_node = |cut: &Mid| {
+            let mut v: Vec<(u32, [u32; 3])> = cut
+                .nodes()
+                .iter()
+                .zip(positions(cut, &h))
+                .map(|(&n, p)| (n, p.map(f32::to_bits)))
+                .collect();
+            v.sort_unstable();
+            v
+        };
+        plain.reset(&h).unwrap();
+        renumbered.reset(&h).unwrap();
+        let mut renumbers = 0;
+        for i in 0..240 {
+            let frames = if (80..160).contains(&i) { 4 } else { 0 };
+            plain.set_geomorph_frames(frames);
+            renumbered.set_geomorph_frames(frames);
+            let view = orbit(i, 1.5 + 4.0 * libm::fabsf(libm::sinf(i as f32 * 0.05)));
+            let a = plain.adapt(&h, &view, &policy, &Budget::default());
+            let b = renumbered.adapt(&h, &view, &policy, &Budget::default());
+            // Restless vertices take turns by slot, so which are asked may differ.
+            let asked = |s: crate::adapt::FrameStats| crate::adapt::FrameStats {
+                settled: 0,
+                visited: 0,
+                ..s
+            };
+            assert_eq!(asked(a), asked(b), "frame {i}");
+            if i % 9 == 4 {
+                assert!(renumbered.renumber());
+                renumbers += 1;
+                renumbered
+                    .check(&h)
+                    .unwrap_or_else(|d| panic!("frame {i}: {d:?}"));
+                assert!(renumbered.nodes().windows(2).all(|w| w[0] < w[1]));
+                let t = renumbered.triangles();
+                let first = |k: usize| t[k].iter().map(|s| s.index()).min().unwrap_or(0);
+                assert!((1..t.len()).all(|k| first(k - 1) <= first(k)), "frame {i}");
+            }
+            assert_eq!(
+                node_triangles(&plain),
+                node_triangles(&renumbered),
+                "frame {i}"
+            );
+            assert_eq!(by_node(&plain), by_node(&renumbered), "frame {i}");
+        }
+        assert!(renumbers > 20);
+        // Without room for its scratch it refuses, and changes nothing.
+        let mut tight: Cut<64, 100, 16> = Cut::new();
+        tight.reset(&h).unwrap();
+        while tight.vertex_count() * 2 <= 100 && tight.refine_everything(&h) > 0 {}
+        let before = tight.nodes().to_vec();
+        assert!(!tight.renumber());
+        assert_eq!(tight.nodes(), &before[..]);
+    }
+
     #[test]
     fn the_budget_goes_where_the_error_is_largest() {
         let bytes = sphere_bytes();
