@@ -77,11 +77,13 @@ impl<const M: usize, I: SlotIndex> NodeMap<M, I> {
         self.len = 0;
     }
 
-    /// Empties the map and lends its whole table as scratch; [`NodeMap::reset`] clears it after.
-    pub fn scratch(&mut self) -> &mut [I; M] {
+    /// Empties the map and lends the first `len` entries of its table (at most `M`) as
+    /// scratch; [`NodeMap::reset`] clears them after.
+    pub fn scratch(&mut self, len: usize) -> &mut [I] {
+        let len = len.min(M);
         self.len = 0;
-        self.span = M as u32;
-        &mut self.table
+        self.span = self.span.max(len as u32);
+        &mut self.table[..len]
     }
 
     /// Entries the map takes at most (7/8 of its table).

@@ -49,13 +49,14 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
     /// assert!(cut.check(&h).is_ok());
     /// # }
     /// ```
+    #[inline(never)]
     pub fn renumber(&mut self) -> bool {
         let n = self.v.len();
         let nf = self.t.len();
         if n.saturating_mul(2) > F {
             return false;
         }
-        let scratch = self.map.scratch();
+        let scratch = self.map.scratch(2 * n);
         // Vertices: `order[k]` is the slot that becomes `k`, `to[s]` the slot `s` becomes.
         let (order, to) = scratch.split_at_mut(n);
         let to = &mut to[..n];
@@ -81,7 +82,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         }
         permute(to, |a, b| self.v.swap(a, b));
         // Triangles: dealt out vertex by vertex, each to its corner of least slot, in fan order.
-        let to = &mut self.map.scratch()[..nf];
+        let to = self.map.scratch(nf);
         to.iter_mut().for_each(|t| *t = I::store(NIL));
         let mut next = 0u32;
         for s in 0..n as u32 {
