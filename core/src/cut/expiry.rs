@@ -156,8 +156,9 @@ pub(crate) struct Motion {
     blends: bool,
     tick: u8,
     sparse: bool,
-    /// Eye units per unit of the planes' sway in the count (see [`SwayScale`]).
-    scale: f32,
+    /// Eye units per unit of the planes' sway in the count (see [`SwayScale`]), less one: zero
+    /// is a scale of 1, so that a zeroed cut (`Cut::new`, a `static` in `.bss`) is a new one.
+    scale_less_one: f32,
     /// The motion since the scale was last checked.
     seen: SwayScale,
     /// Whether this count has had its first check.
@@ -235,7 +236,7 @@ impl Motion {
         blends: false,
         tick: 0,
         sparse: false,
-        scale: 1.0,
+        scale_less_one: 0.0,
         seen: SwayScale::ZERO,
         checked: false,
     };
@@ -265,10 +266,11 @@ impl Motion {
             0.0
         };
         // The step as the count weighs it (see `SwayScale`).
+        let scale = self.scale_less_one + 1.0;
         let step = |scale: f32| moved.max(scale * swayed);
         let same =
             self.valid && envelope == self.envelope && t == self.threshold && blends == self.blends;
-        let continues = same && libm::ceilf(step(self.scale) / self.quantum) <= JUMP;
+        let continues = same && libm::ceilf(step(scale) / self.quantum) <= JUMP;
         if continues && envelope.frustum {
             self.seen.add(moved, swayed);
         }
@@ -278,15 +280,15 @@ impl Motion {
             } else {
                 SwayScale::FIRST
             };
-        let drifted = self.seen.ratio().filter(|&r| due && drifted(self.scale, r));
+        let drifted = self.seen.ratio().filter(|&r| due && drifted(scale, r));
         if due {
             self.seen = SwayScale::ZERO;
             self.checked = true;
         }
         let renew = if !continues || drifted.is_some() {
             self.now = 0;
-            if let Some(scale) = drifted {
-                self.scale = scale;
+            if let Some(r) = drifted {
+                self.scale_less_one = r - 1.0;
             }
             let q = model.1 / QUANTA_PER_RADIUS;
             // A degenerate model settles nothing (every margin is under an infinite quantum).
@@ -297,7 +299,7 @@ impl Motion {
             };
             Renew::Forget
         } else {
-            self.now += libm::ceilf(step(self.scale) / self.quantum) as u32;
+            self.now += libm::ceilf(step(scale) / self.quantum) as u32;
             if self.now >= REBASE {
                 self.now -= REBASE;
                 Renew::Rebase
@@ -305,7 +307,8 @@ impl Motion {
                 Renew::Keep
             }
         };
-        let step = step(self.scale);
+        let scale = self.scale_less_one + 1.0;
+        let step = step(scale);
         *self = Motion {
             valid: true,
             tick: self.tick.wrapping_add(1),
@@ -327,7 +330,7 @@ impl Motion {
                 self.quantum
             },
             quantum: self.quantum,
-            scale: self.scale,
+            scale,
             tick: u32::from(self.tick),
             sparse: self.sparse,
         })
@@ -490,11 +493,12 @@ mod tests {
         // becomes the measured ratio, about 2.
         let mut f = 0;
         while frame(&mut m, f).renew != Renew::Forget || f == 0 {
-            assert_eq!(m.scale, 1.0);
+            assert_eq!(m.scale_less_one + 1.0, 1.0);
             f += 1;
         }
         assert_eq!(f, u32::from(SwayScale::FIRST));
-        assert!((1.8..2.2).contains(&m.scale), "{}", m.scale);
+        let scale = m.scale_less_one + 1.0;
+        assert!((1.8..2.2).contains(&scale), "{scale}");
         // A vertex whose answer holds while the planes sway less than `room` is marked with
         // `room` counted at the scale; it stays settled no longer than the planes take to sway
         // that far, but about twice as long as under a scale of 1.
