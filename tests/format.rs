@@ -59,7 +59,8 @@ fn walk(view: &HierarchyView<'_>) {
     fly(view);
 }
 
-/// A small cut over whatever parsed: refinement, a few frames from around and inside, coarsening.
+/// A small cut over whatever parsed: refinement, a few frames from around and inside (its slots
+/// renumbered now and then), coarsening.
 /// Hostile files may be refused or leave the cut coarse, but nothing may panic.
 fn fly(view: &HierarchyView<'_>) {
     let mut cut = Cut::<512, 1024, 128>::boxed();
@@ -77,6 +78,9 @@ fn fly(view: &HierarchyView<'_>) {
             ..Budget::default()
         };
         let _ = cut.adapt(view, &v, &QRefine::new(0.5 + a), &budget);
+        if i % 2 == 1 {
+            let _ = cut.renumber();
+        }
     }
     for p in view.parent_nodes().take(2000) {
         let _ = cut.collapse(view, p);

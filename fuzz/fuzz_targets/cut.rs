@@ -1,5 +1,6 @@
 //! Hostile hierarchies into the runtime cut: whatever `HierarchyView::parse` accepts can be reset,
-//! refined, adapted over a few frames under a budget and coarsened without a panic.
+//! refined, adapted over a few frames under a budget (its slots renumbered now and then) and
+//! coarsened without a panic.
 //!
 //! Each input is tried with its checksum recomputed, so that mutations of valid files (the seeds
 //! in `seeds/hierarchy`) reach the cut.
@@ -36,6 +37,9 @@ fuzz_target!(|data: &[u8]| {
             ..Budget::default()
         };
         let _ = cut.adapt(&view, &v, &QRefine::new(0.25 + a), &budget);
+        if i % 2 == 1 {
+            let _ = cut.renumber();
+        }
     }
     for p in view.parent_nodes().take(512) {
         let _ = cut.collapse(&view, p);

@@ -344,9 +344,12 @@ impl Motion {
         self.sparse = settled.saturating_mul(8) < measured || skipped < measured;
     }
 
-    /// Forgets the marks (a new hierarchy, or a frame that did not mark).
+    /// Forgets the marks and the motion seen (a new hierarchy): the scale is checked again
+    /// [`SwayScale::FIRST`] frames on.
     pub fn clear(&mut self) {
         self.valid = false;
+        self.seen = SwayScale::ZERO;
+        self.checked = false;
     }
 
     /// Turns skipping on or off (it starts on).

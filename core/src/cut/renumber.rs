@@ -87,7 +87,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         let mut next = 0u32;
         for s in 0..n as u32 {
             around(&self.v, &self.t, s, |f| {
-                let first = self.t.at(f).into_iter().min() == Some(s);
+                let first = self.t.get(f).and_then(|t| t.into_iter().min()) == Some(s);
                 if let Some(t) = to.get_mut(f as usize).filter(|t| first && t.load() == NIL) {
                     *t = I::store(next);
                     next += 1;
