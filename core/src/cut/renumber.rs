@@ -13,7 +13,8 @@
 //! recommended `F = 2 V` has it).
 //!
 //! The cut stays the same cut: the same nodes and triangles, settled marks and geomorphs; only
-//! the slots change, and with them the order in which later frames meet vertices.
+//! the slots change, and with them the order in which later frames meet vertices (which a
+//! window of the active list, `Budget::max_visits`, and the restless vertices' turns follow).
 
 use super::fan::around;
 use super::slot::SlotIndex;
