@@ -204,6 +204,9 @@ impl Budget {
     }
 }
 
+/// Float rounding between the cut's bounds and the exact tests stays far below this.
+const SLACK: f32 = 1.0 + 1e-5;
+
 /// A pair's parent's error as the collapse candidates keep it: negative when culled, so that
 /// culled pairs collapse first and without a blend.
 #[inline]
@@ -314,9 +317,9 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             threshold: self.threshold,
             ops: 0,
         };
-        self.evaluate(h, view, policy, budget.max_visits, &mut frame);
+        let settling = self.evaluate(h, view, policy, budget.max_visits, &mut frame);
         self.coarsen(h, view, policy, budget, &mut frame);
-        self.refine(h, view, policy, budget, &mut frame);
+        self.refine(h, view, policy, budget, settling.as_ref(), &mut frame);
         self.enforce_max(h, view, policy, budget, &mut frame.stats);
         // A cut that shrank gets a smaller node map (faster lookups).
         self.respan_map(self.v.len());
@@ -357,7 +360,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         policy: &P,
         max_visits: u32,
         frame: &mut Frame,
-    ) {
+    ) -> Option<Settling> {
         self.candidates.clear();
         self.pairs.clear();
         // Most vertices are far from wanting a split: the policy's envelope and the cut's digest
@@ -367,8 +370,6 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         // geomorph) are listed and read in batches: first every record the batch needs is
         // touched (independent loads the processor overlaps), then decoded.
         const BATCH: usize = 32;
-        // Float rounding between the bound and the exact test stays far below this.
-        const SLACK: f32 = 1.0 + 1e-5;
         let t = frame.threshold;
         let blends = self.geomorph_frames > 0;
         // No geomorph runs or can start: no decision reaches a vertex but its own and its
@@ -674,6 +675,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         frame.stats.visited += visited;
         self.motion
             .tally(tally.measured, tally.settled, frame.stats.settled);
+        settling
     }
 
     /// Marks slot `i` as the margin `margin` of its answers says (see [`Settling::mark`]), and
@@ -984,10 +986,17 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         view: &View,
         policy: &P,
         budget: &Budget,
+        settling: Option<&Settling>,
         frame: &mut Frame,
     ) {
         let t = frame.threshold;
         let frames = self.geomorph_frames;
+        // A leaf a split makes is marked where it is judged, as next frame's walk would mark
+        // it (without geomorphs, as there): a leaf's own answer never expires, so only a first
+        // child's pair has a margin to measure (new parents are left to the walk: their margins
+        // are mostly under a step, just past the threshold that split their parent).
+        let settling = settling.filter(|_| frames == 0 && self.blends.len() == 0);
+        let sphere_only = reads_spheres(policy);
         let mut traded = 0usize;
         let mut listed = false;
         while let Some((bits, v)) = self.candidates.heap_pop() {
@@ -1055,6 +1064,20 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                         && self.candidates.heap_push((d.error.to_bits(), c)).is_err()
                     {
                         frame.stats.queue_overflow = true;
+                    }
+                    if let Some(m) = settling.filter(|_| !record.is_parent()) {
+                        let i = cs as usize;
+                        let pair = self.v.flags[i] & FIRST_CHILD != 0 && self.v.mate(i) != NIL;
+                        let room = match h.parent_record(c).filter(|_| pair) {
+                            Some((_, r)) => {
+                                let p = bounds_read(h, r, sphere_only);
+                                m.margins
+                                    .wanted(&p, (t, SLACK), (m.step, 4))
+                                    .within(m.scale)
+                            }
+                            None => f32::INFINITY,
+                        };
+                        self.v.mark(i, m.mark(room));
                     }
                 }
             }
