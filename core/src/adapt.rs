@@ -624,8 +624,6 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             core::hint::black_box(touched);
             for &k in pairs {
                 parent_bounds[k] = bounds_read(h, records[k], sphere_only);
-            }
-            for &k in pairs {
                 kept[k] = false;
             }
             if let Some(m) = &settling {
@@ -1067,10 +1065,9 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                     }
                     if let Some(m) = settling.filter(|_| !record.is_parent()) {
                         let i = cs as usize;
-                        let pair = self.v.flags[i] & FIRST_CHILD != 0 && self.v.mate(i) != NIL;
-                        let room = match h.parent_record(c).filter(|_| pair) {
-                            Some((_, r)) => {
-                                let p = bounds_read(h, r, sphere_only);
+                        let room = match self.pair_parent(h, i) {
+                            Some(p) => {
+                                let p = bounds_read(h, h.record(p), sphere_only);
                                 m.margins
                                     .wanted(&p, (t, SLACK), (m.step, 4))
                                     .within(m.scale)

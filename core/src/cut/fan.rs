@@ -8,7 +8,7 @@
 
 use super::slot::SlotIndex;
 use super::store::{Triangles, Vertices};
-use super::{prev3, Cut, NIL};
+use super::{Cut, NIL};
 
 /// Longest fan walked around one vertex; a hierarchy with larger vertex degrees is refused
 /// rather than walked forever.
@@ -46,15 +46,13 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
     /// The triangle after `f` going counter-clockwise around vertex `v` (`NIL` at a border).
     #[inline]
     pub(crate) fn ccw(&self, f: u32, v: u32) -> Option<u32> {
-        let k = self.t.corner_of(f, v)?;
-        Some(self.t.adj_at(f, prev3(k)))
+        self.t.ccw(f, v)
     }
 
     /// The triangle before `f` going counter-clockwise around `v` (`NIL` at a border).
     #[inline]
     pub(crate) fn cw(&self, f: u32, v: u32) -> Option<u32> {
-        let k = self.t.corner_of(f, v)?;
-        Some(self.t.adj_at(f, k))
+        self.t.cw(f, v)
     }
 
     /// Collects `v`'s triangles into `out` and says whether the walk found every triangle that
@@ -130,29 +128,21 @@ pub(crate) fn around<const V: usize, const F: usize, I: SlotIndex>(
     if start == NIL {
         return;
     }
-    // Counter-clockwise around `v` across the edge before its corner; clockwise across the
-    // edge from it.
-    let ccw = |f: u32| {
-        triangles
-            .corner_of(f, v)
-            .map(|k| triangles.adj_at(f, prev3(k)))
-    };
-    let cw = |f: u32| triangles.corner_of(f, v).map(|k| triangles.adj_at(f, k));
     let mut f = start;
     while left > 0 {
         visit(f);
         left -= 1;
-        match ccw(f) {
+        match triangles.ccw(f, v) {
             Some(g) if g == start => return,
             Some(g) if g != NIL => f = g,
             _ => break,
         }
     }
     // A border: the rest lies clockwise of the start.
-    let mut g = cw(start).unwrap_or(NIL);
+    let mut g = triangles.cw(start, v).unwrap_or(NIL);
     while g != NIL && left > 0 {
         visit(g);
         left -= 1;
-        g = cw(g).unwrap_or(NIL);
+        g = triangles.cw(g, v).unwrap_or(NIL);
     }
 }

@@ -513,9 +513,13 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
 
     /// Rebuilds the node map over a span fit for `entries` active vertices, if it needs another.
     pub(crate) fn respan_map(&mut self, entries: usize) {
-        if !self.map.should_resize(entries) {
-            return;
+        if self.map.should_resize(entries) {
+            self.rebuild_map(entries);
         }
+    }
+
+    /// Empties the node map, sizes it for `entries` entries and enters every active vertex.
+    pub(crate) fn rebuild_map(&mut self, entries: usize) {
         self.map.reset(NodeMap::<F, I>::span_for(entries));
         for s in 0..self.v.len() as u32 {
             self.map.insert(s, self.v.nodes());

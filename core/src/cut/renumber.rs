@@ -76,8 +76,8 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 to.get(s as usize).map_or(NIL, |t| t.load())
             }
         };
-        self.t.renumber_links(vertex, |f| f);
-        self.v.renumber_links(vertex, |f| f);
+        self.t.renumber_corners(vertex);
+        self.v.renumber_mates(vertex);
         for b in self.blends.as_mut_slice() {
             b.slot = vertex(b.slot);
         }
@@ -107,18 +107,15 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 to.get(f as usize).map_or(NIL, |t| t.load())
             }
         };
-        self.t.renumber_links(|s| s, triangle);
-        self.v.renumber_links(|s| s, triangle);
+        self.t.renumber_neighbours(triangle);
+        self.v.renumber_fans(triangle);
         permute(to, |f, g| self.t.swap(f, g));
         // The per-frame lists name slots: they start empty each frame anyway.
         self.stack.clear();
         self.candidates.clear();
         self.pairs.clear();
         self.walk = 0;
-        self.map.reset(super::NodeMap::<F, I>::span_for(n));
-        for s in 0..n as u32 {
-            self.map.insert(s, self.v.nodes());
-        }
+        self.rebuild_map(n);
         true
     }
 }

@@ -14,7 +14,7 @@
 
 use super::expiry::Mark;
 use super::slot::{load3, store3, SlotIndex};
-use super::{BLENDING, COLLAPSING, NIL, RESTLESS, SETTLED};
+use super::{prev3, BLENDING, COLLAPSING, NIL, RESTLESS, SETTLED};
 use crate::format::Digest;
 
 /// The vertex records.
@@ -232,12 +232,17 @@ impl<const V: usize, I: SlotIndex> Vertices<V, I> {
         self.digest.swap(a, b);
     }
 
-    /// Renumbers every record's mate and fan triangle (`NIL` stays `NIL`).
-    pub fn renumber_links(&mut self, vertex: impl Fn(u32) -> u32, triangle: impl Fn(u32) -> u32) {
+    /// Renumbers every record's mate by `vertex`.
+    pub fn renumber_mates(&mut self, vertex: impl Fn(u32) -> u32) {
         let n = self.len();
         for m in &mut self.mate[..n] {
             *m = I::store(vertex(m.load()));
         }
+    }
+
+    /// Renumbers every record's fan triangle by `triangle`.
+    pub fn renumber_fans(&mut self, triangle: impl Fn(u32) -> u32) {
+        let n = self.len();
         for f in &mut self.fan[..n] {
             *f = I::store(triangle(f.load()));
         }
@@ -354,6 +359,21 @@ impl<const F: usize, I: SlotIndex> Triangles<F, I> {
         self.len = self.len.saturating_sub(1);
     }
 
+    /// The triangle after `f` going counter-clockwise around vertex `v` (`NIL` at a border;
+    /// `None` when `f` is not a triangle of `v`).
+    #[inline]
+    pub fn ccw(&self, f: u32, v: u32) -> Option<u32> {
+        let k = self.corner_of(f, v)?;
+        Some(self.adj_at(f, prev3(k)))
+    }
+
+    /// The triangle before `f` going counter-clockwise around `v` (as [`Triangles::ccw`]).
+    #[inline]
+    pub fn cw(&self, f: u32, v: u32) -> Option<u32> {
+        let k = self.corner_of(f, v)?;
+        Some(self.adj_at(f, k))
+    }
+
     /// Exchanges records `f` and `g` (both in range), references to them unchanged.
     pub fn swap(&mut self, f: usize, g: usize) {
         self.corners.swap(f, g);
@@ -361,12 +381,17 @@ impl<const F: usize, I: SlotIndex> Triangles<F, I> {
         self.id.swap(f, g);
     }
 
-    /// Renumbers every record's corners and neighbours (`NIL` stays `NIL`).
-    pub fn renumber_links(&mut self, vertex: impl Fn(u32) -> u32, triangle: impl Fn(u32) -> u32) {
+    /// Renumbers every record's corners by `vertex`.
+    pub fn renumber_corners(&mut self, vertex: impl Fn(u32) -> u32) {
         let n = self.len();
         for c in self.corners[..n].iter_mut().flatten() {
             *c = I::store(vertex(c.load()));
         }
+    }
+
+    /// Renumbers every record's neighbours by `triangle`.
+    pub fn renumber_neighbours(&mut self, triangle: impl Fn(u32) -> u32) {
+        let n = self.len();
         for a in self.adj[..n].iter_mut().flatten() {
             *a = I::store(triangle(a.load()));
         }
