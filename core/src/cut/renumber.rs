@@ -69,13 +69,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         for (k, o) in order.iter().enumerate() {
             to[o.index()] = I::store(k as u32);
         }
-        let vertex = |s: u32| {
-            if s == NIL {
-                NIL
-            } else {
-                to.get(s as usize).map_or(NIL, |t| t.load())
-            }
-        };
+        let vertex = |s: u32| through(to, s);
         self.t.renumber_corners(vertex);
         self.v.renumber_mates(vertex);
         for b in self.blends.as_mut_slice() {
@@ -100,13 +94,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             *t = I::store(next);
             next += 1;
         }
-        let triangle = |f: u32| {
-            if f == NIL {
-                NIL
-            } else {
-                to.get(f as usize).map_or(NIL, |t| t.load())
-            }
-        };
+        let triangle = |f: u32| through(to, f);
         self.t.renumber_neighbours(triangle);
         self.v.renumber_fans(triangle);
         permute(to, |f, g| self.t.swap(f, g));
@@ -117,6 +105,15 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         self.walk = 0;
         self.rebuild_map(n);
         true
+    }
+}
+
+/// Where `to` sends `x` (`NIL` stays `NIL`, and so does anything out of its range).
+fn through<I: SlotIndex>(to: &[I], x: u32) -> u32 {
+    if x == NIL {
+        NIL
+    } else {
+        to.get(x as usize).map_or(NIL, |t| t.load())
     }
 }
 
