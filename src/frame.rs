@@ -69,7 +69,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex + VertexIndex>
         self.cut.triangles()
     }
 
-    #[inline]
+    #[inline(always)]
     fn vertex(&self, i: usize) -> SourceVertex {
         let v = self.cut.vertex(self.h, i);
         SourceVertex {

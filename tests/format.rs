@@ -35,6 +35,11 @@ fn walk(view: &HierarchyView<'_>) {
         assert_eq!(n.parent == NONE, i < view.roots());
         assert!(n.radius >= 0.0 && n.position.iter().all(|c| c.is_finite()));
     }
+    // What drawing reads of a node is what the whole record says, past the last node too.
+    for i in (0..view.nodes()).chain([view.nodes(), view.nodes() + 7, NONE]) {
+        let n = view.node(i);
+        assert_eq!(view.vertex(i), (n.position, n.normal, n.color), "node {i}");
+    }
     let mut parents = 0;
     for p in view.parent_nodes() {
         parents += 1;

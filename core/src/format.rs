@@ -1146,8 +1146,11 @@ impl<'a> HierarchyView<'a> {
     #[inline]
     #[must_use]
     pub fn vertex(&self, i: u32) -> ([f32; 3], [f32; 3], [u8; 3]) {
-        let (position, normal, _) = self.node_record(i);
-        (position, normal, self.color(i))
+        // Position and normal lead every record, a leaf's and a parent's alike (out of range:
+        // zeros, as `record_bytes` reads it).
+        let r: [u8; 8] = self.fixed(self.record(i).offset).unwrap_or([0; 8]);
+        let normal = oct_decode(r[6] as i8, r[7] as i8);
+        (self.model.position(&r), normal, self.color(i))
     }
 
     /// Node `i`'s colour: white without colours, black out of range.

@@ -61,6 +61,8 @@ fn lerp3(a: [f32; 3], b: [f32; 3], s: f32) -> [f32; 3] {
 }
 
 impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, I> {
+    /// Node `node` as drawn when no geomorph moves it.
+    #[inline(always)]
     fn node_out(&self, h: &HierarchyView<'_>, node: u32) -> VertexOut {
         let (position, normal, color) = h.vertex(node);
         VertexOut {
@@ -77,6 +79,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
     /// between where it started and where it goes while a geomorph runs. (Slots out of range
     /// read as the default.)
     #[must_use]
+    #[inline(always)]
     pub fn vertex(&self, h: &HierarchyView<'_>, s: usize) -> VertexOut {
         let Some(&node) = self.v.nodes().get(s) else {
             return VertexOut::default();
