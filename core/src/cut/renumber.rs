@@ -7,16 +7,16 @@
 //! vertices, and a fan walk steps between distant triangles. [`Cut::renumber`] puts the vertices
 //! in the order of their nodes (so their records are read from the file front to back: a
 //! parent's id is below its children's, and the builder numbers nodes along the surface where
-//! its input does) and the triangles in the order of their first corner's slot, walking each
-//! vertex's fan. It needs no memory of its own: the node map lends its table as scratch and is
-//! rebuilt after, which is why it needs room for two entries per vertex slot there (the
-//! recommended `F = 2 V` has it).
+//! its input does) and the triangles in the order of their first corner's slot (counted out,
+//! with no fan walk: walks step between distant triangles one dependent read after another).
+//! It needs no memory of its own: the node map lends its table as scratch and is rebuilt
+//! after, which is why it needs room for two entries per vertex slot there (the recommended
+//! `F = 2 V` has it), and the vertices' fan entries count the triangles and are set again.
 //!
 //! The cut stays the same cut: the same nodes and triangles, settled marks and geomorphs; only
 //! the slots change, and with them the order in which later frames meet vertices (which a
 //! window of the active list, `Budget::max_visits`, and the restless vertices' turns follow).
 
-use super::fan::around;
 use super::slot::SlotIndex;
 use super::{Cut, NIL};
 
@@ -76,28 +76,59 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             b.slot = vertex(b.slot);
         }
         permute(to, |a, b| self.v.swap(a, b));
-        // Triangles: dealt out vertex by vertex, each to its corner of least slot, in fan order.
+        // Triangles: counted out by their corner of least slot, in their old order among those
+        // of one vertex (a counting sort whose counters are the vertices' fan entries, which
+        // are set again after). A triangle without such a corner (only in a cut a crafted file
+        // broke) goes after the others, in its order.
         let to = self.map.scratch(nf);
-        to.iter_mut().for_each(|t| *t = I::store(NIL));
-        let mut next = 0u32;
-        for s in 0..n as u32 {
-            around(&self.v, &self.t, s, |f| {
-                let first = self.t.get(f).and_then(|t| t.into_iter().min()) == Some(s);
-                if let Some(t) = to.get_mut(f as usize).filter(|t| first && t.load() == NIL) {
-                    *t = I::store(next);
-                    next += 1;
+        let counts = self.v.fans_mut();
+        let least = |t: Option<[u32; 3]>| {
+            t.and_then(|t| t.into_iter().min())
+                .filter(|&m| (m as usize) < n)
+        };
+        counts.iter_mut().for_each(|c| *c = I::store(0));
+        let mut rest = 0u32;
+        for f in 0..nf as u32 {
+            match least(self.t.get(f)) {
+                Some(m) => counts[m as usize] = I::store(counts[m as usize].load() + 1),
+                None => rest += 1,
+            }
+        }
+        let mut sum = 0u32;
+        for c in counts.iter_mut() {
+            let k = c.load();
+            *c = I::store(sum);
+            sum += k;
+        }
+        let mut after = sum;
+        for (f, t) in (0..nf as u32).zip(to.iter_mut()) {
+            let place = match least(self.t.get(f)) {
+                Some(m) => {
+                    let p = counts[m as usize].load();
+                    counts[m as usize] = I::store(p + 1);
+                    p
                 }
-            });
+                None => {
+                    after += 1;
+                    after - 1
+                }
+            };
+            *t = I::store(place);
         }
-        // A triangle no fan reached (only in a cut a crafted file broke) keeps its order after.
-        for t in to.iter_mut().filter(|t| t.load() == NIL) {
-            *t = I::store(next);
-            next += 1;
-        }
+        debug_assert_eq!(after, sum + rest);
         let triangle = |f: u32| through(to, f);
         self.t.renumber_neighbours(triangle);
-        self.v.renumber_fans(triangle);
         permute(to, |f, g| self.t.swap(f, g));
+        // Each vertex's fan starts at its first triangle, as `reset` makes it.
+        let fans = self.v.fans_mut();
+        fans.iter_mut().for_each(|f| *f = I::store(NIL));
+        for f in (0..nf as u32).rev() {
+            for c in self.t.at(f) {
+                if let Some(x) = fans.get_mut(c as usize) {
+                    *x = I::store(f);
+                }
+            }
+        }
         // The per-frame lists name slots: they start empty each frame anyway.
         self.stack.clear();
         self.candidates.clear();

@@ -240,12 +240,9 @@ impl<const V: usize, I: SlotIndex> Vertices<V, I> {
         }
     }
 
-    /// Renumbers every record's fan triangle by `triangle`.
-    pub fn renumber_fans(&mut self, triangle: impl Fn(u32) -> u32) {
-        let n = self.len();
-        for f in &mut self.fan[..n] {
-            *f = I::store(triangle(f.load()));
-        }
+    /// The active records' fan entries, to be set anew.
+    pub fn fans_mut(&mut self) -> &mut [I] {
+        &mut self.fan[..self.len as usize]
     }
 }
 
