@@ -75,7 +75,9 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         for b in self.blends.as_mut_slice() {
             b.slot = vertex(b.slot);
         }
-        permute(to, |a, b| self.v.swap(a, b));
+        if !self.v.scatter(to) {
+            permute(to, |a, b| self.v.swap(a, b));
+        }
         // Triangles: counted out by their corner of least slot, in their old order among those
         // of one vertex (a counting sort whose counters are the vertices' fan entries, which
         // are set again after). A triangle without such a corner (only in a cut a crafted file
@@ -118,7 +120,9 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         debug_assert_eq!(after, sum + rest);
         let triangle = |f: u32| through(to, f);
         self.t.renumber_neighbours(triangle);
-        permute(to, |f, g| self.t.swap(f, g));
+        if !self.t.scatter(to) {
+            permute(to, |f, g| self.t.swap(f, g));
+        }
         // Each vertex's fan starts at its first triangle, as `reset` makes it.
         let fans = self.v.fans_mut();
         fans.iter_mut().for_each(|f| *f = I::store(NIL));
@@ -145,6 +149,22 @@ fn through<I: SlotIndex>(to: &[I], x: u32) -> u32 {
         NIL
     } else {
         to.get(x as usize).map_or(NIL, |t| t.load())
+    }
+}
+
+/// Moves `a[s]` to `a[to[s]]` for every `s` below `to.len()`, through the entries after them
+/// (`a` at least twice as long as `to`, which must be a permutation): the reads and writes are
+/// independent of each other, where exchanges along a cycle wait for one another.
+pub(super) fn scatter<T: Copy, I: SlotIndex>(a: &mut [T], to: &[I]) {
+    let n = to.len();
+    let (low, high) = a.split_at_mut(n);
+    for (x, t) in low.iter().zip(to) {
+        if let Some(y) = high.get_mut(t.index()) {
+            *y = *x;
+        }
+    }
+    if let Some(high) = high.get(..n) {
+        low.copy_from_slice(high);
     }
 }
 

@@ -13,6 +13,7 @@
 //! (across edges `t[k] -> t[k + 1]`) and its id in the hierarchy's numbering.
 
 use super::expiry::Mark;
+use super::renumber::scatter;
 use super::slot::{load3, store3, SlotIndex};
 use super::{prev3, BLENDING, COLLAPSING, NIL, RESTLESS, SETTLED};
 use crate::format::Digest;
@@ -232,6 +233,22 @@ impl<const V: usize, I: SlotIndex> Vertices<V, I> {
         self.digest.swap(a, b);
     }
 
+    /// Moves every record `s` to `to[s]` (a permutation of the active records) through the free
+    /// records after them; `false`, with nothing moved, when fewer are free than active.
+    pub fn scatter(&mut self, to: &[I]) -> bool {
+        if to.len() != self.len() || 2 * self.len() > V {
+            return false;
+        }
+        scatter(&mut self.node, to);
+        scatter(&mut self.fan, to);
+        scatter(&mut self.degree, to);
+        scatter(&mut self.mate, to);
+        scatter(&mut self.tag, to);
+        scatter(&mut self.flags, to);
+        scatter(&mut self.digest, to);
+        true
+    }
+
     /// Renumbers every record's mate by `vertex`.
     pub fn renumber_mates(&mut self, vertex: impl Fn(u32) -> u32) {
         let n = self.len();
@@ -376,6 +393,17 @@ impl<const F: usize, I: SlotIndex> Triangles<F, I> {
         self.corners.swap(f, g);
         self.adj.swap(f, g);
         self.id.swap(f, g);
+    }
+
+    /// Moves every record `f` to `to[f]` as [`Vertices::scatter`] does.
+    pub fn scatter(&mut self, to: &[I]) -> bool {
+        if to.len() != self.len() || 2 * self.len() > F {
+            return false;
+        }
+        scatter(&mut self.corners, to);
+        scatter(&mut self.adj, to);
+        scatter(&mut self.id, to);
+        true
     }
 
     /// Renumbers every record's corners by `vertex`.
