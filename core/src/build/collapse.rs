@@ -7,7 +7,6 @@
 //! collapse are pushed again with fresh costs, which keeps the whole build at O(n log n) for
 //! meshes of bounded vertex degree.
 
-use alloc::collections::BTreeMap;
 use alloc::vec;
 use alloc::vec::Vec;
 
@@ -15,6 +14,7 @@ use super::closest::Surface;
 use super::flatten::{flatten, PlanarCollapse};
 use super::quadric::{place, Quadric};
 use super::queue::CostQueue;
+use super::rejected::Rejected;
 use super::vec3::{add, cross, dot, from_f32, len, normalize, scale, sub, Vec3d};
 use super::{BuildOptions, Cost, ErrorBound, InputMesh, Placement, NONE};
 
@@ -60,9 +60,8 @@ pub(crate) struct Engine<'o> {
     /// [`CostQueue::pushes`] at the queue's last purge of merged vertices' entries.
     purged_at: u64,
     deferred: Vec<(u32, u32)>,
-    /// Edges found illegal, by endpoint: retried when a collapse changes that endpoint's ring
-    /// (a map, since few vertices have any).
-    rejected: BTreeMap<u32, Vec<u32>>,
+    /// Edges found illegal, by endpoint: retried when a collapse changes that endpoint's ring.
+    rejected: Rejected,
     pub collapses: Vec<Collapse>,
     /// For error bounds measured as residuals ([`ErrorBound::Spheroid`], [`ErrorBound::Hoppe`]):
     /// the triangles around each collapse's new vertex as it made them, collapse `k`'s at
@@ -81,6 +80,9 @@ pub(crate) struct Engine<'o> {
     /// The remesher's border rules ([`Engine::keep_borders`]): which vertices sit on a corner of
     /// the input's border, where it turns by more than 30 degrees. Empty: no such rules.
     pub corners: Vec<bool>,
+    /// Where a collapse gathers its new vertex's faces and ring.
+    scratch_faces: Vec<u32>,
+    scratch_ring: Vec<u32>,
 }
 
 /// Room the cost queue keeps for a collapse's pushes (the new vertex's edges, and retries).
@@ -108,6 +110,14 @@ pub(crate) fn kept(opts: &BuildOptions, v: Vec3d, children: [Vec3d; 2]) -> Optio
     (opts.placement == Placement::Endpoint)
         .then(|| children.iter().position(|&c| c == v))
         .flatten()
+}
+
+/// `items` in `list`'s allocation, grown to their exact length if it is too small.
+fn exactly(mut list: Vec<u32>, items: &[u32]) -> Vec<u32> {
+    list.clear();
+    list.reserve_exact(items.len());
+    list.extend_from_slice(items);
+    list
 }
 
 fn face_normal(p: &[Vec3d], f: [u32; 3]) -> Vec3d {
@@ -183,7 +193,7 @@ impl<'o> Engine<'o> {
             queue: CostQueue::default(),
             purged_at: 0,
             deferred: Vec::new(),
-            rejected: BTreeMap::new(),
+            rejected: Rejected::with_ids(2 * n),
             collapses: Vec::new(),
             fans: Vec::new(),
             fan_ends: Vec::new(),
@@ -192,6 +202,8 @@ impl<'o> Engine<'o> {
             planar: None,
             min_shape: 0.0,
             corners: Vec::new(),
+            scratch_faces: Vec::new(),
+            scratch_ring: Vec::new(),
         };
         e.alive_count = e.alive.iter().filter(|&&a| a).count();
         // Every collapse makes one vertex id and at most n - 1 are made: the per-id arrays are
@@ -221,7 +233,8 @@ impl<'o> Engine<'o> {
         // Room for half as many again as the edges: the bunny's queue peaks at a third more.
         e.queue.reserve(edges + edges / 2);
         for v in 0..n as u32 {
-            for x in e.vverts[v as usize].clone() {
+            for k in 0..e.vverts[v as usize].len() {
+                let x = e.vverts[v as usize][k];
                 if v < x {
                     e.push(v, x);
                 }
@@ -237,7 +250,7 @@ impl<'o> Engine<'o> {
     pub fn release_work(&mut self) {
         self.queue = CostQueue::default();
         self.deferred = Vec::new();
-        self.rejected = BTreeMap::new();
+        self.rejected = Rejected::default();
         self.vfaces = Vec::new();
         self.vverts = Vec::new();
         self.quadric = Vec::new();
@@ -246,6 +259,8 @@ impl<'o> Engine<'o> {
         self.marked = Vec::new();
         self.alive = Vec::new();
         self.surface = None;
+        self.scratch_faces = Vec::new();
+        self.scratch_ring = Vec::new();
     }
 
     /// Vertex `v`'s colour in `0..=1` (black when the mesh has none).
@@ -398,15 +413,22 @@ impl<'o> Engine<'o> {
             }
         }
         let (na, nb) = (self.neighbours(a), self.neighbours(b));
-        // Link condition: the common neighbours are exactly the wings.
-        let common: Vec<u32> = na
-            .iter()
-            .copied()
-            .filter(|x| nb.binary_search(x).is_ok())
-            .collect();
-        let mut w: Vec<u32> = wings.iter().copied().filter(|&x| x != NONE).collect();
-        w.sort_unstable();
-        if common != w {
+        // Link condition: the common neighbours are exactly the wings (both rings are sorted,
+        // so one merge finds them).
+        let w = wings.map(|x| (x != NONE).then_some(x));
+        let mut common = 0;
+        let (mut i, mut j) = (0, 0);
+        while let (Some(&x), Some(&y)) = (na.get(i), nb.get(j)) {
+            if x == y {
+                if !w.contains(&Some(x)) {
+                    return Ok(false);
+                }
+                common += 1;
+            }
+            i += usize::from(x <= y);
+            j += usize::from(y <= x);
+        }
+        if common != w.iter().flatten().count() || (w[0].is_some() && w[0] == w[1]) {
             return Ok(false);
         }
         let edge_on_border = count == 1;
@@ -435,7 +457,7 @@ impl<'o> Engine<'o> {
         }
         // Degrees: the merged vertex and the wings keep enough neighbours (this also stops a
         // closed component from shrinking below a tetrahedron).
-        let degree_p = na.len() + nb.len() - 2 - common.len();
+        let degree_p = na.len() + nb.len() - 2 - common;
         let border_p = ba || bb;
         // Under the remesher's border rules only a corner may be left as an ear.
         let ruled = !self.corners.is_empty();
@@ -444,7 +466,7 @@ impl<'o> Engine<'o> {
         if degree_p < if border_p { 2 + straight_p } else { 3 } {
             return Ok(false);
         }
-        for &x in &w {
+        for x in w.into_iter().flatten() {
             let ring = self.neighbours(x);
             let min = if border(x, ring) { 3 + straight(x) } else { 4 };
             if ring.len() < min {
@@ -524,8 +546,7 @@ impl<'o> Engine<'o> {
                     return true;
                 }
                 Ok(false) => {
-                    self.rejected.entry(a).or_default().push(b);
-                    self.rejected.entry(b).or_default().push(a);
+                    self.rejected.add(a, b);
                 }
                 Err(()) => self.deferred.push((a, b)),
             }
@@ -602,10 +623,16 @@ impl<'o> Engine<'o> {
             self.corners.push(corner);
         }
 
-        let mut pf = Vec::new();
-        for s in [a, b] {
-            let slot = self.at(s);
-            for f in core::mem::take(&mut self.vfaces[slot]) {
+        // The lists of p are built in scratch buffers and stored at their exact length in the
+        // allocations of a's lists (grown by pushing they held up to twice the room).
+        let mut pf = core::mem::take(&mut self.scratch_faces);
+        pf.clear();
+        let (own_faces, b_faces) = (
+            core::mem::take(&mut self.vfaces[sa]),
+            core::mem::take(&mut self.vfaces[sb]),
+        );
+        for (s, list) in [(a, &own_faces), (b, &b_faces)] {
+            for &f in list {
                 let t = &mut self.faces[f as usize];
                 if t.contains(&a) && t.contains(&b) {
                     if self.face_alive[f as usize] {
@@ -641,7 +668,8 @@ impl<'o> Engine<'o> {
             self.fans.extend(pf.iter().map(|&f| self.faces[f as usize]));
             self.fan_ends.push(self.fans.len() as u32);
         }
-        self.vfaces[sa] = pf;
+        self.vfaces[sa] = exactly(own_faces, &pf);
+        self.scratch_faces = pf;
         self.alive[ia] = false;
         self.alive[ib] = false;
         self.alive.push(true);
@@ -653,12 +681,14 @@ impl<'o> Engine<'o> {
             faces,
             neighbours,
         });
-        self.rejected.remove(&a);
-        self.rejected.remove(&b);
+        self.rejected.take(a);
+        self.rejected.take(b);
         // The ring of p: both rings but a and b. Its members swap a and b for p, which as the
         // newest vertex goes last and keeps their rings sorted.
-        let mut ring: Vec<u32> = core::mem::take(&mut self.vverts[sa]);
-        ring.extend(core::mem::take(&mut self.vverts[sb]));
+        let mut ring = core::mem::take(&mut self.scratch_ring);
+        ring.clear();
+        ring.extend_from_slice(&self.vverts[sa]);
+        ring.extend_from_slice(&core::mem::take(&mut self.vverts[sb]));
         ring.retain(|&x| x != a && x != b);
         ring.sort_unstable();
         ring.dedup();
@@ -668,24 +698,21 @@ impl<'o> Engine<'o> {
             r.retain(|&y| y != a && y != b);
             r.push(p);
         }
-        self.vverts[sa] = ring.clone();
+        self.vverts[sa] = exactly(core::mem::take(&mut self.vverts[sa]), &ring);
+        self.scratch_ring = ring;
         // Fresh costs for the edges of p (no other edge's cost changed); edges around it that were
         // illegal may have become legal.
-        for &x in &ring {
+        for k in 0..self.vverts[sa].len() {
+            let x = self.vverts[sa][k];
             self.push(p, x);
-            let mut retry = self.rejected.remove(&x).unwrap_or_default();
+            let mut retry = self.rejected.take(x);
             retry.sort_unstable();
             retry.dedup();
             for y in retry {
                 if self.alive[y as usize] {
                     // Out of y's list too, or every retry would push the edge once more per
                     // endpoint and the copies would double with each rejection.
-                    if let Some(list) = self.rejected.get_mut(&y) {
-                        list.retain(|&z| z != x);
-                        if list.is_empty() {
-                            self.rejected.remove(&y);
-                        }
-                    }
+                    self.rejected.drop_from(y, x);
                     self.push(x, y);
                 }
             }

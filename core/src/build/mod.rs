@@ -47,6 +47,7 @@ pub(crate) mod flatten;
 mod input;
 mod quadric;
 mod queue;
+mod rejected;
 pub(crate) mod vec3;
 mod write;
 
