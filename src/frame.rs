@@ -15,7 +15,7 @@ use vdlod_core::policy::Policy;
 use vdlod_raster::texture::Texture;
 use vdlod_raster::{
     shade, Depth, DrawError, DrawParams, DrawStats, Light, MeshSource, Pixel, ShadedVertex,
-    Shading, SourceVertex, Target, TargetError, Uv, VertexIndex, Window,
+    Shading, SourceVertex, Target, TargetError, Uv, VertexBatch, VertexIndex, Window, BATCH,
 };
 
 use crate::camera::{Camera, CameraError};
@@ -69,7 +69,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex + VertexIndex>
         self.cut.triangles()
     }
 
-    #[inline(always)]
+    #[inline]
     fn vertex(&self, i: usize) -> SourceVertex {
         let v = self.cut.vertex(self.h, i);
         SourceVertex {
@@ -77,6 +77,19 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex + VertexIndex>
             normal: v.normal,
             color: v.color,
         }
+    }
+
+    /// A batch through [`Cut::vertices`], out of line so that its loop, with the per-slot fetch
+    /// inlined, is not unrolled into every lane (more code, and slower on the Cortex-M7).
+    #[inline(never)]
+    fn batch(&self, first: usize, len: usize, out: &mut VertexBatch) {
+        self.cut.vertices(self.h, first, len.min(BATCH), |k, v| {
+            for a in 0..3 {
+                out.positions[a][k] = v.position[a];
+                out.normals[a][k] = v.normal[a];
+                out.colors[a][k] = v.color[a] as f32;
+            }
+        });
     }
 
     fn has_normals(&self) -> bool {

@@ -1146,6 +1146,12 @@ impl<'a> HierarchyView<'a> {
     #[inline]
     #[must_use]
     pub fn vertex(&self, i: u32) -> ([f32; 3], [f32; 3], [u8; 3]) {
+        self.vertex_inline(i)
+    }
+
+    /// [`HierarchyView::vertex`], inlined where it is called (the cut's batch read).
+    #[inline(always)]
+    pub(crate) fn vertex_inline(&self, i: u32) -> ([f32; 3], [f32; 3], [u8; 3]) {
         // Position and normal lead every record, a leaf's and a parent's alike (out of range:
         // zeros, as `record_bytes` reads it).
         let r: [u8; 8] = self.fixed(self.record(i).offset).unwrap_or([0; 8]);
