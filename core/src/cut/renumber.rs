@@ -81,7 +81,8 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         // Triangles: counted out by their corner of least slot, in their old order among those
         // of one vertex (a counting sort whose counters are the vertices' fan entries, which
         // are set again after). A triangle without such a corner (only in a cut a crafted file
-        // broke) goes after the others, in its order.
+        // broke) goes after the others, in its order. No count or place reaches `F`, which is
+        // below `I::LIMIT`, so none is stored as `NIL`.
         let to = self.map.scratch(nf);
         let counts = self.v.fans_mut();
         let least = |t: Option<[u32; 3]>| {
