@@ -120,6 +120,21 @@ fn exactly(mut list: Vec<u32>, items: &[u32]) -> Vec<u32> {
     list
 }
 
+/// The corners that follow `v` counter-clockwise in triangle `t` (`None` when `v` is not one):
+/// a face of a vertex's list has it once, so one test finds which edges of the face are its.
+#[inline]
+fn after(t: [u32; 3], v: u32) -> Option<(u32, u32)> {
+    if t[0] == v {
+        Some((t[1], t[2]))
+    } else if t[1] == v {
+        Some((t[2], t[0]))
+    } else if t[2] == v {
+        Some((t[0], t[1]))
+    } else {
+        None
+    }
+}
+
 fn face_normal(p: &[Vec3d], f: [u32; 3]) -> Vec3d {
     let [a, b, c] = f.map(|i| p[i as usize]);
     cross(sub(b, a), sub(c, a))
@@ -284,15 +299,15 @@ impl<'o> Engine<'o> {
         let mut wings = [NONE; 2];
         let mut count = 0;
         for &f in &self.vfaces[self.at(a)] {
-            let t = self.faces[f as usize];
-            for k in 0..3 {
-                if t[k] == a && t[(k + 1) % 3] == b {
-                    wings[0] = t[(k + 2) % 3];
-                    count += 1;
-                } else if t[k] == b && t[(k + 1) % 3] == a {
-                    wings[1] = t[(k + 2) % 3];
-                    count += 1;
-                }
+            let Some((next, prev)) = after(self.faces[f as usize], a) else {
+                continue;
+            };
+            if next == b {
+                wings[0] = prev;
+                count += 1;
+            } else if prev == b {
+                wings[1] = next;
+                count += 1;
             }
         }
         (wings, count)
@@ -306,10 +321,7 @@ impl<'o> Engine<'o> {
         self.vfaces[self.at(a)]
             .iter()
             .copied()
-            .find(|&f| {
-                let t = self.faces[f as usize];
-                (0..3).any(|k| t[k] == a && t[(k + 1) % 3] == b)
-            })
+            .find(|&f| after(self.faces[f as usize], a).is_some_and(|(next, _)| next == b))
             .unwrap_or(NONE)
     }
 
