@@ -9,9 +9,13 @@ use vdlod_core::format::{crc32, HierarchyView, CRC_OFFSET, HEADER_SIZE, NONE};
 
 fn check(data: &[u8]) {
     if let Ok(view) = HierarchyView::parse(data) {
-        for i in 0..view.nodes() {
+        for i in 0..view.nodes() + 2 {
             let n = view.node(i);
             assert!(n.parent == NONE || n.parent < i);
+            // What drawing reads of a node is what its whole record says.
+            let same = |a: [f32; 3], b: [f32; 3]| a.map(f32::to_bits) == b.map(f32::to_bits);
+            let (position, normal, color) = view.vertex(i);
+            assert!(same(position, n.position) && same(normal, n.normal) && color == n.color);
         }
         for p in view.parent_nodes() {
             let s = view.split(p);
