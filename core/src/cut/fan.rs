@@ -7,7 +7,6 @@
 //! crafted to contradict the mesh.
 
 use super::slot::SlotIndex;
-use super::store::{Triangles, Vertices};
 use super::{Cut, NIL};
 
 /// Longest fan walked around one vertex; a hierarchy with larger vertex degrees is refused
@@ -100,49 +99,38 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         out.len() == degree
     }
 
-    /// Calls `visit` with each triangle around slot `v` (see [`around`]).
-    pub(crate) fn for_each_around(&self, v: u32, visit: impl FnMut(u32)) {
-        around(&self.v, &self.t, v, visit);
+    /// Calls `visit` with each triangle around slot `v`, walking at most as many steps as the
+    /// vertex has triangles (so a fan a crafted file broke ends the walk, not the program).
+    pub(crate) fn for_each_around(&self, v: u32, mut visit: impl FnMut(u32)) {
+        if v as usize >= self.v.len() {
+            return;
+        }
+        let start = self.v.fan(v as usize);
+        let mut left = self.v.degree[v as usize];
+        if start == NIL {
+            return;
+        }
+        let mut f = start;
+        while left > 0 {
+            visit(f);
+            left -= 1;
+            match self.ccw(f, v) {
+                Some(g) if g == start => return,
+                Some(g) if g != NIL => f = g,
+                _ => break,
+            }
+        }
+        // A border: the rest lies clockwise of the start.
+        let mut g = self.cw(start, v).unwrap_or(NIL);
+        while g != NIL && left > 0 {
+            visit(g);
+            left -= 1;
+            g = self.cw(g, v).unwrap_or(NIL);
+        }
     }
 
     /// Whether walking `v`'s fan finds every triangle that uses `v`, each once.
     pub(crate) fn fan_complete(&self, v: u32) -> bool {
         self.complete_fan(v, &mut Fan::new())
-    }
-}
-
-/// Calls `visit` with each triangle around slot `v` of `vertices` over `triangles`, walking at
-/// most as many steps as the vertex has triangles (so a fan a crafted file broke ends the walk,
-/// not the program).
-pub(crate) fn around<const V: usize, const F: usize, I: SlotIndex>(
-    vertices: &Vertices<V, I>,
-    triangles: &Triangles<F, I>,
-    v: u32,
-    mut visit: impl FnMut(u32),
-) {
-    if v as usize >= vertices.len() {
-        return;
-    }
-    let start = vertices.fan(v as usize);
-    let mut left = vertices.degree[v as usize];
-    if start == NIL {
-        return;
-    }
-    let mut f = start;
-    while left > 0 {
-        visit(f);
-        left -= 1;
-        match triangles.ccw(f, v) {
-            Some(g) if g == start => return,
-            Some(g) if g != NIL => f = g,
-            _ => break,
-        }
-    }
-    // A border: the rest lies clockwise of the start.
-    let mut g = triangles.cw(start, v).unwrap_or(NIL);
-    while g != NIL && left > 0 {
-        visit(g);
-        left -= 1;
-        g = triangles.cw(g, v).unwrap_or(NIL);
     }
 }
