@@ -83,18 +83,16 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         // are set again after). A triangle without such a corner (only in a cut a crafted file
         // broke) goes after the others, in its order. No count or place reaches `F`, which is
         // below `I::LIMIT`, so none is stored as `NIL`.
+        // `to[f]` holds the triangle's least corner (or `NIL`) until it holds its place.
         let to = self.map.scratch(nf);
         let counts = self.v.fans_mut();
-        let least = |t: Option<[u32; 3]>| {
-            t.and_then(|t| t.into_iter().min())
-                .filter(|&m| (m as usize) < n)
-        };
         counts.iter_mut().for_each(|c| *c = I::store(0));
-        let mut rest = 0u32;
-        for f in 0..nf as u32 {
-            match least(self.t.get(f)) {
-                Some(m) => counts[m as usize] = I::store(counts[m as usize].load() + 1),
-                None => rest += 1,
+        for (f, t) in (0..nf as u32).zip(to.iter_mut()) {
+            let least = self.t.get(f).and_then(|t| t.into_iter().min());
+            *t = I::store(NIL);
+            if let Some(m) = least.filter(|&m| (m as usize) < n) {
+                counts[m as usize] = I::store(counts[m as usize].load() + 1);
+                *t = I::store(m);
             }
         }
         let mut sum = 0u32;
@@ -104,11 +102,11 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             sum += k;
         }
         let mut after = sum;
-        for (f, t) in (0..nf as u32).zip(to.iter_mut()) {
-            let place = match least(self.t.get(f)) {
-                Some(m) => {
-                    let p = counts[m as usize].load();
-                    counts[m as usize] = I::store(p + 1);
+        for t in to.iter_mut() {
+            let place = match counts.get_mut(t.index()).filter(|_| t.load() != NIL) {
+                Some(c) => {
+                    let p = c.load();
+                    *c = I::store(p + 1);
                     p
                 }
                 None => {
@@ -118,7 +116,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             };
             *t = I::store(place);
         }
-        debug_assert_eq!(after, sum + rest);
+        debug_assert_eq!(after as usize, nf);
         let triangle = |f: u32| through(to, f);
         self.t.renumber_neighbours(triangle);
         if !self.t.scatter(to) {
