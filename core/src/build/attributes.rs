@@ -19,6 +19,7 @@ use alloc::vec::Vec;
 use super::bound::{equation3, hoppe};
 use super::closest::{closest, point};
 use super::collapse::{kept, Engine};
+use super::input::Borders;
 use super::vec3::{add, cross, dot, from_f32, len, normalize, scale, sub, Vec3d};
 use super::{ErrorBound, Hierarchy, InputMesh, Node, NONE};
 use crate::format::{oct_decode, oct_encode};
@@ -49,7 +50,9 @@ fn angle(a: Vec3d, b: Vec3d) -> f64 {
     libm::atan2(len(cross(a, b)), dot(a, b))
 }
 
-pub(crate) fn finish(mesh: &InputMesh<'_>, mut e: Engine<'_>) -> Hierarchy {
+/// The hierarchy of the collapses `e` made on `mesh`, whose vertices on a border `on_border`
+/// names (as `input::checked` finds them).
+pub(crate) fn finish(mesh: &InputMesh<'_>, mut e: Engine<'_>, on_border: &Borders) -> Hierarchy {
     let heap_pushes = e.queue.pushes();
     e.release_work();
     let leaves = mesh.positions.len();
@@ -184,56 +187,6 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, mut e: Engine<'_>) -> Hierarchy {
         }
     }
 
-    // Input vertices on a border (an endpoint of an edge only one triangle uses): each edge is
-    // listed under its lesser endpoint (a counting sort, in less room than a list of pairs, and
-    // several times faster than sorting them all), and each endpoint's few sorted on their own.
-    let n = leaves;
-    let edge = |t: &[u32; 3], k: usize| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]));
-    let mut start = vec![0u32; n + 1];
-    for t in mesh.triangles {
-        for k in 0..3 {
-            if let Some(s) = start.get_mut(edge(t, k).0 as usize + 1) {
-                *s += 1;
-            }
-        }
-    }
-    for v in 0..n {
-        start[v + 1] += start[v];
-    }
-    let mut next = start.clone();
-    let mut others = vec![0u32; start[n] as usize];
-    for t in mesh.triangles {
-        for k in 0..3 {
-            let (a, b) = edge(t, k);
-            if let Some(at) = next.get_mut(a as usize) {
-                others[*at as usize] = b;
-                *at += 1;
-            }
-        }
-    }
-    drop(next);
-    let mut on_border = vec![false; leaves];
-    for a in 0..n {
-        let list = &mut others[start[a] as usize..start[a + 1] as usize];
-        list.sort_unstable();
-        let mut k = 0;
-        while k < list.len() {
-            let mut j = k + 1;
-            while j < list.len() && list[j] == list[k] {
-                j += 1;
-            }
-            if j - k == 1 {
-                for v in [a as u32, list[k]] {
-                    if let Some(flag) = on_border.get_mut(v as usize) {
-                        *flag = true;
-                    }
-                }
-            }
-            k = j;
-        }
-    }
-    drop((start, others));
-
     let mut errors: Vec<(f32, f32)> = Vec::new();
     for (k, c) in e.collapses.iter().enumerate() {
         let p = c.parent as usize;
@@ -241,7 +194,7 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, mut e: Engine<'_>) -> Hierarchy {
         let (s, t) = range[p];
         let below = &order[s as usize..t as usize];
         let own = if e.opts.bound == ErrorBound::Offset {
-            offset_bound(below, &pos, pos[p], n, &on_border)
+            offset_bound(below, &pos, pos[p], n, on_border)
         } else {
             let start = k.checked_sub(1).map_or(0, |j| e.fan_ends[j] as usize);
             let fan = &e.fans[start..e.fan_ends[k] as usize];
@@ -291,13 +244,13 @@ fn offset_bound(
     pos: &[Vec3d],
     center: Vec3d,
     n: Vec3d,
-    on_border: &[bool],
+    on_border: &Borders,
 ) -> [f32; 2] {
     let (mut along, mut outline) = (0.0f64, 0.0f64);
     for &leaf in below {
         let d = sub(pos[leaf as usize], center);
         along = along.max(dot(d, n).abs());
-        if on_border.get(leaf as usize) == Some(&true) {
+        if on_border.contains(leaf) {
             outline = outline.max(len(cross(d, n)));
         }
     }

@@ -126,6 +126,35 @@ impl core::error::Error for BuildError {}
 /// Checks `mesh`; on success every edge is in one or two consistently oriented triangles and every
 /// vertex's triangles form a single fan.
 pub fn validate(mesh: &InputMesh<'_>) -> Result<(), BuildError> {
+    checked(mesh).map(|_| ())
+}
+
+/// Which vertices lie on a border (an endpoint of an edge that one triangle uses), a bit each:
+/// the builder keeps them through its collapses.
+pub(crate) struct Borders(Vec<u64>);
+
+impl Borders {
+    fn new(n: usize) -> Borders {
+        Borders(vec![0; n.div_ceil(64)])
+    }
+
+    fn insert(&mut self, v: u32) {
+        if let Some(w) = self.0.get_mut(v as usize / 64) {
+            *w |= 1 << (v % 64);
+        }
+    }
+
+    /// Whether vertex `v` is on a border (false for anything out of range).
+    pub fn contains(&self, v: u32) -> bool {
+        self.0
+            .get(v as usize / 64)
+            .is_some_and(|w| w >> (v % 64) & 1 != 0)
+    }
+}
+
+/// [`validate`], and on success which vertices lie on a border, which the checks find on the
+/// way and the builder needs after.
+pub(crate) fn checked(mesh: &InputMesh<'_>) -> Result<Borders, BuildError> {
     let n = mesh.positions.len();
     if mesh.triangles.is_empty() {
         return Err(BuildError::Empty);
@@ -190,6 +219,7 @@ pub fn validate(mesh: &InputMesh<'_>) -> Result<(), BuildError> {
         }
     }
     let edges = sorted_by_vertex(n, &edges, |e| e.0);
+    let mut on_border = Borders::new(n);
     let mut i = 0;
     while i < edges.len() {
         let mut j = i + 1;
@@ -198,7 +228,10 @@ pub fn validate(mesh: &InputMesh<'_>) -> Result<(), BuildError> {
         }
         let (a, b) = (edges[i].0, edges[i].1);
         match j - i {
-            1 => {}
+            1 => {
+                on_border.insert(a);
+                on_border.insert(b);
+            }
             2 if edges[i].2 != edges[i + 1].2 => {}
             2 => return Err(BuildError::InconsistentOrientation { a, b }),
             _ => return Err(BuildError::NonManifoldEdge { a, b }),
@@ -226,7 +259,7 @@ pub fn validate(mesh: &InputMesh<'_>) -> Result<(), BuildError> {
         }
         i = j;
     }
-    Ok(())
+    Ok(on_border)
 }
 
 /// `items` in the order `sort_unstable` gives them, where each item's order starts with

@@ -394,7 +394,7 @@ pub fn build(
     opts: &BuildOptions,
     progress: &mut dyn FnMut(Progress),
 ) -> Result<Hierarchy, BuildError> {
-    validate(mesh)?;
+    let on_border = input::checked(mesh)?;
     let mut engine = collapse::Engine::new(mesh, opts);
     let target = (opts.base_vertices as usize).max(1);
     let total = engine.alive_count.saturating_sub(target) as u32;
@@ -408,7 +408,7 @@ pub fn build(
         }
     }
     progress(Progress { done, total });
-    Ok(attributes::finish(mesh, engine))
+    Ok(attributes::finish(mesh, engine, &on_border))
 }
 
 #[cfg(test)]
