@@ -81,15 +81,27 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex + VertexIndex>
 
     /// A batch through [`Cut::vertices`], out of line so that its loop, with the per-slot fetch
     /// inlined, is not unrolled into every lane (more code, and slower on the Cortex-M7).
+    /// Without vertex colours the draw uses its base colour, so the colours are neither
+    /// converted nor, once inlined, read from the file.
     #[inline(never)]
     fn batch(&self, first: usize, len: usize, out: &mut VertexBatch) {
-        self.cut.vertices(self.h, first, len.min(BATCH), |k, v| {
-            for a in 0..3 {
-                out.positions[a][k] = v.position[a];
-                out.normals[a][k] = v.normal[a];
-                out.colors[a][k] = v.color[a] as f32;
-            }
-        });
+        let count = len.min(BATCH);
+        if self.colors {
+            self.cut.vertices(self.h, first, count, |k, v| {
+                for a in 0..3 {
+                    out.positions[a][k] = v.position[a];
+                    out.normals[a][k] = v.normal[a];
+                    out.colors[a][k] = v.color[a] as f32;
+                }
+            });
+        } else {
+            self.cut.vertices(self.h, first, count, |k, v| {
+                for a in 0..3 {
+                    out.positions[a][k] = v.position[a];
+                    out.normals[a][k] = v.normal[a];
+                }
+            });
+        }
     }
 
     fn has_normals(&self) -> bool {
