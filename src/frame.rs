@@ -9,7 +9,7 @@ use core::fmt;
 
 use glam::Vec3;
 use vdlod_core::adapt::{Budget, FrameStats};
-use vdlod_core::cut::{Cut, SlotIndex};
+use vdlod_core::cut::{Cut, SlotIndex, VertexLanes, LANES};
 use vdlod_core::format::HierarchyView;
 use vdlod_core::policy::Policy;
 use vdlod_raster::texture::Texture;
@@ -56,6 +56,9 @@ impl<'a, 'h, const V: usize, const F: usize, const Q: usize, I: SlotIndex>
     }
 }
 
+// The cut hands out its vertices in batches of the vertex stage's size.
+const _: () = assert!(LANES == BATCH);
+
 impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex + VertexIndex> MeshSource
     for CutMesh<'_, '_, V, F, Q, I>
 {
@@ -79,29 +82,19 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex + VertexIndex>
         }
     }
 
-    /// A batch through [`Cut::vertices`], out of line so that its loop, with the per-slot fetch
-    /// inlined, is not unrolled into every lane (more code, and slower on the Cortex-M7).
-    /// Without vertex colours the draw uses its base colour, so the colours are neither
-    /// converted nor, once inlined, read from the file.
+    /// A batch through [`Cut::vertex_lanes`], out of line so that its loops are not unrolled
+    /// into every caller. Without vertex colours the draw uses its base colour, so the colours
+    /// are neither read nor converted.
     #[inline(never)]
     fn batch(&self, first: usize, len: usize, out: &mut VertexBatch) {
-        let count = len.min(BATCH);
+        let mut lanes = VertexLanes::default();
         if self.colors {
-            self.cut.vertices(self.h, first, count, |k, v| {
-                for a in 0..3 {
-                    out.positions[a][k] = v.position[a];
-                    out.normals[a][k] = v.normal[a];
-                    out.colors[a][k] = v.color[a] as f32;
-                }
-            });
+            self.cut.vertex_lanes(self.h, first, len, true, &mut lanes);
+            out.colors = lanes.colors.map(|c| c.map(f32::from));
         } else {
-            self.cut.vertices(self.h, first, count, |k, v| {
-                for a in 0..3 {
-                    out.positions[a][k] = v.position[a];
-                    out.normals[a][k] = v.normal[a];
-                }
-            });
+            self.cut.vertex_lanes(self.h, first, len, false, &mut lanes);
         }
+        (out.positions, out.normals) = (lanes.positions, lanes.normals);
     }
 
     fn has_normals(&self) -> bool {

@@ -54,6 +54,7 @@
 //! split below it; the builder's files do every split legally in the reverse of its collapse
 //! order, and the cut's forcing refuses a crafted file whose splits wait on each other.
 
+use crate::cut::LANES;
 use core::fmt;
 
 /// First four bytes of a hierarchy file.
@@ -448,17 +449,42 @@ pub fn oct_encode(n: [f32; 3]) -> (i8, i8) {
 /// Decodes octahedral coordinates in `[-127, 127]` to a unit vector (one square root and one
 /// division: the policies decode an axis per vertex per frame).
 pub fn oct_decode(x: i8, y: i8) -> [f32; 3] {
-    // In units of 1/127: |u| + |v| + |z| = 127 before normalizing. The lower hemisphere's
-    // fold is computed always and selected, so that it costs no branch.
+    let w = oct_unfold(x, y);
+    scale(w, 1.0 / libm::sqrtf(dot3(w)))
+}
+
+/// [`oct_decode`] before normalizing: in units of 1/127, `|u| + |v| + |z| = 127`. The lower
+/// hemisphere's fold is computed always and selected, so that it costs no branch.
+#[inline(always)]
+fn oct_unfold(x: i8, y: i8) -> [f32; 3] {
     let (x, y) = (x as f32, y as f32);
     let z = 127.0 - x.abs() - y.abs();
     let sign = |a: f32| if a >= 0.0 { 1.0 } else { -1.0 };
     let fold = z < 0.0;
     let u = if fold { (127.0 - y.abs()) * sign(x) } else { x };
     let v = if fold { (127.0 - x.abs()) * sign(y) } else { y };
-    // Never zero: the components' magnitudes add up to 127.
-    let inv = 1.0 / libm::sqrtf(u * u + v * v + z * z);
-    [u * inv, v * inv, z * inv]
+    [u, v, z]
+}
+
+/// `|w|^2`, never zero for [`oct_unfold`]'s vectors (their magnitudes add up to 127).
+#[inline(always)]
+fn dot3(w: [f32; 3]) -> f32 {
+    w[0] * w[0] + w[1] * w[1] + w[2] * w[2]
+}
+
+#[inline(always)]
+fn scale(w: [f32; 3], by: f32) -> [f32; 3] {
+    [w[0] * by, w[1] * by, w[2] * by]
+}
+
+/// Positions and normals of [`LANES`] records' leading bytes ([`HierarchyView::leading`]),
+/// attribute by attribute: [`ModelBox::position`] and [`oct_decode`] lane by lane, in the same
+/// operations (so the same floats), but in loops the compiler runs in SIMD registers; only the
+/// square roots go one at a time.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct DecodedLanes {
+    pub positions: [[f32; LANES]; 3],
+    pub normals: [[f32; LANES]; 3],
 }
 
 /// A validated hierarchy, borrowed in place.
@@ -1149,19 +1175,58 @@ impl<'a> HierarchyView<'a> {
         self.vertex_inline(i)
     }
 
-    /// [`HierarchyView::vertex`], inlined where it is called (the cut's batch read).
+    /// [`HierarchyView::vertex`], inlined where it is called.
     #[inline(always)]
     pub(crate) fn vertex_inline(&self, i: u32) -> ([f32; 3], [f32; 3], [u8; 3]) {
-        // Position and normal lead every record, a leaf's and a parent's alike (out of range:
-        // zeros, as `record_bytes` reads it).
-        let r: [u8; 8] = self.fixed(self.record(i).offset).unwrap_or([0; 8]);
+        let r = self.leading(i);
         let normal = oct_decode(r[6] as i8, r[7] as i8);
         (self.model.position(&r), normal, self.color(i))
     }
 
+    /// The leading 8 bytes of node `i`'s record: position and normal lead every record, a
+    /// leaf's and a parent's alike (out of range: zeros, as `record_bytes` reads it).
+    #[inline(always)]
+    pub(crate) fn leading(&self, i: u32) -> [u8; 8] {
+        self.fixed(self.record(i).offset).unwrap_or([0; 8])
+    }
+
+    /// [`DecodedLanes`] of the leading bytes of up to [`LANES`] records (see
+    /// [`HierarchyView::leading`]; lanes past the records hold zeros, which decode to finite
+    /// values).
+    #[inline(always)]
+    pub(crate) fn decode_lanes(&self, r: &[[u8; 8]; LANES]) -> DecodedLanes {
+        let mut positions = [[0.0f32; LANES]; 3];
+        let mut unfolded = [[0.0f32; LANES]; 3];
+        let mut squares = [0.0f32; LANES];
+        for k in 0..LANES {
+            let p = self.model.position(&r[k]);
+            let w = oct_unfold(r[k][6] as i8, r[k][7] as i8);
+            for a in 0..3 {
+                positions[a][k] = p[a];
+                unfolded[a][k] = w[a];
+            }
+            squares[k] = dot3(w);
+        }
+        let mut inv = [0.0f32; LANES];
+        for (i, s) in inv.iter_mut().zip(squares) {
+            *i = libm::sqrtf(s);
+        }
+        for i in &mut inv {
+            *i = 1.0 / *i;
+        }
+        let mut normals = [[0.0f32; LANES]; 3];
+        for k in 0..LANES {
+            let n = scale([unfolded[0][k], unfolded[1][k], unfolded[2][k]], inv[k]);
+            for a in 0..3 {
+                normals[a][k] = n[a];
+            }
+        }
+        DecodedLanes { positions, normals }
+    }
+
     /// Node `i`'s colour: white without colours, black out of range.
-    #[inline]
-    fn color(&self, i: u32) -> [u8; 3] {
+    #[inline(always)]
+    pub(crate) fn color(&self, i: u32) -> [u8; 3] {
         if !self.has_colors() {
             return [255; 3];
         }

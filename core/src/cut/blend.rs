@@ -14,6 +14,9 @@ use super::slot::SlotIndex;
 use super::{depth_color, Coloring, Cut, BLENDING, COLLAPSING, NIL};
 use crate::format::HierarchyView;
 
+/// Vertices in a batch of [`Cut::vertex_lanes`].
+pub const LANES: usize = 8;
+
 /// A vertex as drawn this frame.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct VertexOut {
@@ -23,6 +26,41 @@ pub struct VertexOut {
     pub normal: [f32; 3],
     /// Colour (see [`Coloring`]).
     pub color: [u8; 3],
+}
+
+/// Up to [`LANES`] vertices as drawn this frame, attribute by attribute (structure of arrays):
+/// what [`Cut::vertex_lanes`] fills.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct VertexLanes {
+    /// Positions, by coordinate.
+    pub positions: [[f32; LANES]; 3],
+    /// Unit normals, by coordinate.
+    pub normals: [[f32; LANES]; 3],
+    /// Colours (see [`Coloring`]), by channel.
+    pub colors: [[u8; LANES]; 3],
+}
+
+impl VertexLanes {
+    /// Lane `k` (below [`LANES`]) as one vertex.
+    #[must_use]
+    pub fn get(&self, k: usize) -> VertexOut {
+        let k = k.min(LANES - 1);
+        VertexOut {
+            position: [0, 1, 2].map(|a| self.positions[a][k]),
+            normal: [0, 1, 2].map(|a| self.normals[a][k]),
+            color: [0, 1, 2].map(|a| self.colors[a][k]),
+        }
+    }
+
+    /// Makes lane `k` (below [`LANES`]) `v`.
+    #[inline(always)]
+    fn set(&mut self, k: usize, v: &VertexOut) {
+        for a in 0..3 {
+            self.positions[a][k] = v.position[a];
+            self.normals[a][k] = v.normal[a];
+            self.colors[a][k] = v.color[a];
+        }
+    }
 }
 
 /// One running geomorph.
@@ -68,10 +106,16 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         VertexOut {
             position,
             normal,
-            color: match self.coloring {
-                Coloring::Node => color,
-                Coloring::Depth => depth_color(h.depth(node)),
-            },
+            color: self.node_color(h, node, color),
+        }
+    }
+
+    /// Node `node`'s colour as drawn, `color` its colour in the file (see [`Coloring`]).
+    #[inline(always)]
+    fn node_color(&self, h: &HierarchyView<'_>, node: u32, color: [u8; 3]) -> [u8; 3] {
+        match self.coloring {
+            Coloring::Node => color,
+            Coloring::Depth => depth_color(h.depth(node)),
         }
     }
 
@@ -83,15 +127,17 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         self.vertex_inline(h, s)
     }
 
-    /// Slots `first..first + count` as [`Cut::vertex`] reads them, each handed to `each` with
-    /// its place in the batch: how a renderer reads the cut a batch at a time, with the
-    /// per-slot work inlined into one loop (the vertex stage's per-call overhead was a third of
-    /// the fetch). Slots past the last read as the default.
+    /// Slots `first..first + count` (at most [`LANES`]) as [`Cut::vertex`] reads them, into
+    /// `out` attribute by attribute: how a renderer reads the cut a batch at a time. The slots
+    /// in no geomorph (nearly all) are decoded lane by lane, in loops the compiler runs in SIMD
+    /// registers, into the same floats [`Cut::vertex`] gives. Colours are read only when
+    /// `colors` asks for them (else they stay 0); lanes past `count` and slots past the last
+    /// read as [`VertexOut::default`].
     ///
     /// ```
     /// # #[cfg(feature = "build")] {
     /// use vdlod_core::build::{build, BuildOptions, InputMesh};
-    /// use vdlod_core::cut::{Cut, VertexOut};
+    /// use vdlod_core::cut::{Cut, VertexLanes};
     /// use vdlod_core::format::HierarchyView;
     /// let positions = [[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0],
     ///                  [0.0, -1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]];
@@ -102,22 +148,58 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
     /// let h = HierarchyView::parse(&bytes).unwrap();
     /// let mut cut = Cut::<16, 32, 16>::new();
     /// cut.reset(&h).unwrap();
-    /// let mut batch = [VertexOut::default(); 8];
-    /// cut.vertices(&h, 0, batch.len(), |k, v| batch[k] = v);
-    /// assert_eq!(batch[1], cut.vertex(&h, 1));
-    /// assert_eq!(batch[7], VertexOut::default()); // past the last slot
+    /// let mut lanes = VertexLanes::default();
+    /// cut.vertex_lanes(&h, 0, 8, true, &mut lanes);
+    /// assert_eq!(lanes.get(1), cut.vertex(&h, 1));
+    /// assert_eq!(lanes.get(7), Default::default()); // past the last slot
     /// # }
     /// ```
     #[inline(always)]
-    pub fn vertices(
+    pub fn vertex_lanes(
         &self,
         h: &HierarchyView<'_>,
         first: usize,
         count: usize,
-        mut each: impl FnMut(usize, VertexOut),
+        colors: bool,
+        out: &mut VertexLanes,
     ) {
-        for k in 0..count {
-            each(k, self.vertex_inline(h, first + k));
+        let n = count.min(LANES);
+        let slots = first..first.saturating_add(n);
+        let plain = self.v.nodes().get(slots.clone()).filter(|_| {
+            self.v.flags[slots.clone()]
+                .iter()
+                .all(|f| f & (BLENDING | COLLAPSING) == 0)
+        });
+        let Some(nodes) = plain else {
+            for k in 0..LANES {
+                let v = match k < n {
+                    true => self.vertex_inline(h, first.saturating_add(k)),
+                    false => VertexOut::default(),
+                };
+                out.set(k, &v);
+            }
+            if !colors {
+                out.colors = [[0; LANES]; 3];
+            }
+            return;
+        };
+        let mut leading = [[0u8; 8]; LANES];
+        for (r, &node) in leading.iter_mut().zip(nodes) {
+            *r = h.leading(node);
+        }
+        let d = h.decode_lanes(&leading);
+        (out.positions, out.normals) = (d.positions, d.normals);
+        for k in n..LANES {
+            out.set(k, &VertexOut::default());
+        }
+        out.colors = [[0; LANES]; 3];
+        if colors {
+            for (k, &node) in nodes.iter().enumerate() {
+                let c = self.node_color(h, node, h.color(node));
+                for (channel, c) in out.colors.iter_mut().zip(c) {
+                    channel[k] = c;
+                }
+            }
         }
     }
 

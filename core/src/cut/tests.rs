@@ -667,6 +667,65 @@ mod adapt {
         assert!((last.vsplits + last.ecols) as usize * 100 <= n, "{last:?}");
     }
 
+    /// The batch read gives every slot bit for bit as the one-at-a-time read does, from any
+    /// start and for any count, in both colourings, with geomorphs running on some vertices of
+    /// a batch and on none; past the last slot and past the count, the default.
+    #[test]
+    fn vertex_lanes_read_each_slot_as_vertex_does() {
+        let bytes = sphere_bytes();
+        let h = HierarchyView::parse(&bytes).unwrap();
+        let policy = ScreenError::new(2.0);
+        let mut cut: Box<Mid> = Cut::boxed();
+        cut.reset(&h).unwrap();
+        cut.set_geomorph_frames(8);
+        let bits = |v: VertexOut| {
+            let f = |a: [f32; 3]| a.map(f32::to_bits);
+            (f(v.position), f(v.normal), v.color)
+        };
+        let (mut mixed, mut plain) = (0, 0);
+        for (frame, distance) in [30.0, 2.0, 2.0, 2.0, 30.0, 30.0].into_iter().enumerate() {
+            cut.adapt(
+                &h,
+                &orbit(frame as u32, distance),
+                &policy,
+                &Budget::default(),
+            );
+            for coloring in [Coloring::Node, Coloring::Depth] {
+                cut.set_coloring(coloring);
+                let len = cut.vertex_count();
+                for first in 0..len + 3 {
+                    let blending = (first..(first + LANES).min(len))
+                        .any(|s| cut.v.flags[s] & (BLENDING | COLLAPSING) != 0);
+                    (mixed, plain) = (mixed + blending as u32, plain + !blending as u32);
+                    for count in [0, 1, 5, LANES] {
+                        for colors in [false, true] {
+                            let mut lanes = VertexLanes::default();
+                            cut.vertex_lanes(&h, first, count, colors, &mut lanes);
+                            for k in 0..LANES {
+                                let mut want = match k < count {
+                                    true => cut.vertex(&h, first + k),
+                                    false => VertexOut::default(),
+                                };
+                                if !colors {
+                                    want.color = [0; 3];
+                                }
+                                assert_eq!(
+                                    bits(lanes.get(k)),
+                                    bits(want),
+                                    "frame {frame}, {coloring:?}, slot {first} + {k} of {count}"
+                                );
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        assert!(
+            mixed > 0 && plain > 0,
+            "{mixed} batches blending, {plain} not"
+        );
+    }
+
     #[test]
     fn geomorphs_blend_and_settle() {
         let bytes = sphere_bytes();
