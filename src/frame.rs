@@ -9,7 +9,7 @@ use core::fmt;
 
 use glam::Vec3;
 use vdlod_core::adapt::{Budget, FrameStats};
-use vdlod_core::cut::{Cut, SlotIndex, VertexLanes, LANES};
+use vdlod_core::cut::{Cut, SlotIndex, LANES};
 use vdlod_core::format::HierarchyView;
 use vdlod_core::policy::Policy;
 use vdlod_raster::texture::Texture;
@@ -87,14 +87,13 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex + VertexIndex>
     /// are neither read nor converted.
     #[inline(never)]
     fn batch(&self, first: usize, len: usize, out: &mut VertexBatch) {
-        let mut lanes = VertexLanes::default();
+        let mut colors = [[0; LANES]; 3];
+        let (p, n) = (&mut out.positions, &mut out.normals);
+        let asked = self.colors.then_some(&mut colors);
+        self.cut.vertex_lanes(self.h, first, len, p, n, asked);
         if self.colors {
-            self.cut.vertex_lanes(self.h, first, len, true, &mut lanes);
-            out.colors = lanes.colors.map(|c| c.map(f32::from));
-        } else {
-            self.cut.vertex_lanes(self.h, first, len, false, &mut lanes);
+            out.colors = colors.map(|c| c.map(f32::from));
         }
-        (out.positions, out.normals) = (lanes.positions, lanes.normals);
     }
 
     fn has_normals(&self) -> bool {

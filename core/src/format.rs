@@ -477,16 +477,6 @@ fn scale(w: [f32; 3], by: f32) -> [f32; 3] {
     [w[0] * by, w[1] * by, w[2] * by]
 }
 
-/// Positions and normals of [`LANES`] records' leading bytes ([`HierarchyView::leading`]),
-/// attribute by attribute: [`ModelBox::position`] and [`oct_decode`] lane by lane, in the same
-/// operations (so the same floats), but in loops the compiler runs in SIMD registers; only the
-/// square roots go one at a time.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct DecodedLanes {
-    pub positions: [[f32; LANES]; 3],
-    pub normals: [[f32; LANES]; 3],
-}
-
 /// A validated hierarchy, borrowed in place.
 #[derive(Clone, Copy)]
 pub struct HierarchyView<'a> {
@@ -1190,38 +1180,36 @@ impl<'a> HierarchyView<'a> {
         self.fixed(self.record(i).offset).unwrap_or([0; 8])
     }
 
-    /// [`DecodedLanes`] of the leading bytes of up to [`LANES`] records (see
-    /// [`HierarchyView::leading`]; lanes past the records hold zeros, which decode to finite
-    /// values).
+    /// Positions and normals of the leading bytes of [`LANES`] records
+    /// ([`HierarchyView::leading`]), attribute by attribute: [`ModelBox::position`] and
+    /// [`oct_decode`] lane by lane, in the same operations (so the same floats), but in loops
+    /// the compiler runs in SIMD registers; only the square roots go one at a time.
     #[inline(always)]
-    pub(crate) fn decode_lanes(&self, r: &[[u8; 8]; LANES]) -> DecodedLanes {
-        let mut positions = [[0.0f32; LANES]; 3];
-        let mut unfolded = [[0.0f32; LANES]; 3];
+    pub(crate) fn decode_lanes(
+        &self,
+        r: &[[u8; 8]; LANES],
+        positions: &mut [[f32; LANES]; 3],
+        normals: &mut [[f32; LANES]; 3],
+    ) {
         let mut squares = [0.0f32; LANES];
         for k in 0..LANES {
             let p = self.model.position(&r[k]);
             let w = oct_unfold(r[k][6] as i8, r[k][7] as i8);
             for a in 0..3 {
                 positions[a][k] = p[a];
-                unfolded[a][k] = w[a];
+                normals[a][k] = w[a];
             }
             squares[k] = dot3(w);
         }
         let mut inv = [0.0f32; LANES];
         for (i, s) in inv.iter_mut().zip(squares) {
-            *i = libm::sqrtf(s);
+            *i = 1.0 / libm::sqrtf(s);
         }
-        for i in &mut inv {
-            *i = 1.0 / *i;
-        }
-        let mut normals = [[0.0f32; LANES]; 3];
-        for k in 0..LANES {
-            let n = scale([unfolded[0][k], unfolded[1][k], unfolded[2][k]], inv[k]);
-            for a in 0..3 {
-                normals[a][k] = n[a];
+        for axis in normals.iter_mut() {
+            for (c, i) in axis.iter_mut().zip(inv) {
+                *c *= i;
             }
         }
-        DecodedLanes { positions, normals }
     }
 
     /// Node `i`'s colour: white without colours, black out of range.

@@ -28,41 +28,6 @@ pub struct VertexOut {
     pub color: [u8; 3],
 }
 
-/// Up to [`LANES`] vertices as drawn this frame, attribute by attribute (structure of arrays):
-/// what [`Cut::vertex_lanes`] fills.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct VertexLanes {
-    /// Positions, by coordinate.
-    pub positions: [[f32; LANES]; 3],
-    /// Unit normals, by coordinate.
-    pub normals: [[f32; LANES]; 3],
-    /// Colours (see [`Coloring`]), by channel.
-    pub colors: [[u8; LANES]; 3],
-}
-
-impl VertexLanes {
-    /// Lane `k` (below [`LANES`]) as one vertex.
-    #[must_use]
-    pub fn get(&self, k: usize) -> VertexOut {
-        let k = k.min(LANES - 1);
-        VertexOut {
-            position: [0, 1, 2].map(|a| self.positions[a][k]),
-            normal: [0, 1, 2].map(|a| self.normals[a][k]),
-            color: [0, 1, 2].map(|a| self.colors[a][k]),
-        }
-    }
-
-    /// Makes lane `k` (below [`LANES`]) `v`.
-    #[inline(always)]
-    fn set(&mut self, k: usize, v: &VertexOut) {
-        for a in 0..3 {
-            self.positions[a][k] = v.position[a];
-            self.normals[a][k] = v.normal[a];
-            self.colors[a][k] = v.color[a];
-        }
-    }
-}
-
 /// One running geomorph.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Blend {
@@ -127,17 +92,17 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         self.vertex_inline(h, s)
     }
 
-    /// Slots `first..first + count` (at most [`LANES`]) as [`Cut::vertex`] reads them, into
-    /// `out` attribute by attribute: how a renderer reads the cut a batch at a time. The slots
-    /// in no geomorph (nearly all) are decoded lane by lane, in loops the compiler runs in SIMD
-    /// registers, into the same floats [`Cut::vertex`] gives. Colours are read only when
-    /// `colors` asks for them (else they stay 0); lanes past `count` and slots past the last
-    /// read as [`VertexOut::default`].
+    /// Slots `first..first + count` (at most [`LANES`]) as [`Cut::vertex`] reads them, into the
+    /// caller's arrays attribute by attribute (lane `k` is slot `first + k`): how a renderer
+    /// reads the cut a batch at a time. The slots in no geomorph (nearly all) are decoded lane
+    /// by lane, in loops the compiler runs in SIMD registers, into the same floats
+    /// [`Cut::vertex`] gives. Colours are read only when `colors` is given; lanes past `count`
+    /// and slots past the last read as [`VertexOut::default`].
     ///
     /// ```
     /// # #[cfg(feature = "build")] {
     /// use vdlod_core::build::{build, BuildOptions, InputMesh};
-    /// use vdlod_core::cut::{Cut, VertexLanes};
+    /// use vdlod_core::cut::{Cut, LANES};
     /// use vdlod_core::format::HierarchyView;
     /// let positions = [[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0],
     ///                  [0.0, -1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]];
@@ -148,10 +113,10 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
     /// let h = HierarchyView::parse(&bytes).unwrap();
     /// let mut cut = Cut::<16, 32, 16>::new();
     /// cut.reset(&h).unwrap();
-    /// let mut lanes = VertexLanes::default();
-    /// cut.vertex_lanes(&h, 0, 8, true, &mut lanes);
-    /// assert_eq!(lanes.get(1), cut.vertex(&h, 1));
-    /// assert_eq!(lanes.get(7), Default::default()); // past the last slot
+    /// let (mut p, mut n) = ([[0.0; LANES]; 3], [[0.0; LANES]; 3]);
+    /// cut.vertex_lanes(&h, 0, LANES, &mut p, &mut n, None);
+    /// assert_eq!([p[0][1], p[1][1], p[2][1]], cut.vertex(&h, 1).position);
+    /// assert_eq!([n[0][7], n[1][7], n[2][7]], [0.0; 3]); // past the last slot
     /// # }
     /// ```
     #[inline(always)]
@@ -160,8 +125,9 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         h: &HierarchyView<'_>,
         first: usize,
         count: usize,
-        colors: bool,
-        out: &mut VertexLanes,
+        positions: &mut [[f32; LANES]; 3],
+        normals: &mut [[f32; LANES]; 3],
+        mut colors: Option<&mut [[u8; LANES]; 3]>,
     ) {
         let n = count.min(LANES);
         let slots = first..first.saturating_add(n);
@@ -176,10 +142,13 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                     true => self.vertex_inline(h, first.saturating_add(k)),
                     false => VertexOut::default(),
                 };
-                out.set(k, &v);
-            }
-            if !colors {
-                out.colors = [[0; LANES]; 3];
+                for a in 0..3 {
+                    positions[a][k] = v.position[a];
+                    normals[a][k] = v.normal[a];
+                    if let Some(c) = colors.as_deref_mut() {
+                        c[a][k] = v.color[a];
+                    }
+                }
             }
             return;
         };
@@ -187,17 +156,19 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         for (r, &node) in leading.iter_mut().zip(nodes) {
             *r = h.leading(node);
         }
-        let d = h.decode_lanes(&leading);
-        (out.positions, out.normals) = (d.positions, d.normals);
+        h.decode_lanes(&leading, positions, normals);
         for k in n..LANES {
-            out.set(k, &VertexOut::default());
+            for a in 0..3 {
+                positions[a][k] = 0.0;
+                normals[a][k] = 0.0;
+            }
         }
-        out.colors = [[0; LANES]; 3];
-        if colors {
+        if let Some(c) = colors {
+            *c = [[0; LANES]; 3];
             for (k, &node) in nodes.iter().enumerate() {
-                let c = self.node_color(h, node, h.color(node));
-                for (channel, c) in out.colors.iter_mut().zip(c) {
-                    channel[k] = c;
+                let color = self.node_color(h, node, h.color(node));
+                for (channel, color) in c.iter_mut().zip(color) {
+                    channel[k] = color;
                 }
             }
         }

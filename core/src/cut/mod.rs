@@ -92,7 +92,7 @@ pub(crate) mod split;
 mod store;
 
 pub(crate) use blend::Blend;
-pub use blend::{VertexLanes, VertexOut, LANES};
+pub use blend::{VertexOut, LANES};
 pub use check::Defect;
 pub use fan::MAX_FAN;
 pub(crate) use fan::{Fan, PairFans};

@@ -699,21 +699,33 @@ mod adapt {
                     (mixed, plain) = (mixed + blending as u32, plain + !blending as u32);
                     for count in [0, 1, 5, LANES] {
                         for colors in [false, true] {
-                            let mut lanes = VertexLanes::default();
-                            cut.vertex_lanes(&h, first, count, colors, &mut lanes);
+                            // Filled with garbage, which every lane must overwrite.
+                            let mut p = [[f32::NAN; LANES]; 3];
+                            let mut n = [[f32::NAN; LANES]; 3];
+                            let mut c = [[7u8; LANES]; 3];
+                            let asked = colors.then_some(&mut c);
+                            cut.vertex_lanes(&h, first, count, &mut p, &mut n, asked);
                             for k in 0..LANES {
-                                let mut want = match k < count {
+                                let want = match k < count {
                                     true => cut.vertex(&h, first + k),
                                     false => VertexOut::default(),
                                 };
-                                if !colors {
-                                    want.color = [0; 3];
-                                }
+                                let got = VertexOut {
+                                    position: [0, 1, 2].map(|a| p[a][k]),
+                                    normal: [0, 1, 2].map(|a| n[a][k]),
+                                    color: match colors {
+                                        true => [0, 1, 2].map(|a| c[a][k]),
+                                        false => want.color,
+                                    },
+                                };
                                 assert_eq!(
-                                    bits(lanes.get(k)),
+                                    bits(got),
                                     bits(want),
                                     "frame {frame}, {coloring:?}, slot {first} + {k} of {count}"
                                 );
+                            }
+                            if !colors {
+                                assert_eq!(c, [[7; LANES]; 3], "colours written unasked");
                             }
                         }
                     }
