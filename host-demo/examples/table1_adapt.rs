@@ -4,12 +4,14 @@
 //! the first.
 //!
 //! ```text
-//! cargo run --release -p vdlod-demo --example table1_adapt -- [FRAMES [SIZE [COUNT [FILE.vdh]]]]
+//! cargo run --release -p vdlod-demo --example table1_adapt -- [FRAMES [SIZE [COUNT [FILE.vdh [EVICT_MB]]]]]
 //! ```
 //!
 //! `FRAMES` frames per revolution (400: 0.9 degrees a frame), frustum size `SIZE` (0.2), `COUNT`
 //! frames timed (100). The hierarchy of the Loop-subdivided bunny takes a few seconds to build;
-//! with `FILE.vdh` it is read from there, or written there when the file does not exist. For
+//! with `FILE.vdh` it is read from there, or written there when the file does not exist. With
+//! `EVICT_MB`, that many megabytes are written and read between frames, untimed, as a frame's
+//! drawing would evict the cut from the caches (16 stands for `reproduce table1`'s draw). For
 //! instruction counts, run it twice under callgrind with `--toggle-collect='*Cut*>::adapt'`,
 //! with `COUNT` and with 0, and divide the difference by `COUNT`.
 
@@ -37,6 +39,8 @@ fn main() -> Result<(), String> {
     let size = number(1, 0.2)?;
     let count = number(2, 100.0)? as u32;
     let file = args.get(3);
+    let evict = number(4, 0.0)?;
+    let mut sweep = vec![0u8; (evict * 1e6) as usize];
     let bunny = || load_obj_bytes(BUNNY_NAME, BUNNY_OBJ).map_err(|e| e.to_string());
     let mesh = bunny()?.loop_subdivide();
     let bytes = match file.map(std::fs::read) {
@@ -65,20 +69,26 @@ fn main() -> Result<(), String> {
     cut.reset(&h).map_err(|e| e.to_string())?;
     cut.adapt(&h, &views[0], &policy, &Budget::default());
     let (mut visited, mut settled, mut ops) = (0u64, 0u64, 0u64);
-    let start = Instant::now();
-    for view in &views[1..] {
+    let mut adapting = std::time::Duration::ZERO;
+    for (i, view) in views[1..].iter().enumerate() {
+        if !sweep.is_empty() {
+            sweep.fill(i as u8);
+            std::hint::black_box(sweep.iter().fold(0u8, |a, &b| a ^ b));
+        }
+        let start = Instant::now();
         let s = cut.adapt(&h, view, &policy, &Budget::default());
+        adapting += start.elapsed();
         visited += u64::from(s.visited);
         settled += u64::from(s.settled);
         ops += u64::from(s.vsplits + s.ecols);
     }
     let n = u64::from(count.max(1));
     println!(
-        "frames={frames} frustum={size} count={count} visited={} settled={} ops={} adapt_ms={:.3}",
+        "frames={frames} frustum={size} count={count} evict_mb={evict} visited={} settled={} ops={} adapt_ms={:.3}",
         visited / n,
         settled / n,
         ops / n,
-        start.elapsed().as_secs_f64() * 1e3 / n as f64
+        adapting.as_secs_f64() * 1e3 / n as f64
     );
     Ok(())
 }
