@@ -1,6 +1,7 @@
 //! Hostile hierarchies into the runtime cut: whatever `HierarchyView::parse` accepts can be reset,
 //! refined, adapted over a few frames under a budget (its slots renumbered now and then) and
-//! coarsened without a panic.
+//! coarsened without a panic, and every frame's vertices read a batch at a time are the ones
+//! read one at a time, bit for bit.
 //!
 //! Each input is tried with its checksum recomputed, so that mutations of valid files (the seeds
 //! in `seeds/hierarchy`) reach the cut.
@@ -8,7 +9,7 @@
 
 use libfuzzer_sys::fuzz_target;
 use vdlod_core::adapt::Budget;
-use vdlod_core::cut::Cut;
+use vdlod_core::cut::{Cut, VertexOut, LANES};
 use vdlod_core::format::{crc32, HierarchyView, CRC_OFFSET, HEADER_SIZE};
 use vdlod_core::policy::{QRefine, View};
 
@@ -37,6 +38,7 @@ fuzz_target!(|data: &[u8]| {
             ..Budget::default()
         };
         let _ = cut.adapt(&view, &v, &QRefine::new(0.25 + a), &budget);
+        same_both_ways(&cut, &view);
         if i % 2 == 1 {
             let _ = cut.renumber();
         }
@@ -45,3 +47,31 @@ fuzz_target!(|data: &[u8]| {
         let _ = cut.collapse(&view, p);
     }
 });
+
+/// Every slot (and a few past the last) read by `Cut::vertex_lanes`, from every start, is what
+/// `Cut::vertex` reads.
+fn same_both_ways(cut: &Cut<256, 512, 64>, h: &HierarchyView<'_>) {
+    let bits = |v: &VertexOut| {
+        (
+            v.position.map(f32::to_bits),
+            v.normal.map(f32::to_bits),
+            v.color,
+        )
+    };
+    for first in 0..cut.vertex_count() + 2 {
+        let (mut p, mut n, mut c) = ([[0.0; LANES]; 3], [[0.0; LANES]; 3], [[0; LANES]; 3]);
+        cut.vertex_lanes(h, first, LANES, &mut p, &mut n, Some(&mut c));
+        for k in 0..LANES {
+            let lane = VertexOut {
+                position: [0, 1, 2].map(|a| p[a][k]),
+                normal: [0, 1, 2].map(|a| n[a][k]),
+                color: [0, 1, 2].map(|a| c[a][k]),
+            };
+            assert_eq!(
+                bits(&lane),
+                bits(&cut.vertex(h, first + k)),
+                "slot {first} + {k}"
+            );
+        }
+    }
+}
