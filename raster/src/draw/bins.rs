@@ -400,10 +400,15 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
                         continue; // neither filled nor outlined
                     }
                 }
-                if !outlined && pixel_bounds(xy, &frame).is_none() {
+                if !outlined {
+                    // The rows of the pixel centres it may cover: a band without them has
+                    // nothing of it to fill.
+                    if let Some([_, _, first, end]) = pixel_bounds(xy, &frame) {
+                        span(t, first as u16, end as u16);
+                    }
                     continue;
                 }
-                // Whole pixel rows: they hold the pixel centres filled and the wireframe's pixels.
+                // Whole pixel rows: they hold the wireframe's pixels.
                 let ys = v.map(|v| v.y >> SUBPIXEL_BITS);
                 let first = ys[0].min(ys[1]).min(ys[2]).max(0);
                 let end = ys[0].max(ys[1]).max(ys[2]).min(last);
