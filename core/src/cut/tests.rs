@@ -667,6 +667,14 @@ mod adapt {
         assert!((last.vsplits + last.ecols) as usize * 100 <= n, "{last:?}");
     }
 
+    /// A cut of `h` from its base mesh, with geomorphs over 8 frames.
+    fn blending_cut(h: &HierarchyView<'_>) -> Box<Mid> {
+        let mut cut: Box<Mid> = Cut::boxed();
+        cut.reset(h).unwrap();
+        cut.set_geomorph_frames(8);
+        cut
+    }
+
     /// The batch read gives every slot bit for bit as the one-at-a-time read does, from any
     /// start and for any count, in both colourings, with geomorphs running on some vertices of
     /// a batch and on none; past the last slot and past the count, the default.
@@ -675,9 +683,7 @@ mod adapt {
         let bytes = sphere_bytes();
         let h = HierarchyView::parse(&bytes).unwrap();
         let policy = ScreenError::new(2.0);
-        let mut cut: Box<Mid> = Cut::boxed();
-        cut.reset(&h).unwrap();
-        cut.set_geomorph_frames(8);
+        let mut cut = blending_cut(&h);
         let bits = |v: VertexOut| {
             let f = |a: [f32; 3]| a.map(f32::to_bits);
             (f(v.position), f(v.normal), v.color)
@@ -743,9 +749,7 @@ mod adapt {
         let bytes = sphere_bytes();
         let h = HierarchyView::parse(&bytes).unwrap();
         let policy = ScreenError::new(2.0);
-        let mut cut: Box<Mid> = Cut::boxed();
-        cut.reset(&h).unwrap();
-        cut.set_geomorph_frames(8);
+        let mut cut = blending_cut(&h);
         let far = orbit(0, 30.0);
         let near = orbit(0, 2.0);
         for _ in 0..20 {
