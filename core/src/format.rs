@@ -54,7 +54,6 @@
 //! split below it; the builder's files do every split legally in the reverse of its collapse
 //! order, and the cut's forcing refuses a crafted file whose splits wait on each other.
 
-use crate::cut::LANES;
 use core::fmt;
 
 /// First four bytes of a hierarchy file.
@@ -1180,19 +1179,19 @@ impl<'a> HierarchyView<'a> {
         self.fixed(self.record(i).offset).unwrap_or([0; 8])
     }
 
-    /// Positions and normals of the leading bytes of [`LANES`] records
-    /// ([`HierarchyView::leading`]), attribute by attribute: [`ModelBox::position`] and
-    /// [`oct_decode`] lane by lane, in the same operations (so the same floats), but in loops
-    /// the compiler runs in SIMD registers; only the square roots go one at a time.
+    /// Positions and normals of the leading bytes of `N` records ([`HierarchyView::leading`]),
+    /// attribute by attribute: [`ModelBox::position`] and [`oct_decode`] lane by lane, in the
+    /// same operations (so the same floats), but in loops the compiler runs in SIMD registers;
+    /// only the square roots go one at a time.
     #[inline(always)]
-    pub(crate) fn decode_lanes(
+    pub(crate) fn decode_lanes<const N: usize>(
         &self,
-        r: &[[u8; 8]; LANES],
-        positions: &mut [[f32; LANES]; 3],
-        normals: &mut [[f32; LANES]; 3],
+        r: &[[u8; 8]; N],
+        positions: &mut [[f32; N]; 3],
+        normals: &mut [[f32; N]; 3],
     ) {
-        let mut squares = [0.0f32; LANES];
-        for k in 0..LANES {
+        let mut squares = [0.0f32; N];
+        for k in 0..N {
             let p = self.model.position(&r[k]);
             let w = oct_unfold(r[k][6] as i8, r[k][7] as i8);
             for a in 0..3 {
@@ -1201,7 +1200,7 @@ impl<'a> HierarchyView<'a> {
             }
             squares[k] = dot3(w);
         }
-        let mut inv = [0.0f32; LANES];
+        let mut inv = [0.0f32; N];
         for (i, s) in inv.iter_mut().zip(squares) {
             *i = 1.0 / libm::sqrtf(s);
         }

@@ -131,11 +131,12 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
     ) {
         let n = count.min(LANES);
         let slots = first..first.saturating_add(n);
-        let plain = self.v.nodes().get(slots.clone()).filter(|_| {
-            self.v.flags[slots.clone()]
-                .iter()
-                .all(|f| f & (BLENDING | COLLAPSING) == 0)
-        });
+        let still = |f: &[u8]| f.iter().all(|f| f & (BLENDING | COLLAPSING) == 0);
+        let plain = self
+            .v
+            .nodes()
+            .get(slots.clone())
+            .filter(|_| self.v.flags.get(slots.clone()).is_some_and(still));
         let Some(nodes) = plain else {
             for k in 0..LANES {
                 let v = match k < n {
