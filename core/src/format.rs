@@ -56,6 +56,8 @@
 
 use core::fmt;
 
+use crate::policy::dot;
+
 /// First four bytes of a hierarchy file.
 pub const MAGIC: [u8; 4] = *b"VDLH";
 /// The version this crate reads and writes.
@@ -449,7 +451,8 @@ pub fn oct_encode(n: [f32; 3]) -> (i8, i8) {
 /// division: the policies decode an axis per vertex per frame).
 pub fn oct_decode(x: i8, y: i8) -> [f32; 3] {
     let w = oct_unfold(x, y);
-    scale(w, 1.0 / libm::sqrtf(dot3(w)))
+    // Never zero: the components' magnitudes add up to 127.
+    scale(w, 1.0 / libm::sqrtf(dot(w, w)))
 }
 
 /// [`oct_decode`] before normalizing: in units of 1/127, `|u| + |v| + |z| = 127`. The lower
@@ -463,12 +466,6 @@ fn oct_unfold(x: i8, y: i8) -> [f32; 3] {
     let u = if fold { (127.0 - y.abs()) * sign(x) } else { x };
     let v = if fold { (127.0 - x.abs()) * sign(y) } else { y };
     [u, v, z]
-}
-
-/// `|w|^2`, never zero for [`oct_unfold`]'s vectors (their magnitudes add up to 127).
-#[inline(always)]
-fn dot3(w: [f32; 3]) -> f32 {
-    w[0] * w[0] + w[1] * w[1] + w[2] * w[2]
 }
 
 #[inline(always)]
@@ -1198,7 +1195,7 @@ impl<'a> HierarchyView<'a> {
                 positions[a][k] = p[a];
                 normals[a][k] = w[a];
             }
-            squares[k] = dot3(w);
+            squares[k] = dot(w, w);
         }
         let mut inv = [0.0f32; N];
         for (i, s) in inv.iter_mut().zip(squares) {
