@@ -15,9 +15,9 @@
 //! Either way a band draws its triangles in the frame's order, so the bands stitch to the whole
 //! frame bit for bit.
 
-use super::{corners, for_each_clipped, Facing, Plain, Window, SUBPIXEL_BITS};
+use super::{clockwise, corners, for_each_clipped, Facing, Plain, Window, SUBPIXEL_BITS};
 use super::{needs_clipping, signed_area2_xy, DrawError, DrawStats, ShadedMesh};
-use crate::edge::{pixel_bounds, signed_area2};
+use crate::edge::{covers_centre, pixel_bounds, signed_area2};
 use crate::mesh::MeshSource;
 use crate::target::{Depth, Pixel, Target, TargetError};
 
@@ -396,15 +396,21 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
                     stats.rasterized += 1;
                 } else {
                     stats.culled += 1;
-                    if facing == Facing::Front {
+                    if !outlined || facing == Facing::Front {
                         continue; // neither filled nor outlined
                     }
                 }
                 if !outlined {
                     // The rows of the pixel centres it may cover: a band without them has
                     // nothing of it to fill.
-                    if let Some([_, _, first, end]) = pixel_bounds(xy, &frame) {
-                        span(t, first as u16, end as u16);
+                    if let Some([x0, x1, first, end]) = pixel_bounds(xy, &frame) {
+                        // Bounds of one pixel centre: whether it covers that centre decides
+                        // whether any band draws it (most such triangles of a detailed mesh
+                        // on a small frame cover none).
+                        let single = (x0 == x1) & (first == end);
+                        if !single || covers_centre(clockwise(area, xy), x0, first) {
+                            span(t, first as u16, end as u16);
+                        }
                     }
                     continue;
                 }
