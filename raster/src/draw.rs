@@ -565,7 +565,7 @@ pub(crate) trait Fill<P: Pixel, D: Depth> {
         s: &[ScreenVertex; 3],
         q: &[[f32; 3]; 3],
         area: i64,
-        bounds: [i64; 4],
+        bounds: [i32; 4],
     );
 }
 
@@ -582,7 +582,7 @@ impl<P: Pixel, D: Depth> Fill<P, D> for Plain {
         s: &[ScreenVertex; 3],
         _: &[[f32; 3]; 3],
         area: i64,
-        bounds: [i64; 4],
+        bounds: [i32; 4],
     ) {
         scan(target, s, area, bounds, depth_test::<P, D>);
     }

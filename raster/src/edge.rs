@@ -16,7 +16,9 @@
 //! evaluated from the two barycentric weights the edge functions already hold, against per-triangle
 //! differences pre-divided by the area: four multiply-adds on four lanes, no division in the pixel
 //! loop, and no set-up at all for the many triangles of a detailed mesh that cover no pixel
-//! centre. Only IEEE basic operations are used, so the result is the same on every target.
+//! centre. A triangle whose bounds hold one pixel centre (most of them, on a small frame) has
+//! its edge functions evaluated at that centre alone, and its attributes set up only when it
+//! covers it. Only IEEE basic operations are used, so the result is the same on every target.
 
 use crate::target::{Depth, Pixel, Target, Window};
 use crate::vertex::saturate_u8;
@@ -118,19 +120,36 @@ pub fn signed_area2_xy(p: [[i32; 2]; 3]) -> i64 {
 
 /// The pixels whose centres the bounding box of three snapped points can contain, clipped to
 /// `window` (in frame pixels), as inclusive `(x0, x1, y0, y1)`; `None` when there are none.
+/// In 32-bit integers (a device's registers): exact in the guard band's range (see the module's
+/// notes), which the vertex stage never leaves.
 #[inline(always)]
-pub fn pixel_bounds(p: [[i32; 2]; 3], window: &Window) -> Option<[i64; 4]> {
-    let min_x = p[0][0].min(p[1][0]).min(p[2][0]) as i64;
-    let max_x = p[0][0].max(p[1][0]).max(p[2][0]) as i64;
-    let min_y = p[0][1].min(p[1][1]).min(p[2][1]) as i64;
-    let max_y = p[0][1].max(p[1][1]).max(p[2][1]) as i64;
-    // First and last pixel whose centre (i + 1/2) can lie inside [min, max].
-    let (wx, wy) = (window.x as i64, window.y as i64);
-    let x0 = ((min_x - HALF + SUBPIXEL_ONE as i64 - 1) >> SUBPIXEL_BITS).max(wx);
-    let x1 = ((max_x - HALF) >> SUBPIXEL_BITS).min(wx + window.width as i64 - 1);
-    let y0 = ((min_y - HALF + SUBPIXEL_ONE as i64 - 1) >> SUBPIXEL_BITS).max(wy);
-    let y1 = ((max_y - HALF) >> SUBPIXEL_BITS).min(wy + window.height as i64 - 1);
+pub fn pixel_bounds(p: [[i32; 2]; 3], window: &Window) -> Option<[i32; 4]> {
+    let min_x = p[0][0].min(p[1][0]).min(p[2][0]);
+    let max_x = p[0][0].max(p[1][0]).max(p[2][0]);
+    let min_y = p[0][1].min(p[1][1]).min(p[2][1]);
+    let max_y = p[0][1].max(p[1][1]).max(p[2][1]);
+    // Window edges are below `MAX_DIMENSION`, so they fit.
+    let (wx, wy) = (window.x as i32, window.y as i32);
+    let x0 = first_centre(min_x).max(wx);
+    let x1 = last_centre(max_x).min(wx + window.width as i32 - 1);
+    let y0 = first_centre(min_y).max(wy);
+    let y1 = last_centre(max_y).min(wy + window.height as i32 - 1);
     (x0 <= x1 && y0 <= y1).then_some([x0, x1, y0, y1])
+}
+
+/// The first pixel whose centre (`i + 1/2`) is at or after snapped coordinate `c`. Wrapping, so
+/// that no coordinate panics: within 127 of `i32::MAX` a wrong bound only widens or empties the
+/// pixels scanned, each of which is still tested exactly.
+#[inline(always)]
+fn first_centre(c: i32) -> i32 {
+    c.wrapping_add(SUBPIXEL_ONE - 1 - HALF as i32) >> SUBPIXEL_BITS
+}
+
+/// The last pixel whose centre is at or before snapped coordinate `c` (wrapping, as
+/// [`first_centre`]).
+#[inline(always)]
+fn last_centre(c: i32) -> i32 {
+    c.wrapping_sub(HALF as i32) >> SUBPIXEL_BITS
 }
 
 /// One edge function `E(p) = dx * (p.y - a.y) - dy * (p.x - a.x)` for the edge `a -> b`.
@@ -170,14 +189,24 @@ fn edge_at(a: [i32; 2], b: [i32; 2], px: i64, py: i64) -> i64 {
     value - (!top_left) as i64
 }
 
+/// The edge functions (opposite vertices 0, 1 and 2) of a triangle clockwise on screen at the
+/// centre of pixel `(x, y)`, as its scan computes them there.
+#[inline(always)]
+fn at_centre(v: [[i32; 2]; 3], x: i32, y: i32) -> [i64; 3] {
+    let px = ((x as i64) << SUBPIXEL_BITS) + HALF;
+    let py = ((y as i64) << SUBPIXEL_BITS) + HALF;
+    [
+        edge_at(v[1], v[2], px, py),
+        edge_at(v[2], v[0], px, py),
+        edge_at(v[0], v[1], px, py),
+    ]
+}
+
 /// Whether a triangle clockwise on screen covers the centre of pixel `(x, y)`, exactly as its
 /// scan decides it.
 #[inline(always)]
-pub(crate) fn covers_centre(v: [[i32; 2]; 3], x: i64, y: i64) -> bool {
-    let (px, py) = ((x << SUBPIXEL_BITS) + HALF, (y << SUBPIXEL_BITS) + HALF);
-    let e0 = edge_at(v[1], v[2], px, py);
-    let e1 = edge_at(v[2], v[0], px, py);
-    let e2 = edge_at(v[0], v[1], px, py);
+pub(crate) fn covers_centre(v: [[i32; 2]; 3], x: i32, y: i32) -> bool {
+    let [e0, e1, e2] = at_centre(v, x, y);
     (e0 | e1 | e2) >= 0
 }
 
@@ -278,11 +307,24 @@ pub(crate) fn scan<P: Pixel, D: Depth, F>(
     target: &mut Target<'_, P, D>,
     v: &[ScreenVertex; 3],
     area: i64,
-    bounds: [i64; 4],
+    bounds: [i32; 4],
     mut plot: F,
 ) where
     F: FnMut(&mut P, &mut D, Fragment<'_>),
 {
+    let [x0, x1, y0, y1] = bounds;
+    if (x0 == x1) & (y0 == y1) {
+        // One pixel centre (most triangles of a detailed mesh on a small frame): the edge
+        // functions there, and the attributes only when it is covered.
+        let [e0, e1, e2] = at_centre(v.map(|v| [v.x, v.y]), x0, y0);
+        if (e0 | e1 | e2) >= 0 {
+            let i = target.index(x0 as usize, y0 as usize);
+            if let (Some(c), Some(d)) = (target.color.get_mut(i), target.depth.get_mut(i)) {
+                plot(c, d, Attrs::new(v, area).at(e1, e2));
+            }
+        }
+        return;
+    }
     let attrs = Attrs::new(v, area);
     pixels(target, v, bounds, |c, d, e1, e2| {
         plot(c, d, attrs.at(e1, e2))
@@ -327,7 +369,7 @@ pub(crate) fn scan_textured<P: Pixel, D: Depth, F>(
     v: &[ScreenVertex; 3],
     q: &[[f32; 3]; 3],
     area: i64,
-    bounds: [i64; 4],
+    bounds: [i32; 4],
     mut plot: F,
 ) where
     F: FnMut(&mut P, &mut D, Fragment<'_>, [f32; 2]),
@@ -345,13 +387,13 @@ pub(crate) fn scan_textured<P: Pixel, D: Depth, F>(
 fn pixels<P: Pixel, D: Depth, F>(
     target: &mut Target<'_, P, D>,
     v: &[ScreenVertex; 3],
-    [x0, x1, y0, y1]: [i64; 4],
+    [x0, x1, y0, y1]: [i32; 4],
     mut visit: F,
 ) where
     F: FnMut(&mut P, &mut D, i64, i64),
 {
-    let px = (x0 << SUBPIXEL_BITS) + HALF;
-    let py = (y0 << SUBPIXEL_BITS) + HALF;
+    let px = ((x0 as i64) << SUBPIXEL_BITS) + HALF;
+    let py = ((y0 as i64) << SUBPIXEL_BITS) + HALF;
     let e = [
         Edge::new(&v[1], &v[2], px, py),
         Edge::new(&v[2], &v[0], px, py),
@@ -493,7 +535,7 @@ mod tests {
             let covered = count(&[tri], 6, 6);
             for y in 0..6 {
                 for x in 0..6 {
-                    let one = covers_centre(cw.map(|v| [v.x, v.y]), x as i64, y as i64);
+                    let one = covers_centre(cw.map(|v| [v.x, v.y]), x as i32, y as i32);
                     proptest::prop_assert_eq!(one, covered[y * 6 + x] == 1, "pixel {} {}", x, y);
                 }
             }

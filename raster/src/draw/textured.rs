@@ -71,7 +71,7 @@ impl<P: Pixel, D: Depth, T: Pixel> Fill<P, D> for Textured<'_, '_, T> {
         s: &[ScreenVertex; 3],
         q: &[[f32; 3]; 3],
         area: i64,
-        bounds: [i64; 4],
+        bounds: [i32; 4],
     ) {
         let texture = self.0;
         let plot = |c: &mut P, d: &mut D, f: Fragment<'_>, uv: [f32; 2]| {
