@@ -421,27 +421,42 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
                 if first <= end {
                     span(t, first as u16, end as u16);
                 }
-            } else if needs_clipping(&v, union, &mut stats) {
-                for_each_clipped(
-                    &self.viewport,
-                    params,
-                    self.mesh,
-                    &[i0, i1, i2],
-                    [[0.0; 3]; 3],
-                    [[0.0; 2]; 3],
-                    union,
-                    |s, _| {
-                        if facing.draws(signed_area2(s)) {
-                            stats.rasterized += 1;
-                        } else {
-                            stats.culled += 1;
-                        }
-                    },
-                );
+                continue;
+            }
+            if needs_clipping(&v, union, &mut stats) {
+                self.count_clipped(&[i0, i1, i2], union, facing, &mut stats);
                 span(t, 0, last as u16);
             }
         }
         stats
+    }
+}
+
+impl<M: MeshSource> ShadedMesh<'_, M> {
+    /// Counts the pieces of a clipped triangle (vertex indices `tri`, outcodes' union `union`)
+    /// as filled or culled. Out of line: few triangles need it, and inlined in the binning loop
+    /// it held registers that loop wants.
+    #[cold]
+    #[inline(never)]
+    fn count_clipped(&self, tri: &[u32; 3], union: u8, facing: Facing, stats: &mut DrawStats) {
+        let colors = [[0.0; 3]; 3];
+        let uvs = [[0.0; 2]; 3];
+        for_each_clipped(
+            &self.viewport,
+            self.params,
+            self.mesh,
+            tri,
+            colors,
+            uvs,
+            union,
+            |s, _| {
+                if facing.draws(signed_area2(s)) {
+                    stats.rasterized += 1;
+                } else {
+                    stats.culled += 1;
+                }
+            },
+        );
     }
 }
 
