@@ -519,6 +519,23 @@ mod tests {
     }
 
     proptest::proptest! {
+        /// The 32-bit pixel bounds are the pixels whose centres lie in `[min, max]`, computed in
+        /// 64 bits by floor division: every position of a pixel (all 256 subpixel steps), the
+        /// pixel anywhere in the guard band's range and past it by far.
+        #[test]
+        fn centres_bound_exactly(pixel in -(1i32 << 18)..(1 << 18)) {
+            let one = i64::from(SUBPIXEL_ONE);
+            for c in (pixel * SUBPIXEL_ONE)..((pixel + 1) * SUBPIXEL_ONE) {
+                let first = (i64::from(c) - HALF + one - 1).div_euclid(one);
+                let last = (i64::from(c) - HALF).div_euclid(one);
+                proptest::prop_assert_eq!(i64::from(first_centre(c)), first, "{}", c);
+                proptest::prop_assert_eq!(i64::from(last_centre(c)), last, "{}", c);
+                // The centre `i + 1/2` is at or after `c` exactly from `first` on.
+                proptest::prop_assert!(first * one + HALF >= i64::from(c));
+                proptest::prop_assert!((first - 1) * one + HALF < i64::from(c));
+            }
+        }
+
         /// The one-centre test the binning uses agrees with the scan at every pixel, edges and
         /// corners through centres included (coordinates on a coarse grid hit them often).
         #[test]
