@@ -138,8 +138,8 @@ pub fn pixel_bounds(p: [[i32; 2]; 3], window: &Window) -> Option<[i32; 4]> {
 }
 
 /// The first pixel whose centre (`i + 1/2`) is at or after snapped coordinate `c`. Wrapping, so
-/// that no coordinate panics: within 127 of `i32::MAX` a wrong bound only widens or empties the
-/// pixels scanned, each of which is still tested exactly.
+/// that no coordinate panics: within 128 of either end of `i32` a wrong bound only widens or
+/// empties the pixels scanned, each of which is still tested exactly.
 #[inline(always)]
 fn first_centre(c: i32) -> i32 {
     c.wrapping_add(SUBPIXEL_ONE - 1 - HALF as i32) >> SUBPIXEL_BITS

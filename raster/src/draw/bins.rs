@@ -430,9 +430,7 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
         }
         stats
     }
-}
 
-impl<M: MeshSource> ShadedMesh<'_, M> {
     /// Counts the pieces of a clipped triangle (vertex indices `tri`, outcodes' union `union`)
     /// as filled or culled. Out of line: few triangles need it, and inlined in the binning loop
     /// it held registers that loop wants.
