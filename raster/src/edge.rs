@@ -122,6 +122,18 @@ pub fn signed_area2_xy(p: [[i32; 2]; 3]) -> i64 {
 /// `window` (in frame pixels), as inclusive `(x0, x1, y0, y1)`; `None` when there are none.
 /// In 32-bit integers (a device's registers): exact in the guard band's range (see the module's
 /// notes), which the vertex stage never leaves.
+///
+/// ```
+/// use vdlod_raster::edge::{pixel_bounds, SUBPIXEL_ONE};
+/// use vdlod_raster::Window;
+/// let px = |x: f32| (x * SUBPIXEL_ONE as f32) as i32;
+/// // From (0.2, 0.2) to (2.9, 1.4) pixels: the centres 0.5, 1.5 and 2.5 across, 0.5 down.
+/// let p = [[px(0.2), px(0.2)], [px(2.9), px(0.2)], [px(0.2), px(1.4)]];
+/// assert_eq!(pixel_bounds(p, &Window::full(8, 8)), Some([0, 2, 0, 0]));
+/// // Between centres: nothing to scan.
+/// let q = [[px(0.6), px(0.6)], [px(1.4), px(0.6)], [px(0.6), px(1.4)]];
+/// assert_eq!(pixel_bounds(q, &Window::full(8, 8)), None);
+/// ```
 #[inline(always)]
 pub fn pixel_bounds(p: [[i32; 2]; 3], window: &Window) -> Option<[i32; 4]> {
     let min_x = p[0][0].min(p[1][0]).min(p[2][0]);
