@@ -140,12 +140,13 @@ pub fn pixel_bounds(p: [[i32; 2]; 3], window: &Window) -> Option<[i32; 4]> {
     let max_x = p[0][0].max(p[1][0]).max(p[2][0]);
     let min_y = p[0][1].min(p[1][1]).min(p[2][1]);
     let max_y = p[0][1].max(p[1][1]).max(p[2][1]);
-    // Window edges are below `MAX_DIMENSION`, so they fit.
+    // A target's window edges are below `MAX_DIMENSION`, so they fit; a window built by hand
+    // past `i32` wraps (nonsense bounds, no panic).
     let (wx, wy) = (window.x as i32, window.y as i32);
     let x0 = first_centre(min_x).max(wx);
-    let x1 = last_centre(max_x).min(wx + window.width as i32 - 1);
+    let x1 = last_centre(max_x).min(wx.wrapping_add(window.width as i32).wrapping_sub(1));
     let y0 = first_centre(min_y).max(wy);
-    let y1 = last_centre(max_y).min(wy + window.height as i32 - 1);
+    let y1 = last_centre(max_y).min(wy.wrapping_add(window.height as i32).wrapping_sub(1));
     (x0 <= x1 && y0 <= y1).then_some([x0, x1, y0, y1])
 }
 
@@ -528,6 +529,43 @@ mod tests {
             seen += 1;
         });
         assert!(seen > 0);
+    }
+
+    #[test]
+    fn pixel_bounds_take_any_window_and_coordinates() {
+        let huge = [
+            usize::MAX,
+            1 << 40,
+            i32::MAX as usize,
+            (i32::MAX as usize) + 5,
+            0,
+            7,
+        ];
+        let ends = [i32::MIN, i32::MAX, 0, -1, 1 << 30];
+        for x in huge {
+            for width in huge {
+                let window = Window {
+                    x,
+                    y: x,
+                    width,
+                    height: width,
+                };
+                for a in ends {
+                    for b in ends {
+                        // Nonsense in, no panic (checked in debug builds, where overflow panics).
+                        let _ = pixel_bounds([[a, b], [b, a], [a, a]], &window);
+                    }
+                }
+            }
+        }
+        let frame = Window::full(8, 8);
+        assert_eq!(
+            pixel_bounds(
+                [[0, 0], [8 * SUBPIXEL_ONE, 0], [0, 8 * SUBPIXEL_ONE]],
+                &frame
+            ),
+            Some([0, 7, 0, 7])
+        );
     }
 
     proptest::proptest! {
