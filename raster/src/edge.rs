@@ -102,7 +102,15 @@ pub enum Coverage {
     Scanned,
     /// Zero area after snapping, or back-facing with [`Facing::Front`].
     Culled,
+    /// A coordinate beyond [`MAX_COORDINATE`], where the edge functions would not fit their
+    /// integers: nothing drawn.
+    OutOfRange,
 }
+
+/// The largest snapped coordinate [`fill_triangle`] takes, either sign: 2^21 pixels, far past
+/// any guard band (the vertex stage's stay below 2^14 pixels), and small enough that every
+/// edge function and area stays inside an `i64`.
+pub const MAX_COORDINATE: i32 = 1 << 29;
 
 /// Twice the signed area in snapped units; negative for triangles that are counter-clockwise in
 /// device coordinates (front-facing), because screen y grows downwards.
@@ -297,6 +305,10 @@ pub fn fill_triangle<P: Pixel, D: Depth, F>(
 where
     F: FnMut(&mut P, &mut D, Fragment<'_>),
 {
+    let within = |c: i32| (-MAX_COORDINATE..=MAX_COORDINATE).contains(&c);
+    if !tri.iter().all(|v| within(v.x) && within(v.y)) {
+        return Coverage::OutOfRange;
+    }
     let area = signed_area2(tri);
     if !facing.draws(area) {
         return Coverage::Culled;
@@ -529,6 +541,26 @@ mod tests {
             seen += 1;
         });
         assert!(seen > 0);
+    }
+
+    #[test]
+    fn fill_triangle_refuses_coordinates_past_its_range() {
+        let mut color = [Rgba8::default(); 16];
+        let mut depth = [0u32; 16];
+        let mut t = Target::new(&mut color, &mut depth, 4, 4).unwrap();
+        for far in [i32::MIN, i32::MAX, MAX_COORDINATE + 1, -MAX_COORDINATE - 1] {
+            let tri = [sv(0, 0), sv(far, 0), sv(0, far)];
+            assert_eq!(
+                fill_triangle(&mut t, &tri, Facing::Both, |_, _, _| {}),
+                Coverage::OutOfRange
+            );
+        }
+        // At the range's ends, every edge function fits: scanned without an overflow (debug).
+        let m = MAX_COORDINATE;
+        let tri = [sv(-m, -m), sv(m, -m), sv(0, m)];
+        let mut covered = 0;
+        let c = fill_triangle(&mut t, &tri, Facing::Both, |_, _, _| covered += 1);
+        assert_eq!((c, covered), (Coverage::Scanned, 16));
     }
 
     #[test]
