@@ -45,6 +45,11 @@ fn quantized_axis(a: Vec3d) -> Vec3d {
     from_f32(oct_decode(x, y))
 }
 
+/// Node `i`'s position as stored, widened.
+fn at(nodes: &[Node], i: u32) -> Vec3d {
+    from_f32(nodes[i as usize].position)
+}
+
 /// Angle between two unit vectors.
 fn angle(a: Vec3d, b: Vec3d) -> f64 {
     libm::atan2(len(cross(a, b)), dot(a, b))
@@ -105,50 +110,52 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, mut e: Engine<'_>, on_border: &Border
         }
     }
     drop(face_id);
-    // Positions as stored (f32) are what the bounds are measured from.
-    let pos: Vec<Vec3d> = nodes.iter().map(|n| from_f32(n.position)).collect();
+    // Positions as stored (f32) are what the bounds are measured from: read from the nodes
+    // (`at`), not copied, since this is where the build's memory peaks.
 
     // Leaves: radius to the farthest neighbour, cone around the incident triangles' normals.
     let mut radius = vec![0.0f64; m];
     let mut axis = vec![[0.0f64; 3]; m];
     let mut half = vec![0.0f64; m];
     let mut weight = vec![0.0f64; m];
-    let mut face_normals = Vec::with_capacity(mesh.triangles.len());
+    let face_normal = |t: &[u32; 3]| {
+        let [a, b, c] = t.map(|i| at(&nodes, i));
+        cross(sub(b, a), sub(c, a))
+    };
     for t in mesh.triangles {
-        let [a, b, c] = t.map(|i| pos[i as usize]);
-        let n = cross(sub(b, a), sub(c, a));
-        face_normals.push(normalize(n));
+        let n = face_normal(t);
         for &v in t {
-            let v = v as usize;
-            axis[v] = add(axis[v], n);
-            weight[v] += len(n);
+            axis[v as usize] = add(axis[v as usize], n);
+            weight[v as usize] += len(n);
             for &w in t {
-                radius[v] = radius[v].max(len(sub(pos[w as usize], pos[v])));
+                radius[v as usize] = radius[v as usize].max(len(sub(at(&nodes, w), at(&nodes, v))));
             }
         }
     }
     for a in axis.iter_mut().take(leaves) {
         *a = quantized_axis(normalize(*a).unwrap_or([0.0, 0.0, 1.0]));
     }
-    for (t, n) in mesh.triangles.iter().zip(&face_normals) {
+    // The unit normals again rather than kept from the loop above (32 bytes a triangle).
+    for t in mesh.triangles {
+        let n = normalize(face_normal(t));
         for &v in t {
             let v = v as usize;
             half[v] = half[v].max(n.map_or(core::f64::consts::PI, |n| angle(axis[v], n)));
         }
     }
-    drop(face_normals);
     // Parents, in formation order (children first).
     for c in &e.collapses {
         let p = c.parent as usize;
         let [a, b] = c.children.map(|x| x as usize);
+        let pos = |i: usize| at(&nodes, i as u32);
         radius[p] =
-            (len(sub(pos[a], pos[p])) + radius[a]).max(len(sub(pos[b], pos[p])) + radius[b]);
+            (len(sub(pos(a), pos(p))) + radius[a]).max(len(sub(pos(b), pos(p))) + radius[b]);
         weight[p] = weight[a] + weight[b];
         let sum = add(
             scale(axis[a], weight[a].max(1e-30)),
             scale(axis[b], weight[b].max(1e-30)),
         );
-        axis[p] = match kept(e.opts, pos[p], [pos[a], pos[b]]) {
+        axis[p] = match kept(e.opts, pos(p), [pos(a), pos(b)]) {
             Some(k) => axis[[a, b][k]],
             None => quantized_axis(normalize(sum).unwrap_or(axis[a])),
         };
@@ -194,14 +201,14 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, mut e: Engine<'_>, on_border: &Border
         let (s, t) = range[p];
         let below = &order[s as usize..t as usize];
         let own = if e.opts.bound == ErrorBound::Offset {
-            offset_bound(below, &pos, pos[p], n, on_border)
+            offset_bound(below, &nodes, at(&nodes, p as u32), n, on_border)
         } else {
             let start = k.checked_sub(1).map_or(0, |j| e.fan_ends[j] as usize);
             let fan = &e.fans[start..e.fan_ends[k] as usize];
             errors.clear();
             errors.extend(below.iter().map(|&leaf| {
-                let x = pos[leaf as usize];
-                let d = sub(x, nearest(x, fan, &pos).unwrap_or(pos[p]));
+                let x = at(&nodes, leaf);
+                let d = sub(x, nearest(x, fan, &nodes).unwrap_or(at(&nodes, p as u32)));
                 (up(dot(d, n).abs()), up(len(cross(d, n))))
             }));
             match e.opts.bound {
@@ -241,14 +248,14 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, mut e: Engine<'_>, on_border: &Border
 /// [`ErrorBound::Offset`] of a node at `center` with normal `n` over the leaves `below`.
 fn offset_bound(
     below: &[u32],
-    pos: &[Vec3d],
+    nodes: &[Node],
     center: Vec3d,
     n: Vec3d,
     on_border: &Borders,
 ) -> [f32; 2] {
     let (mut along, mut outline) = (0.0f64, 0.0f64);
     for &leaf in below {
-        let d = sub(pos[leaf as usize], center);
+        let d = sub(at(nodes, leaf), center);
         along = along.max(dot(d, n).abs());
         if on_border.contains(leaf) {
             outline = outline.max(len(cross(d, n)));
@@ -266,12 +273,12 @@ fn offset_bound(
     [up(along), up(along.max(outline))]
 }
 
-/// The closest point to `x` on the triangles `fan` (corners in `pos`), or `None` for no
-/// triangle.
-fn nearest(x: Vec3d, fan: &[[u32; 3]], pos: &[Vec3d]) -> Option<Vec3d> {
+/// The closest point to `x` on the triangles `fan` (corners at `nodes`' positions), or `None`
+/// for no triangle.
+fn nearest(x: Vec3d, fan: &[[u32; 3]], nodes: &[Node]) -> Option<Vec3d> {
     fan.iter()
         .map(|t| {
-            let corners = t.map(|v| pos[v as usize]);
+            let corners = t.map(|v| at(nodes, v));
             let (w, d2) = closest(x, corners);
             (d2, point(corners, w))
         })
