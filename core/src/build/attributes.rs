@@ -67,7 +67,7 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, mut e: Engine<'_>, on_border: &Border
             position: if i < leaves {
                 mesh.positions[i]
             } else {
-                to_f32(e.pos[i])
+                to_f32(e.pos.get(i as u32))
             },
             parent: NONE,
             children: [NONE; 2],
@@ -79,7 +79,7 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, mut e: Engine<'_>, on_border: &Border
         })
         .collect();
     // The collapse-time positions and colours are in the nodes now.
-    e.pos = Vec::new();
+    e.pos.release();
     e.color = Vec::new();
     // Triangle ids as the file numbers them: the base triangles first, then two per split.
     let base_count = e.face_alive.iter().filter(|&&a| a).count() as u32;

@@ -12,10 +12,11 @@ use alloc::vec::Vec;
 
 use super::closest::Surface;
 use super::flatten::{flatten, PlanarCollapse};
+use super::positions::Positions;
 use super::quadric::{place, Quadric};
 use super::queue::CostQueue;
 use super::rejected::Rejected;
-use super::vec3::{add, cross, dot, from_f32, len, normalize, scale, sub, Vec3d};
+use super::vec3::{add, cross, dot, len, normalize, scale, sub, Vec3d};
 use super::{BuildOptions, Cost, ErrorBound, InputMesh, Placement, NONE};
 
 /// What one collapse did, enough to undo it by a vertex split.
@@ -36,7 +37,7 @@ pub struct Collapse {
 
 pub(crate) struct Engine<'o> {
     pub opts: &'o BuildOptions,
-    pub pos: Vec<Vec3d>,
+    pub pos: Positions<'o>,
     /// Quadric and area of each live vertex, by its slot (as are its faces and ring below): a
     /// collapse's vertex takes its first child's slot, so there are never more slots than input
     /// vertices.
@@ -135,15 +136,16 @@ fn after(t: [u32; 3], v: u32) -> Option<(u32, u32)> {
     }
 }
 
-fn face_normal(p: &[Vec3d], f: [u32; 3]) -> Vec3d {
-    let [a, b, c] = f.map(|i| p[i as usize]);
+fn face_normal(p: &Positions<'_>, f: [u32; 3]) -> Vec3d {
+    let [a, b, c] = f.map(|i| p.get(i));
     cross(sub(b, a), sub(c, a))
 }
 
 impl<'o> Engine<'o> {
-    pub fn new(mesh: &InputMesh<'_>, opts: &'o BuildOptions) -> Engine<'o> {
+    pub fn new(mesh: &InputMesh<'o>, opts: &'o BuildOptions) -> Engine<'o> {
         let n = mesh.positions.len();
-        let pos: Vec<Vec3d> = mesh.positions.iter().map(|&p| from_f32(p)).collect();
+        // Every collapse makes one vertex id and at most n - 1 are made.
+        let pos = Positions::new(mesh.positions, n.saturating_sub(1));
         let faces = mesh.triangles.to_vec();
         // Each vertex's faces and neighbours in lists of their exact length (grown by pushing,
         // they took a sixth of the build's instructions and held twice the room).
@@ -166,7 +168,7 @@ impl<'o> Engine<'o> {
         let mut quadric = vec![Quadric::default(); n];
         let mut area = vec![0.0; n];
         for tri in &faces {
-            let [a, b, c] = tri.map(|i| pos[i as usize]);
+            let [a, b, c] = tri.map(|i| pos.get(i));
             let q = Quadric::triangle(a, b, c);
             let ar = 0.5 * len(cross(sub(b, a), sub(c, a)));
             for &v in tri {
@@ -224,7 +226,6 @@ impl<'o> Engine<'o> {
         // Every collapse makes one vertex id and at most n - 1 are made: the per-id arrays are
         // sized once, so that none doubles (and, while it is copied, holds both sizes) mid-build.
         let ids = n.saturating_sub(1);
-        e.pos.reserve_exact(ids);
         e.slot.reserve_exact(ids);
         e.color
             .reserve_exact(if e.color.is_empty() { 0 } else { ids });
@@ -237,7 +238,7 @@ impl<'o> Engine<'o> {
                 let (a, b) = (tri[k], tri[(k + 1) % 3]);
                 if e.edge_faces(a, b).1 == 0 {
                     let n = normalize(face_normal(&e.pos, tri)).unwrap_or([0.0; 3]);
-                    let q = Quadric::boundary(e.pos[a as usize], e.pos[b as usize], n, 16.0);
+                    let q = Quadric::boundary(e.pos.get(a), e.pos.get(b), n, 16.0);
                     for v in [a, b] {
                         e.quadric[v as usize] = e.quadric[v as usize].add(&q);
                     }
@@ -342,8 +343,8 @@ impl<'o> Engine<'o> {
         self.corners = (0..self.pos.len() as u32)
             .map(|v| match self.boundary_neighbours(v).as_slice() {
                 &[x, y] => {
-                    let at = self.pos[v as usize];
-                    let (dx, dy) = (sub(at, self.pos[x as usize]), sub(self.pos[y as usize], at));
+                    let at = self.pos.get(v);
+                    let (dx, dy) = (sub(at, self.pos.get(x)), sub(self.pos.get(y), at));
                     let (lx, ly) = (len(dx), len(dy));
                     !(lx > 0.0 && ly > 0.0 && dot(dx, dy) / (lx * ly) > turn)
                 }
@@ -355,13 +356,13 @@ impl<'o> Engine<'o> {
     /// Whether the vertex that merges `a` and `b` at `v` is on a corner: one of them was, and
     /// `v` is where it was.
     fn corner_at(&self, a: u32, b: u32, v: Vec3d) -> bool {
-        let (pa, pb) = (self.pos[a as usize], self.pos[b as usize]);
+        let (pa, pb) = (self.pos.get(a), self.pos.get(b));
         (self.corners[a as usize] && v == pa) || (self.corners[b as usize] && v == pb)
     }
 
     /// Where the merged vertex goes and what the collapse costs.
     fn evaluate(&self, a: u32, b: u32) -> (Vec3d, f64) {
-        let (pa, pb) = (self.pos[a as usize], self.pos[b as usize]);
+        let (pa, pb) = (self.pos.get(a), self.pos.get(b));
         let q = self.quadric[self.at(a)].add(&self.quadric[self.at(b)]);
         let len2 = dot(sub(pa, pb), sub(pa, pb));
         let v = match (self.opts.placement, self.opts.cost) {
@@ -495,7 +496,7 @@ impl<'o> Engine<'o> {
                     continue;
                 }
                 let before = face_normal(&self.pos, t);
-                let moved = t.map(|i| if i == s { v } else { self.pos[i as usize] });
+                let moved = t.map(|i| if i == s { v } else { self.pos.get(i) });
                 let after = cross(sub(moved[1], moved[0]), sub(moved[2], moved[0]));
                 let (lb, la) = (len(before), len(after));
                 let kept = la > 1e-12 * lb && dot(before, after) > 0.0;
@@ -503,7 +504,7 @@ impl<'o> Engine<'o> {
                     return Ok(false);
                 }
                 if self.min_shape > 0.0 {
-                    worst_before = worst_before.min(shape(t.map(|i| self.pos[i as usize])));
+                    worst_before = worst_before.min(shape(t.map(|i| self.pos.get(i))));
                     worst_after = worst_after.min(shape(moved));
                 }
             }
@@ -579,7 +580,7 @@ impl<'o> Engine<'o> {
         ids.sort_unstable();
         ids.dedup();
         let before = ids.iter().map(|&f| (f, self.faces[f as usize])).collect();
-        let pos = |x: u32| self.pos[x as usize];
+        let pos = |x: u32| self.pos.get(x);
         let parent = self.pos.len() as u32;
         match flatten(before, [a, b], parent, v, &pos) {
             Some(map) => {
@@ -618,7 +619,7 @@ impl<'o> Engine<'o> {
         self.area[sa] = area_a + area_b;
         self.slot.push(sa as u32);
         if !self.color.is_empty() {
-            let c = match kept(self.opts, v, [self.pos[ia], self.pos[ib]]) {
+            let c = match kept(self.opts, v, [self.pos.get(a), self.pos.get(b)]) {
                 Some(k) => self.color[[ia, ib][k]],
                 None => {
                     let (wa, wb) = (area_a.max(1e-30), area_b.max(1e-30));

@@ -45,6 +45,7 @@ pub(crate) mod closest;
 pub(crate) mod collapse;
 pub(crate) mod flatten;
 mod input;
+mod positions;
 mod quadric;
 mod queue;
 mod rejected;

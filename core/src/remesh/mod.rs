@@ -242,7 +242,7 @@ pub fn remesh(
                 let v = t[k] as usize;
                 if number[v] == NONE {
                     number[v] = base_positions.len() as u32;
-                    base_positions.push(engine.pos[v].map(|x| x as f32));
+                    base_positions.push(engine.pos.get(v as u32).map(|x| x as f32));
                     let mut w = [0.0; 3];
                     w[k] = 1.0;
                     corner_of.push(Located { face: f, w });
