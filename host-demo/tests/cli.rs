@@ -767,10 +767,12 @@ fn reproduce_terrain_reduces_refines_and_compares_the_costs() {
             let n: u32 = field(l, "triangles");
             assert!(n == want || n == want + 1, "{l}");
         }
-        // The colour cost keeps the colormap's edges: seen from above, where colour is all
-        // there is to see, it beats QEM by several dB.
+        // Seen from above, where colour is all there is to see, the two costs come within a
+        // dB of each other (25%: colour 27.8, QEM 27.4 dB; 10%: 24.2 and 25.1). QEM keeps the
+        // island's outline by its boundary quadrics: without them its border crept inwards and
+        // it scored 8 dB below the colour cost from above.
         let (c, q): (f64, f64) = (field(&color, "psnr_top_db"), field(&qem, "psnr_top_db"));
-        assert!(c > q + 2.0, "{color}\n{qem}");
+        assert!((c - q).abs() < 2.0, "{color}\n{qem}");
     }
     let refined = "10%+importance";
     let paper = line("color", refined, Some("paper"));

@@ -231,12 +231,13 @@ impl<'o> Engine<'o> {
             .reserve_exact(if e.color.is_empty() { 0 } else { ids });
         e.alive.reserve_exact(ids);
         e.collapses.reserve_exact(ids);
-        // Boundary quadrics keep open borders in place.
+        // Boundary quadrics keep open borders in place: on a border edge, the face itself is
+        // the only one.
         for f in 0..e.faces.len() {
             let tri = e.faces[f];
             for k in 0..3 {
                 let (a, b) = (tri[k], tri[(k + 1) % 3]);
-                if e.edge_faces(a, b).1 == 0 {
+                if e.edge_faces(a, b).1 == 1 {
                     let n = normalize(face_normal(&e.pos, tri)).unwrap_or([0.0; 3]);
                     let q = Quadric::boundary(e.pos.get(a), e.pos.get(b), n, 16.0);
                     for v in [a, b] {

@@ -141,6 +141,37 @@ fn open_grid_round_trips_and_keeps_its_border() {
     }
 }
 
+/// A flat square simplified to four vertices still covers the square: on a plane every
+/// collapse costs nothing but for the boundary quadrics, which alone keep a border vertex from
+/// moving inwards and a corner from moving at all. (Past four, a corner has to go.)
+#[test]
+fn flat_square_keeps_its_outline() {
+    let (mut p, t) = grid(10);
+    for v in p.iter_mut() {
+        v[2] = 0.0;
+    }
+    for placement in [Placement::Cost, Placement::Endpoint] {
+        for balanced in [false, true] {
+            let opts = BuildOptions {
+                placement,
+                balanced,
+                base_vertices: 4,
+                ..BuildOptions::default()
+            };
+            let h = build_it(&p, &t, opts);
+            let area: f64 = h
+                .base_triangles
+                .iter()
+                .map(|tri| {
+                    let [a, b, c] = tri.map(|v| h.nodes[v as usize].position.map(f64::from));
+                    0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]))
+                })
+                .sum();
+            assert!((area - 1.0).abs() < 1e-6, "{placement:?} {balanced}: area {area}");
+        }
+    }
+}
+
 #[test]
 fn sphere_round_trips_keeps_genus_and_stays_shallow_when_balanced() {
     let (p, t) = sphere(4); // 1026 vertices, 2048 triangles
