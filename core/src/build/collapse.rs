@@ -232,12 +232,14 @@ impl<'o> Engine<'o> {
         e.alive.reserve_exact(ids);
         e.collapses.reserve_exact(ids);
         // Boundary quadrics keep open borders in place: on a border edge, the face itself is
-        // the only one.
+        // the only one. Both its ends are border vertices, which have fewer faces than
+        // neighbours: that test spares the other edges the search of a fan.
         for f in 0..e.faces.len() {
             let tri = e.faces[f];
             for k in 0..3 {
                 let (a, b) = (tri[k], tri[(k + 1) % 3]);
-                if e.edge_faces(a, b).1 == 1 {
+                let border = |v: u32| e.vfaces[v as usize].len() < e.vverts[v as usize].len();
+                if border(a) && border(b) && e.edge_faces(a, b).1 == 1 {
                     let n = normalize(face_normal(&e.pos, tri)).unwrap_or([0.0; 3]);
                     let q = Quadric::boundary(e.pos.get(a), e.pos.get(b), n, 16.0);
                     for v in [a, b] {
