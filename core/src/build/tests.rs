@@ -167,7 +167,10 @@ fn flat_square_keeps_its_outline() {
                     0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]))
                 })
                 .sum();
-            assert!((area - 1.0).abs() < 1e-6, "{placement:?} {balanced}: area {area}");
+            assert!(
+                (area - 1.0).abs() < 1e-6,
+                "{placement:?} {balanced}: area {area}"
+            );
         }
     }
 }
