@@ -271,8 +271,8 @@ enum Experiment {
     /// adaptation time, file and cut sizes.
     TerrainEngines,
     /// Both engines on a 1025 x 1025 terrain at Lindstrom et al.'s tolerances (0.5, 1, 2,
-    /// 4 px): triangles and the share of pixels differing from full detail (takes minutes and
-    /// about 1.5 GB).
+    /// 4 px): triangles and the share of pixels differing from full detail (takes about a
+    /// minute and 500 MB).
     TerrainTolerances,
     /// The wavelet paper, §3.1: textures over the parametric domain. Both engines at equal
     /// triangles on the 257 x 257 terrain's fly-over, drawn with its colours as a texture, with a
