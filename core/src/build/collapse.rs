@@ -238,8 +238,7 @@ impl<'o> Engine<'o> {
             let tri = e.faces[f];
             for k in 0..3 {
                 let (a, b) = (tri[k], tri[(k + 1) % 3]);
-                let border = |v: u32| e.vfaces[v as usize].len() < e.vverts[v as usize].len();
-                if border(a) && border(b) && e.edge_faces(a, b).1 == 1 {
+                if e.on_border(a) && e.on_border(b) && e.edge_faces(a, b).1 == 1 {
                     let n = normalize(face_normal(&e.pos, tri)).unwrap_or([0.0; 3]);
                     let q = Quadric::boundary(e.pos.get(a), e.pos.get(b), n, 16.0);
                     for v in [a, b] {
@@ -290,6 +289,12 @@ impl<'o> Engine<'o> {
     /// The slot of live vertex `v` (its quadric, area, faces and ring).
     fn at(&self, v: u32) -> usize {
         self.slot[v as usize] as usize
+    }
+
+    /// Whether live vertex `v` is on a border: in a manifold fan an inner vertex has as many
+    /// triangles as neighbours, a border vertex one fewer.
+    pub fn on_border(&self, v: u32) -> bool {
+        self.vfaces[self.at(v)].len() < self.neighbours(v).len()
     }
 
     /// Sorted distinct neighbours of a live vertex.
@@ -364,7 +369,7 @@ impl<'o> Engine<'o> {
     }
 
     /// Where the merged vertex goes and what the collapse costs.
-    fn evaluate(&self, a: u32, b: u32) -> (Vec3d, f64) {
+    pub fn evaluate(&self, a: u32, b: u32) -> (Vec3d, f64) {
         let (pa, pb) = (self.pos.get(a), self.pos.get(b));
         let q = self.quadric[self.at(a)].add(&self.quadric[self.at(b)]);
         let len2 = dot(sub(pa, pb), sub(pa, pb));
@@ -377,9 +382,8 @@ impl<'o> Engine<'o> {
         let v = if self.corners.is_empty() {
             v
         } else {
-            let border = |x: u32| self.vfaces[self.at(x)].len() < self.neighbours(x).len();
             let corner = |x: u32| self.corners[x as usize];
-            match (border(a), border(b), corner(a), corner(b)) {
+            match (self.on_border(a), self.on_border(b), corner(a), corner(b)) {
                 (true, false, ..) | (true, true, true, false) => pa,
                 (false, true, ..) | (true, true, false, true) => pb,
                 _ => v,

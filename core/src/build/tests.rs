@@ -175,6 +175,80 @@ fn flat_square_keeps_its_outline() {
     }
 }
 
+/// Under the remesher's border rules ([`collapse::Engine::keep_borders`]) an edge from the
+/// border inwards merges onto its border end, and a border edge at a corner onto the corner,
+/// exactly: the border is where the input's is, whatever the quadrics would prefer.
+#[test]
+fn border_rules_merge_onto_the_border_end_and_the_corner() {
+    let (p, t) = grid(10);
+    let mesh = InputMesh {
+        positions: &p,
+        colors: None,
+        triangles: &t,
+    };
+    let opts = BuildOptions::default();
+    let mut e = collapse::Engine::new(&mesh, &opts);
+    e.keep_borders();
+    // The grid's corners are the border's only turns, and stay where they are.
+    let corner = |q: vec3::Vec3d| (q[0] == 0.0 || q[0] == 1.0) && (q[1] == 0.0 || q[1] == 1.0);
+    let (mut inwards, mut at_corners) = (0, 0);
+    loop {
+        let border: Vec<bool> = (0..e.pos.len() as u32)
+            .map(|v| e.alive[v as usize] && e.on_border(v))
+            .collect();
+        if !e.step() {
+            break;
+        }
+        let c = e.collapses.last().expect("a step collapses");
+        let [a, b] = c.children;
+        let (pa, pb, v) = (e.pos.get(a), e.pos.get(b), e.pos.get(c.parent));
+        let (ba, bb) = (border[a as usize], border[b as usize]);
+        if ba != bb {
+            assert_eq!(v, if ba { pa } else { pb }, "{a}-{b}");
+            inwards += 1;
+        } else if ba && corner(pa) != corner(pb) {
+            assert_eq!(v, if corner(pa) { pa } else { pb }, "{a}-{b}");
+            at_corners += 1;
+        }
+    }
+    assert!(inwards > 0 && at_corners > 0, "{inwards} {at_corners}");
+}
+
+/// The importance paper's colour cost, `Gerr^2 + length^2 + sqrt(length * dcolor)`, with the
+/// merged vertex at the edge's midpoint. On the input every edge's midpoint lies on the surface
+/// (`Gerr` = 0), so the length and the colour difference (channels in 0..=1) make it.
+#[test]
+fn colour_cost_is_the_papers_formula() {
+    let p = [
+        [0.0, 0.0, 0.0],
+        [2.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [2.0, 1.0, 0.5],
+    ];
+    let t = [[0, 1, 3], [0, 3, 2]];
+    let colors = [[255, 0, 0], [0, 0, 255], [255, 0, 0], [0, 255, 0]];
+    let mesh = InputMesh {
+        positions: &p,
+        colors: Some(&colors),
+        triangles: &t,
+    };
+    let opts = BuildOptions {
+        cost: Cost::Color,
+        ..BuildOptions::default()
+    };
+    let e = collapse::Engine::new(&mesh, &opts);
+    // Length 2, colours red and blue: dcolor = sqrt(2).
+    let (v, cost) = e.evaluate(0, 1);
+    assert_eq!(v, [1.0, 0.0, 0.0]);
+    let want = 4.0 + libm::sqrt(2.0 * libm::sqrt(2.0));
+    assert!((cost - want).abs() < 1e-9, "{cost} {want}");
+    // Length sqrt(5.25) along the diagonal, colours red and green.
+    let (v, cost) = e.evaluate(0, 3);
+    assert_eq!(v, [1.0, 0.5, 0.25]);
+    let want = 5.25 + libm::sqrt(libm::sqrt(5.25) * libm::sqrt(2.0));
+    assert!((cost - want).abs() < 1e-9, "{cost} {want}");
+}
+
 #[test]
 fn sphere_round_trips_keeps_genus_and_stays_shallow_when_balanced() {
     let (p, t) = sphere(4); // 1026 vertices, 2048 triangles
