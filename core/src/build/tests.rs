@@ -247,6 +247,12 @@ fn colour_cost_is_the_papers_formula() {
     assert_eq!(v, [1.0, 0.5, 0.25]);
     let want = 5.25 + libm::sqrt(libm::sqrt(5.25) * libm::sqrt(2.0));
     assert!((cost - want).abs() < 1e-9, "{cost} {want}");
+    // Across the other diagonal (no edge), the midpoint lies off the surface: 0.5 / sqrt(5)
+    // below the plane -y + 2z = 0 of triangle 0-1-3, over that triangle, so Gerr^2 = 1/20.
+    let (v, cost) = e.evaluate(1, 2);
+    assert_eq!(v, [1.0, 0.5, 0.0]);
+    let want = 0.05 + 5.0 + libm::sqrt(libm::sqrt(5.0) * libm::sqrt(2.0));
+    assert!((cost - want).abs() < 1e-9, "{cost} {want}");
 }
 
 #[test]
