@@ -417,7 +417,7 @@ impl<'o> Engine<'o> {
 
     /// Whether collapsing `a-b` into `v` keeps the mesh a manifold of the same topology with no
     /// flipped or degenerate triangle. `Err(())` means legal but for region-of-influence marks.
-    fn legal(&self, a: u32, b: u32, v: Vec3d) -> Result<bool, ()> {
+    pub fn legal(&self, a: u32, b: u32, v: Vec3d) -> Result<bool, ()> {
         let (wings, count) = self.edge_faces(a, b);
         if count == 0 {
             return Ok(false);

@@ -214,6 +214,28 @@ fn border_rules_merge_onto_the_border_end_and_the_corner() {
     assert!(inwards > 0 && at_corners > 0, "{inwards} {at_corners}");
 }
 
+/// A collapse that would turn a triangle over is illegal even when none loses its area: on a
+/// flat grid, merging two inner vertices at their midpoint is legal, and at a point beyond
+/// their neighbours, where the fans fold over, it is not.
+#[test]
+fn a_collapse_that_turns_a_triangle_over_is_illegal() {
+    let (mut p, t) = grid(3);
+    for v in p.iter_mut() {
+        v[2] = 0.0;
+    }
+    let mesh = InputMesh {
+        positions: &p,
+        colors: None,
+        triangles: &t,
+    };
+    let opts = BuildOptions::default();
+    let e = collapse::Engine::new(&mesh, &opts);
+    // Vertices 5 and 6 are the inner (1/3, 1/3) and (2/3, 1/3).
+    assert_eq!(e.legal(5, 6, [0.5, 1.0 / 3.0, 0.0]), Ok(true));
+    assert_eq!(e.legal(5, 6, [0.5, 1.5, 0.0]), Ok(false));
+    assert_eq!(e.legal(5, 6, [0.5, -0.8, 0.0]), Ok(false));
+}
+
 /// The importance paper's colour cost, `Gerr^2 + length^2 + sqrt(length * dcolor)`, with the
 /// merged vertex at the edge's midpoint. On the input every edge's midpoint lies on the surface
 /// (`Gerr` = 0), so the length and the colour difference (channels in 0..=1) make it.
