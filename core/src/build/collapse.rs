@@ -452,10 +452,7 @@ impl<'o> Engine<'o> {
             return Ok(false);
         }
         let edge_on_border = count == 1;
-        // In a manifold fan an inner vertex has as many triangles as neighbours, a border vertex
-        // one fewer.
-        let border = |v: u32, ring: &[u32]| self.vfaces[self.at(v)].len() < ring.len();
-        let (ba, bb) = (border(a, na), border(b, nb));
+        let (ba, bb) = (self.on_border(a), self.on_border(b));
         if ba && bb && !edge_on_border {
             return Ok(false); // would pinch two borders (or a border and itself) together
         }
@@ -488,7 +485,11 @@ impl<'o> Engine<'o> {
         }
         for x in w.into_iter().flatten() {
             let ring = self.neighbours(x);
-            let min = if border(x, ring) { 3 + straight(x) } else { 4 };
+            let min = if self.on_border(x) {
+                3 + straight(x)
+            } else {
+                4
+            };
             if ring.len() < min {
                 return Ok(false);
             }

@@ -105,13 +105,17 @@ pub(crate) fn sphere(levels: u32) -> (Vec<[f32; 3]>, Vec<[u32; 3]>) {
     (p, t)
 }
 
-pub(crate) fn build_it(p: &[[f32; 3]], t: &[[u32; 3]], opts: BuildOptions) -> Hierarchy {
-    let mesh = InputMesh {
+/// Positions and triangles as a mesh without colours.
+pub(crate) fn input<'a>(p: &'a [[f32; 3]], t: &'a [[u32; 3]]) -> InputMesh<'a> {
+    InputMesh {
         positions: p,
         colors: None,
         triangles: t,
-    };
-    build(&mesh, &opts, &mut |_| {}).expect("valid mesh")
+    }
+}
+
+pub(crate) fn build_it(p: &[[f32; 3]], t: &[[u32; 3]], opts: BuildOptions) -> Hierarchy {
+    build(&input(p, t), &opts, &mut |_| {}).expect("valid mesh")
 }
 
 #[test]
@@ -181,11 +185,7 @@ fn flat_square_keeps_its_outline() {
 #[test]
 fn border_rules_merge_onto_the_border_end_and_the_corner() {
     let (p, t) = grid(10);
-    let mesh = InputMesh {
-        positions: &p,
-        colors: None,
-        triangles: &t,
-    };
+    let mesh = input(&p, &t);
     let opts = BuildOptions::default();
     let mut e = collapse::Engine::new(&mesh, &opts);
     e.keep_borders();
@@ -223,11 +223,7 @@ fn a_collapse_that_turns_a_triangle_over_is_illegal() {
     for v in p.iter_mut() {
         v[2] = 0.0;
     }
-    let mesh = InputMesh {
-        positions: &p,
-        colors: None,
-        triangles: &t,
-    };
+    let mesh = input(&p, &t);
     let opts = BuildOptions::default();
     let e = collapse::Engine::new(&mesh, &opts);
     // Vertices 5 and 6 are the inner (1/3, 1/3) and (2/3, 1/3).

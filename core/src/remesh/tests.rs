@@ -3,15 +3,7 @@
 use alloc::vec::Vec;
 
 use super::*;
-use crate::build::tests::{grid, sphere, topology};
-
-fn input<'a>(p: &'a [[f32; 3]], t: &'a [[u32; 3]]) -> InputMesh<'a> {
-    InputMesh {
-        positions: p,
-        colors: None,
-        triangles: t,
-    }
-}
+use crate::build::tests::{grid, input, sphere, topology};
 
 /// Checks what every remesh must be: the counts of its levels, its vertices on the input, the
 /// input's topology and no fold in the map.
