@@ -353,20 +353,17 @@ impl Stage<'_> {
             }
         }
 
-        // Clip space, in the order of `to_clip`: x, y, z columns, then the translation.
-        let mut clip = [[0.0f32; BATCH]; 4];
-        for (r, row) in clip.iter_mut().enumerate() {
-            for k in 0..BATCH {
-                row[k] = m[0][r] * p[0][k] + m[1][r] * p[1][k] + m[2][r] * p[2][k] + m[3][r];
-            }
-        }
+        let clip = transform(&m, &p);
         let mut light = [1.0f32; BATCH];
         if let Some(p) = lighting {
             p.intensities(&n, &mut light);
         }
-        let mut screen = [(0, 0, 0.0f32); BATCH];
-        for (k, s) in screen.iter_mut().enumerate() {
-            *s = viewport.project_xyz(clip[0][k], clip[1][k], clip[2][k], clip[3][k]);
+        // Attribute by attribute here too: an array of tuples would be vectorized vertex by
+        // vertex, with shuffles between the stages.
+        let (mut sx, mut sy, mut sz) = ([0i32; BATCH], [0i32; BATCH], [0.0f32; BATCH]);
+        for k in 0..BATCH {
+            (sx[k], sy[k], sz[k]) =
+                viewport.project_xyz(clip[0][k], clip[1][k], clip[2][k], clip[3][k]);
         }
         // Colour and outcode packed in one 32-bit lane (the record's last four bytes, little end
         // first), so that each record is stored as four words rather than byte by byte.
@@ -379,14 +376,33 @@ impl Stage<'_> {
         for (k, v) in out.iter_mut().enumerate() {
             let [r, g, b, outcode] = packed[k].to_le_bytes();
             *v = ShadedVertex {
-                x: screen[k].0,
-                y: screen[k].1,
-                z: screen[k].2,
+                x: sx[k],
+                y: sy[k],
+                z: sz[k],
                 rgb: [r, g, b],
                 outcode,
             };
         }
     }
+}
+
+/// Clip space of a batch of positions, in the order of `to_clip`: x, y, z columns, then the
+/// translation. Out of line, so that it is vectorized lane by lane on its own (inlined, the
+/// vectorizer laid the lanes out vertex by vertex for the stages after it, and shuffled them).
+#[inline(never)]
+fn transform(m: &[[f32; 4]; 4], p: &[[f32; BATCH]; 3]) -> [[f32; BATCH]; 4] {
+    core::array::from_fn(|r| {
+        let [a, b, c, d] = [m[0][r], m[1][r], m[2][r], m[3][r]];
+        let [x, y, z] = p;
+        let mut row = [0.0f32; BATCH];
+        for half in 0..BATCH / 4 {
+            for j in 0..4 {
+                let k = 4 * half + j;
+                row[k] = a * x[k] + b * y[k] + c * z[k] + d;
+            }
+        }
+        row
+    })
 }
 
 /// Rounds a colour channel to `0..=255`, ties to even (NaN becomes 0).
