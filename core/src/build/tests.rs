@@ -214,6 +214,45 @@ fn border_rules_merge_onto_the_border_end_and_the_corner() {
     assert!(inwards > 0 && at_corners > 0, "{inwards} {at_corners}");
 }
 
+/// Under the remesher's border rules only a corner may be left with a single triangle (an
+/// ear), neither the merged vertex nor a wing; without them both collapses below are legal.
+#[test]
+fn ears_are_left_only_at_corners() {
+    // b = 0, a = 1, w = 2, x = 3 (and y = 4): the border edge b-a has wing w, and b has no
+    // other triangle, so merging a and b leaves a single triangle at the merged vertex.
+    let p = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.5, 1.0, 0.0],
+        [2.0, 1.0, 0.0],
+        [1.5, 2.0, 0.0],
+    ];
+    let t = [[0, 1, 2], [1, 3, 2], [3, 4, 2]];
+    let opts = BuildOptions::default();
+    let mesh = input(&p, &t);
+    let mut e = collapse::Engine::new(&mesh, &opts);
+    let (mid, at_a) = ([0.5, 0.0, 0.0], [1.0, 0.0, 0.0]);
+    assert_eq!(e.legal(1, 0, mid), Ok(true));
+    e.keep_borders();
+    // a turns the border by 45 degrees (a corner), the midpoint of a-b is no corner.
+    assert_eq!(e.legal(1, 0, mid), Ok(false));
+    assert_eq!(e.legal(1, 0, at_a), Ok(true));
+    // Without y, and x on the line from b through w: w's border runs straight there, and
+    // merging a and b would leave w with a single triangle.
+    let p = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.5, 1.0, 0.0],
+        [1.0, 2.0, 0.0],
+    ];
+    let t = [[0, 1, 2], [1, 3, 2]];
+    let mesh = input(&p, &t);
+    let mut e = collapse::Engine::new(&mesh, &opts);
+    assert_eq!(e.legal(1, 0, at_a), Ok(true));
+    e.keep_borders();
+    assert_eq!(e.legal(1, 0, at_a), Ok(false));
+}
+
 /// A collapse that would turn a triangle over is illegal even when none loses its area: on a
 /// flat grid, merging two inner vertices at their midpoint is legal, and at a point beyond
 /// their neighbours, where the fans fold over, it is not.
