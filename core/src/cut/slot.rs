@@ -276,7 +276,7 @@ mod tests {
             x ^= x << 13;
             x ^= x >> 17;
             x ^= x << 5;
-            if x % 3 != 0 && len < 256 {
+            if !x.is_multiple_of(3) && len < 256 {
                 let item = (x % 64, step);
                 assert!(h.heap_push(item).is_ok());
                 kept[len] = item;
