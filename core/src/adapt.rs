@@ -363,6 +363,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
     ) -> Option<Settling> {
         self.candidates.clear();
         self.pairs.clear();
+        self.advance_blends();
         // Most vertices are far from wanting a split: the policy's envelope and the cut's digest
         // of the node (position and largest spheroid radius) prove it without reading the file,
         // and a vertex proven so that judges no pair is done with in the first pass. The others
@@ -718,14 +719,28 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         (asked, settled)
     }
 
-    /// Slot `i`'s own decisions (see [`Cut::evaluate`]) with its demand `d`: its blend advances,
-    /// its visibility moves, and it joins the split heap when over the threshold.
+    /// Every running blend advances a frame, before the walk decides anything: a pair whose
+    /// collapse is reversed restarts both children's blends from where they are, and the second
+    /// child must be where it is whether the walk reaches it before the first child or after
+    /// (advanced as the walk reached it, a frame came out otherwise in another slot order, and
+    /// [`Cut::renumber`] changed the frames after it).
+    fn advance_blends(&mut self) {
+        let mut k = 0;
+        while let Some(b) = self.blends.as_slice().get(k) {
+            let (s, before) = (b.slot as usize, self.blends.len());
+            if self.v.flags.get(s).is_some_and(|f| f & BLENDING != 0) {
+                self.advance(s);
+            }
+            // A split's blend that arrived was freed and the last entry moved into its place.
+            k += usize::from(self.blends.len() == before);
+        }
+    }
+
+    /// Slot `i`'s own decisions (see [`Cut::evaluate`]) with its demand `d`: its visibility
+    /// moves, and it joins the split heap when over the threshold.
     #[inline(always)]
     fn decide(&mut self, h: &HierarchyView<'_>, i: usize, d: Demand, frame: &mut Frame) {
         let t = frame.threshold;
-        if self.v.flags[i] & BLENDING != 0 {
-            self.advance(i);
-        }
         let node = self.v.node[i];
         let flags = self.v.flags[i];
         self.v.flags[i] = seen(flags, d.visible, self.geomorph_frames > 0);
