@@ -1012,7 +1012,19 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         let sphere_only = reads_spheres(policy);
         let mut traded = 0usize;
         let mut listed = false;
-        while let Some((bits, v)) = self.candidates.heap_pop() {
+        // Without a budget, an operation cap, geomorphs (whose blends' room may run out) or a
+        // policy that judges triangles (whose demand changes as neighbours split), every split
+        // over the threshold is done whatever the order: a split's children that want to split
+        // then go next, depth first, while their neighbourhood is in the cache, and skip the
+        // heap (past `DEPTH` waiting, they join it). The same cut, in the same slots for any
+        // numbering of them; otherwise every candidate goes largest error first.
+        const DEPTH: usize = 32;
+        let depth_first = budget.max_triangles == u32::MAX
+            && budget.max_ops == u32::MAX
+            && frames == 0
+            && !policy.judges_triangles();
+        let mut depth = heapless::Vec::<(u32, u32), DEPTH>::new();
+        while let Some((bits, v)) = depth.pop().or_else(|| self.candidates.heap_pop()) {
             let Some(s) = self.slot(v) else {
                 continue;
             };
@@ -1072,11 +1084,11 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                     let d = self.judged(h, cs as usize, &h.bounds_at(record), view, policy);
                     let flags = &mut self.v.flags[cs as usize];
                     *flags = (*flags & !VISIBLE) | kept(d.visible, frames > 0) as u8;
-                    if d.error > t
-                        && record.is_parent()
-                        && self.candidates.heap_push((d.error.to_bits(), c)).is_err()
-                    {
-                        frame.stats.queue_overflow = true;
+                    if d.error > t && record.is_parent() {
+                        let item = (d.error.to_bits(), c);
+                        let waiting = (depth_first && depth.push(item).is_ok())
+                            || self.candidates.heap_push(item).is_ok();
+                        frame.stats.queue_overflow |= !waiting;
                     }
                     if let Some(m) = settling.filter(|_| !record.is_parent()) {
                         let i = cs as usize;
