@@ -14,7 +14,9 @@
 //!    the cut the view asks for and a second call with the same view does nothing (a test over
 //!    the peer orbit at 0.25-4 px);
 //! 2. **refine**: vertices over tolerance are split largest error first (a priority queue), each
-//!    forcing the splits it depends on, and their children join the queue;
+//!    forcing the splits it depends on, and their children join the queue (when nothing can stop
+//!    refinement part way and the order cannot change the cut, the children go next, depth
+//!    first);
 //! 3. **budget**: splits stop at [`Budget::max_triangles`]; when the budget binds, pairs whose
 //!    parent's error is below the next split's are collapsed to make room, so the cut is the best
 //!    the budget allows. [`Budget::target_triangles`] regulates the error threshold from frame to
@@ -989,9 +991,9 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         sort_pairs(self.pairs.as_mut_slice());
     }
 
-    /// Splits the candidates largest error first, each forcing what it needs, within the
-    /// budget; when the budget binds, pairs whose parent is needed less than the next split are
-    /// collapsed to pay for it.
+    /// Splits the candidates largest error first (their children depth first when the order
+    /// cannot matter), each forcing what it needs, within the budget; when the budget binds,
+    /// pairs whose parent is needed less than the next split are collapsed to pay for it.
     #[inline(never)]
     fn refine<P: Policy>(
         &mut self,
