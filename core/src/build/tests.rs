@@ -214,6 +214,27 @@ fn border_rules_merge_onto_the_border_end_and_the_corner() {
     assert!(inwards > 0 && at_corners > 0, "{inwards} {at_corners}");
 }
 
+/// A border vertex may be left with two neighbours (one triangle, an ear) where an inner
+/// vertex may not: merging an inner vertex onto the border vertex it meets leaves a single
+/// triangle, and is legal, though the merged vertex keeps only two neighbours.
+#[test]
+fn a_merged_border_vertex_may_keep_two_neighbours() {
+    // A triangle a = 0, w0 = 1, w1 = 2 split around the inner vertex b = 3.
+    let p = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.3, 0.3, 0.0],
+    ];
+    let t = [[0, 1, 3], [1, 2, 3], [2, 0, 3]];
+    let opts = BuildOptions::default();
+    let mesh = input(&p, &t);
+    let e = collapse::Engine::new(&mesh, &opts);
+    assert!(e.on_border(0) && !e.on_border(3));
+    assert_eq!(e.legal(0, 3, [0.0, 0.0, 0.0]), Ok(true));
+    assert_eq!(e.legal(3, 0, [0.0, 0.0, 0.0]), Ok(true));
+}
+
 /// Under the remesher's border rules only a corner may be left with a single triangle (an
 /// ear), neither the merged vertex nor a wing; without them both collapses below are legal.
 #[test]
