@@ -1018,8 +1018,9 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         // policy that judges triangles (whose demand changes as neighbours split), every split
         // over the threshold is done whatever the order: a split's children that want to split
         // then go next, depth first, while their neighbourhood is in the cache, and skip the
-        // heap (past `DEPTH` waiting, they join it). The same cut, in the same slots for any
-        // numbering of them; otherwise every candidate goes largest error first.
+        // heap (past `DEPTH` waiting, they join it). The same cut as largest error first, in
+        // other slots; the order follows nodes and errors only, never slots, so a renumbered cut
+        // refines alike. Otherwise every candidate goes largest error first.
         const DEPTH: usize = 32;
         let depth_first = budget.max_triangles == u32::MAX
             && budget.max_ops == u32::MAX
