@@ -103,7 +103,7 @@ pub struct Budget {
     /// Active vertices asked per frame at most: the LOD lecture's amortization, the traversal
     /// spread over frames. Each frame asks the next `max_visits` vertices of the active list,
     /// going on where the previous frame stopped and wrapping round; vertices in a geomorph are
-    /// asked every frame besides (their blends advance). Below the active count, frames do not
+    /// asked every frame besides (a blend may turn back). Below the active count, frames do not
     /// skip settled vertices (the window is the saving instead). The vertex cut only.
     pub max_visits: u32,
 }
@@ -351,7 +351,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         stats
     }
 
-    /// One pass over the active vertices: blends advance, the policy speaks for every vertex
+    /// One pass over the active vertices: blends advance first, the policy speaks for every vertex
     /// (split candidates go to the heap) and every sibling pair (collapse candidates to the
     /// pair list).
     #[inline(never)]
@@ -721,11 +721,10 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         (asked, settled)
     }
 
-    /// Every running blend advances a frame, before the walk decides anything: a pair whose
-    /// collapse is reversed restarts both children's blends from where they are, and the second
-    /// child must be where it is whether the walk reaches it before the first child or after
-    /// (advanced as the walk reached it, a frame came out otherwise in another slot order, and
-    /// [`Cut::renumber`] changed the frames after it).
+    /// Every running blend advances a frame, before the walk decides anything. A pair whose
+    /// collapse is reversed restarts both children's blends from where they are; advanced as
+    /// the walk reached it, the second child was a frame further or not depending on whether
+    /// its slot came before the first child's, so frames depended on the slot order.
     fn advance_blends(&mut self) {
         let mut k = 0;
         while let Some(b) = self.blends.as_slice().get(k) {
