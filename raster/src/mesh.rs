@@ -71,9 +71,12 @@ pub trait MeshSource {
     /// Vertex `i` (below [`MeshSource::vertex_count`]).
     fn vertex(&self, i: usize) -> SourceVertex;
     /// Vertices `first..first + len` (`len` at most [`BATCH`], all below
-    /// [`MeshSource::vertex_count`]) into the first `len` lanes of `out`, which arrives zeroed:
-    /// how the vertex stage reads a mesh; override when a batch is cheaper than its vertices one
-    /// by one. The colours are used only when [`MeshSource::has_colors`].
+    /// [`MeshSource::vertex_count`]) into the first `len` lanes of `out`: how the vertex stage
+    /// reads a mesh; override when a batch is cheaper than its vertices one by one. The colours
+    /// are used only when [`MeshSource::has_colors`], the normals only when
+    /// [`MeshSource::has_normals`]. `out` arrives zeroed for a draw's first batch and its last,
+    /// partial one; between them it holds what the batch before left, so an implementation
+    /// writes every lane of each attribute it writes at all, the same attributes every time.
     #[inline(always)]
     fn batch(&self, first: usize, len: usize, out: &mut VertexBatch) {
         for k in 0..len.min(BATCH) {

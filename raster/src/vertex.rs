@@ -295,16 +295,19 @@ pub fn shade_vertices<M: MeshSource>(
     // registers; only the last, partial batch takes the variable-length path.
     let whole = out.len() - out.len() % BATCH;
     let mut batches = out.chunks_exact_mut(BATCH);
+    // One batch of inputs for the whole batches, zeroed once: each fills every lane of what it
+    // has (see `MeshSource::batch`), so zeroing it for every batch (a `memset` call) was waste.
+    let mut input = VertexBatch::default();
     for (first, out) in (0..).step_by(BATCH).zip(&mut batches) {
         if let Ok(out) = <&mut [ShadedVertex; BATCH]>::try_from(out) {
-            stage.batch(mesh, first, BATCH, out);
+            stage.batch(mesh, first, BATCH, &mut input, out);
         }
     }
     let tail = batches.into_remainder();
     if !tail.is_empty() {
         let mut lanes = [ShadedVertex::ZERO; BATCH];
         let len = tail.len();
-        stage.batch(mesh, whole, len, &mut lanes);
+        stage.batch(mesh, whole, len, &mut VertexBatch::default(), &mut lanes);
         tail.copy_from_slice(&lanes[..len]);
     }
 }
@@ -323,13 +326,14 @@ struct Stage<'a> {
 }
 
 impl Stage<'_> {
-    /// Vertices `first..first + len` into the first `len` of `out`.
+    /// Vertices `first..first + len` into the first `len` of `out`, read through `batch`.
     #[inline(always)]
     fn batch<M: MeshSource>(
         &self,
         mesh: &M,
         first: usize,
         len: usize,
+        batch: &mut VertexBatch,
         out: &mut [ShadedVertex; BATCH],
     ) {
         let Stage {
@@ -340,23 +344,19 @@ impl Stage<'_> {
             colors,
         } = *self;
         // Gather the batch; lanes past the end of the mesh hold zeros and are not stored.
-        let mut batch = VertexBatch::default();
-        mesh.batch(first, len, &mut batch);
-        let VertexBatch {
-            positions: p,
-            normals: n,
-            colors: mut rgb,
-        } = batch;
+        mesh.batch(first, len, batch);
+        // Read in place: moving the arrays out copied them through registers.
         if !colors {
-            for (channel, b) in rgb.iter_mut().zip(base) {
+            for (channel, b) in batch.colors.iter_mut().zip(base) {
                 *channel = [b; BATCH];
             }
         }
+        let rgb = &batch.colors;
 
-        let clip = transform(&m, &p);
+        let clip = transform(&m, &batch.positions);
         let mut light = [1.0f32; BATCH];
         if let Some(p) = lighting {
-            p.intensities(&n, &mut light);
+            p.intensities(&batch.normals, &mut light);
         }
         // Attribute by attribute here too: an array of tuples would be vectorized vertex by
         // vertex, with shuffles between the stages.
