@@ -430,3 +430,36 @@ proptest! {
         prop_assert!(c == color && d == depth);
     }
 }
+
+/// With every vertex inside the clipping volume, the triangle loops skip the outcodes; vertices
+/// outside, used by no triangle, send the same triangles through the loops that read them: the
+/// same frame, whole and in bands, and the same statistics.
+#[test]
+fn a_model_in_view_draws_as_with_vertices_outside() {
+    let alone = load_obj_bytes(BUNNY_NAME, BUNNY_OBJ).unwrap();
+    // The scene's bunny with the floor's vertices but not its triangles (the bunny's vertices
+    // come first, so the triangles are the same).
+    let (mut unused, mvp) = scene();
+    unused.triangles.truncate(alone.triangles.len());
+    let p = params(mvp, false);
+    let outcodes = |m: &IndexedMesh| {
+        let mut scratch = vec![ShadedVertex::default(); m.positions.len()];
+        shade(&m.as_raster_mesh(), &p, W, H, &mut scratch).unwrap();
+        scratch.iter().fold(0, |u, v| u | v.outcode)
+    };
+    assert_eq!(outcodes(&alone), 0, "the bunny is in view");
+    assert_ne!(outcodes(&unused), 0, "the floor reaches behind the eye");
+    let (with, without) = (unused.as_raster_mesh(), alone.as_raster_mesh());
+    let (color, depth, stats) = whole::<u32>(&with, &p);
+    assert!(stats.rasterized > 10_000 && stats.clipped == 0, "{stats:?}");
+    let (c, d, s) = whole::<u32>(&without, &p);
+    assert!(c == color && d == depth, "whole frame");
+    assert_eq!(s, stats);
+    let bands: Vec<Window> = Window::bands(W, H, 16).collect();
+    for bins in [Bins::ample(&without, 16), Bins::Rows, Bins::None] {
+        for mesh in [&with, &without] {
+            let (c, d, _) = windowed::<u32>(mesh, &p, &bands, W, bins);
+            assert!(c == color && d == depth, "{bins:?}");
+        }
+    }
+}

@@ -277,6 +277,8 @@ pub struct ShadedMesh<'a, M: MeshSource> {
     lighting: Option<PreparedLighting>,
     viewport: Viewport,
     frame: (usize, usize),
+    /// The union of the vertices' outcodes: 0 when none is outside the clipping volume.
+    outside: u8,
 }
 
 // By hand: a derive would ask `M: Copy`, and both hold only references and plain values.
@@ -331,7 +333,7 @@ pub fn shade<'a, M: MeshSource>(
         }
         .prepare()
     });
-    shade_vertices(
+    let outside = shade_vertices(
         &params.mvp,
         &viewport,
         mesh,
@@ -346,6 +348,7 @@ pub fn shade<'a, M: MeshSource>(
         lighting: prepared,
         viewport,
         frame: (width, height),
+        outside,
     })
 }
 
@@ -380,6 +383,31 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
         order: impl Iterator<Item = usize> + Clone,
         fill: &F,
     ) -> DrawStats {
+        // With every vertex inside the clipping volume (a model in view), no triangle's outcodes
+        // need reading.
+        let stats = match self.outside {
+            0 => self.triangle_loop::<false, P, D, F>(target, order.clone(), fill),
+            _ => self.triangle_loop::<true, P, D, F>(target, order.clone(), fill),
+        };
+        self.draw_wireframe(target, order);
+        stats
+    }
+
+    /// [`ShadedMesh::draw_triangles`]' triangle loop; `CLIPS` false when no vertex is outside
+    /// the clipping volume. Out of line on a device: inlined, both loops' locals took room in
+    /// one stack frame (1.3 KB more at the Cortex-M7's peak); inlined where stacks are large
+    /// (out of line, the whole 320x240 bunny took 3% more instructions on x86-64).
+    #[cfg_attr(any(target_arch = "x86_64", target_arch = "aarch64"), inline(always))]
+    #[cfg_attr(
+        not(any(target_arch = "x86_64", target_arch = "aarch64")),
+        inline(never)
+    )]
+    fn triangle_loop<const CLIPS: bool, P: Pixel, D: Depth, F: Fill<P, D>>(
+        &self,
+        target: &mut Target<'_, P, D>,
+        order: impl Iterator<Item = usize>,
+        fill: &F,
+    ) -> DrawStats {
         let (mesh, params, scratch) = (self.mesh, self.params, self.vertices);
         let viewport = &self.viewport;
         let prepared = self.lighting.as_ref();
@@ -389,9 +417,9 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
             ..DrawStats::default()
         };
         let triangles = mesh.triangles();
-        for t in order.clone() {
+        for t in order {
             let ([i0, i1, i2], v) = corners(scratch, &triangles[t]);
-            let union = v[0].outcode | v[1].outcode | v[2].outcode;
+            let union = outcodes::<CLIPS>(&v);
             let uvs = |mesh: &M| match F::TEXTURED {
                 true => [i0, i1, i2].map(|i| mesh.uv(i as usize)),
                 false => [[0.0; 2]; 3],
@@ -458,7 +486,6 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
                 });
             }
         }
-        self.draw_wireframe(target, order);
         stats
     }
 
@@ -519,6 +546,16 @@ fn corners<'s, I: VertexIndex>(
         &scratch[i2 as usize],
     ];
     ([i0, i1, i2], v)
+}
+
+/// The union of a triangle's outcodes, or 0 without reading them when no vertex of the mesh is
+/// outside the clipping volume (`CLIPS` false).
+#[inline(always)]
+fn outcodes<const CLIPS: bool>(v: &[&ShadedVertex; 3]) -> u8 {
+    match CLIPS {
+        true => v[0].outcode | v[1].outcode | v[2].outcode,
+        false => 0,
+    }
 }
 
 /// Whether a triangle with a vertex outside the clipping volume (outcodes' union `union`, not 0)

@@ -274,7 +274,9 @@ impl PreparedLighting {
 /// as a scalar operation does). `lighting`, when given, lights the vertices by their normals;
 /// vertices take the mesh's colours, or `base` when it has none.
 ///
-/// `out` must hold exactly the mesh's vertices ([`crate::shade`] checks this).
+/// `out` must hold exactly the mesh's vertices ([`crate::shade`] checks this). Returns the union
+/// of their outcodes: 0 when every vertex is inside the clipping volume, so that no triangle
+/// needs its own outcodes looked at.
 #[inline]
 pub fn shade_vertices<M: MeshSource>(
     mvp: &Mat4,
@@ -283,7 +285,7 @@ pub fn shade_vertices<M: MeshSource>(
     lighting: Option<&PreparedLighting>,
     base: [f32; 3],
     out: &mut [ShadedVertex],
-) {
+) -> u8 {
     let stage = Stage {
         m: mvp.to_cols_array_2d(),
         viewport,
@@ -298,9 +300,10 @@ pub fn shade_vertices<M: MeshSource>(
     // One batch of inputs for the whole batches, zeroed once: each fills every lane of what it
     // has (see `MeshSource::batch`), so zeroing it for every batch (a `memset` call) was waste.
     let mut input = VertexBatch::default();
+    let mut union = 0;
     for (first, out) in (0..).step_by(BATCH).zip(&mut batches) {
         if let Ok(out) = <&mut [ShadedVertex; BATCH]>::try_from(out) {
-            stage.batch(mesh, first, BATCH, &mut input, out);
+            union |= stage.batch(mesh, first, BATCH, &mut input, out);
         }
     }
     let tail = batches.into_remainder();
@@ -309,7 +312,9 @@ pub fn shade_vertices<M: MeshSource>(
         let len = tail.len();
         stage.batch(mesh, whole, len, &mut VertexBatch::default(), &mut lanes);
         tail.copy_from_slice(&lanes[..len]);
+        union |= tail.iter().fold(0, |u, v| u | v.outcode);
     }
+    union
 }
 
 /// What the vertex stage keeps the same for every vertex of a draw.
@@ -326,7 +331,9 @@ struct Stage<'a> {
 }
 
 impl Stage<'_> {
-    /// Vertices `first..first + len` into the first `len` of `out`, read through `batch`.
+    /// Vertices `first..first + len` into the first `len` of `out`, read through `batch`;
+    /// returns the union of the batch's outcodes (of all its lanes: a partial batch's caller
+    /// takes its own from the lanes it keeps).
     #[inline(always)]
     fn batch<M: MeshSource>(
         &self,
@@ -335,7 +342,7 @@ impl Stage<'_> {
         len: usize,
         batch: &mut VertexBatch,
         out: &mut [ShadedVertex; BATCH],
-    ) {
+    ) -> u8 {
         let Stage {
             m,
             viewport,
@@ -383,6 +390,7 @@ impl Stage<'_> {
                 outcode,
             };
         }
+        (packed.iter().fold(0, |u, &w| u | w) >> 24) as u8
     }
 }
 
@@ -458,6 +466,46 @@ mod tests {
         };
         shade_vertices(mvp, vp, &mesh, None, [10.0, 20.0, 30.0], &mut out[..n]);
         out
+    }
+
+    /// The vertex stage's union of outcodes is the union of the vertices', whichever vertex is
+    /// outside: in a whole batch, in the partial one, or none; lanes past the end (zeros: the
+    /// eye, outside) do not count.
+    #[test]
+    fn the_union_of_outcodes_is_the_vertices_union() {
+        let mvp = Mat4::perspective_rh(1.0, 1.0, 0.5, 10.0)
+            * Mat4::look_at_rh(Vec3::ZERO, Vec3::new(0.0, 0.0, -1.0), Vec3::Y);
+        let vp = Viewport::new(8, 8);
+        let mut eye = [ShadedVertex::ZERO; 1];
+        let origin = [[0.0f32; 3]];
+        let m = crate::Mesh::<u32> {
+            positions: &origin,
+            ..crate::Mesh::default()
+        };
+        shade_vertices(&mvp, &vp, &m, None, [0.0; 3], &mut eye);
+        assert_ne!(eye[0].outcode, 0, "the eye is outside");
+        for n in [3, 8, 16, 19] {
+            for out_at in (0..n).map(Some).chain([None]) {
+                let mut positions = [[0.0, 0.0, -3.0]; 19];
+                positions[0][0] = 0.5; // still in view
+                if let Some(k) = out_at {
+                    positions[k] = [0.0, 0.0, 3.0]; // behind the eye
+                }
+                let m = crate::Mesh::<u32> {
+                    positions: &positions[..n],
+                    ..crate::Mesh::default()
+                };
+                let mut out = [ShadedVertex::ZERO; 19];
+                let union = shade_vertices(&mvp, &vp, &m, None, [0.0; 3], &mut out[..n]);
+                let want = out[..n].iter().fold(0, |u, v| u | v.outcode);
+                assert_eq!(union, want, "{n} vertices, outside at {out_at:?}");
+                assert_eq!(
+                    union != 0,
+                    out_at.is_some(),
+                    "{n} vertices, outside at {out_at:?}"
+                );
+            }
+        }
     }
 
     #[test]

@@ -15,7 +15,7 @@
 //! Either way a band draws its triangles in the frame's order, so the bands stitch to the whole
 //! frame bit for bit.
 
-use super::{clockwise, corners, for_each_clipped, Facing, Plain, Window, SUBPIXEL_BITS};
+use super::{clockwise, corners, for_each_clipped, outcodes, Facing, Plain, Window, SUBPIXEL_BITS};
 use super::{needs_clipping, signed_area2_xy, DrawError, DrawStats, ShadedMesh};
 use crate::edge::{covers_centre, pixel_bounds, signed_area2};
 use crate::mesh::MeshSource;
@@ -374,7 +374,19 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
     /// rows of each triangle `t` that meets a row (in order), and returns the frame's
     /// statistics.
     #[inline(always)]
-    fn for_each_row_span(&self, mut span: impl FnMut(usize, u16, u16)) -> DrawStats {
+    fn for_each_row_span(&self, span: impl FnMut(usize, u16, u16)) -> DrawStats {
+        // As the triangle loop: with no vertex outside the clipping volume, no triangle's
+        // outcodes are read.
+        match self.outside {
+            0 => self.row_spans::<false>(span),
+            _ => self.row_spans::<true>(span),
+        }
+    }
+
+    /// [`ShadedMesh::for_each_row_span`] with `CLIPS` false when no vertex is outside the
+    /// clipping volume.
+    #[inline(always)]
+    fn row_spans<const CLIPS: bool>(&self, mut span: impl FnMut(usize, u16, u16)) -> DrawStats {
         let triangles = self.mesh.triangles();
         let (params, scratch) = (self.params, self.vertices);
         let facing = Facing::culling(params.cull_back_faces);
@@ -388,7 +400,7 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
         };
         for (t, tri) in triangles.iter().enumerate() {
             let ([i0, i1, i2], v) = corners(scratch, tri);
-            let union = v[0].outcode | v[1].outcode | v[2].outcode;
+            let union = outcodes::<CLIPS>(&v);
             if union == 0 {
                 let xy = v.map(|v| [v.x, v.y]);
                 let area = signed_area2_xy(xy);
