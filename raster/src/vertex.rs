@@ -310,9 +310,8 @@ pub fn shade_vertices<M: MeshSource>(
     if !tail.is_empty() {
         let mut lanes = [ShadedVertex::ZERO; BATCH];
         let len = tail.len();
-        stage.batch(mesh, whole, len, &mut VertexBatch::default(), &mut lanes);
+        union |= stage.batch(mesh, whole, len, &mut VertexBatch::default(), &mut lanes);
         tail.copy_from_slice(&lanes[..len]);
-        union |= tail.iter().fold(0, |u, v| u | v.outcode);
     }
     union
 }
@@ -332,8 +331,7 @@ struct Stage<'a> {
 
 impl Stage<'_> {
     /// Vertices `first..first + len` into the first `len` of `out`, read through `batch`;
-    /// returns the union of the batch's outcodes (of all its lanes: a partial batch's caller
-    /// takes its own from the lanes it keeps).
+    /// returns the union of those vertices' outcodes.
     #[inline(always)]
     fn batch<M: MeshSource>(
         &self,
@@ -390,7 +388,7 @@ impl Stage<'_> {
                 outcode,
             };
         }
-        (packed.iter().fold(0, |u, &w| u | w) >> 24) as u8
+        (packed.iter().take(len).fold(0, |u, &w| u | w) >> 24) as u8
     }
 }
 
