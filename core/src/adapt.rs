@@ -69,7 +69,7 @@
 //! # }
 //! ```
 
-use crate::cut::expiry::{Renew, Settling, Tally, REBASE};
+use crate::cut::expiry::{lives, Renew, Settling, Tally};
 use crate::cut::margin::lesser;
 use crate::cut::split::Split;
 use crate::cut::NIL;
@@ -419,12 +419,12 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         if let Some(m) = &settling {
             match m.renew {
                 Renew::Forget => self.v.unsettle_all(),
-                Renew::Rebase => self.v.rebase(m.now, REBASE),
+                Renew::Rebase(by) => self.v.rebase(m.now, by),
                 Renew::Keep => {}
             }
         }
         // Without settling no mark is trusted (they may be stale) and none is made.
-        let now = settling.as_ref().map_or(u32::MAX, |m| m.now);
+        let now = settling.as_ref().map_or([u32::MAX; 2], |m| m.now);
         // Batch lists, built without branches (each item is written, and counted when it
         // belongs): the vertices still to decide, those of them the bound could not decide
         // ("slow"), and those that judge a pair (by place in the first list).
@@ -432,6 +432,8 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         let mut slow = [0usize; BATCH];
         let mut pairs = [0usize; BATCH];
         let mut margin = [f32::NAN; BATCH];
+        // The same as turned (see `crate::cut::rigid`): vertices alone, without geomorphs.
+        let mut turned = [f32::NAN; BATCH];
         let mut bounds = [Bounds::default(); BATCH];
         let mut demands = [Demand::NONE; BATCH];
         let mut parents = [NONE; BATCH];
@@ -513,6 +515,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                     flags
                 };
                 margin[n] = f32::NEG_INFINITY;
+                turned[n] = f32::NEG_INFINITY;
                 if let Some(m) = settling
                     .as_ref()
                     .filter(|m| markable && m.measures(flags, i))
@@ -529,13 +532,17 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                     // A leaf never splits, whatever it is asked (a parent's bounding radius
                     // is not 0 but where its whole region is a point: looked up then).
                     let leaf = digest.radius == 0 && !h.is_parent(self.v.node[i]);
-                    let own = if leaf {
-                        f32::INFINITY
+                    let (own, moved) = if leaf {
+                        (f32::INFINITY, f32::INFINITY)
                     } else if wants_none {
-                        m.margins.unwanted(s, radius, d2, seen).within(m.scale)
+                        let e = m.margins.unwanted(s, radius, d2, seen);
+                        (e.within(m.scale), e.displaced())
                     } else {
-                        f32::NAN
+                        (f32::NAN, f32::NAN)
                     };
+                    if !blends {
+                        turned[n] = moved / m.lever(center);
+                    }
                     margin[n] = match (blends, seen) {
                         (false, _) => own,
                         (true, (Some(v), room)) if v == visible && (flags & VISIBLE != 0) == v => {
@@ -551,7 +558,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 // A vertex whose record is read is marked once its facing is known (stage 2).
                 let slow_one = !wants_none & sphere.is_none();
                 if let Some(m) = settling.as_ref().filter(|_| alone & !slow_one) {
-                    self.mark(i, m, margin[n], &mut tally);
+                    self.mark(i, m, (margin[n], turned[n]), &mut tally);
                 }
                 listed[n] = i;
                 lone[n] = alone;
@@ -585,7 +592,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                         margin[k] = margin[k].max(m.margins.averted(&bounds[k]));
                     }
                     if lone[k] {
-                        self.mark(listed[k], m, margin[k], &mut tally);
+                        self.mark(listed[k], m, (margin[k], turned[k]), &mut tally);
                     }
                 }
             }
@@ -609,7 +616,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                     .as_ref()
                     .filter(|_| !judges & (flags & FIRST_CHILD != 0) & (m != NIL))
                 {
-                    self.mark(i, s, margin[k], &mut tally);
+                    self.mark(i, s, (margin[k], turned[k]), &mut tally);
                 }
             }
             let pairs = &pairs[..np];
@@ -632,14 +639,17 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             if let Some(m) = &settling {
                 for &k in pairs {
                     // Not measured (restless, not its turn), or already too small: no need.
-                    let room = if margin[k] >= m.step {
-                        let wanted = m.margins.wanted(&parent_bounds[k], (t, SLACK), (m.step, 4));
+                    let room = if margin[k] >= m.step || turned[k] >= m.turn {
+                        let b = &parent_bounds[k];
+                        let (wanted, turns) =
+                            m.margins
+                                .wanted_turned(b, (t, SLACK), (m.step, 4), m.lever(b.center));
                         let wanted = wanted.within(m.scale);
                         // Still wanted from where the eye is now: the pair stays.
                         kept[k] = wanted >= 0.0;
-                        lesser(margin[k], wanted)
+                        (lesser(margin[k], wanted), lesser(turned[k], turns))
                     } else {
-                        margin[k]
+                        (margin[k], turned[k])
                     };
                     self.mark(listed[k], m, room, &mut tally);
                 }
@@ -682,9 +692,9 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
     /// Marks slot `i` as the margin `margin` of its answers says (see [`Settling::mark`]), and
     /// counts it in `tally`.
     #[inline(always)]
-    fn mark(&mut self, i: usize, settling: &Settling, margin: f32, tally: &mut Tally) {
-        let mark = settling.mark(margin);
-        tally.count(margin, mark);
+    fn mark(&mut self, i: usize, settling: &Settling, margins: (f32, f32), tally: &mut Tally) {
+        let mark = settling.mark(margins);
+        tally.count(margins.0, mark);
         self.v.mark(i, mark);
     }
 
@@ -697,13 +707,13 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         (first, count): (usize, usize),
         slot: impl Fn(usize) -> usize,
         visits: usize,
-        now: u32,
+        now: [u32; 2],
     ) -> (usize, u32) {
         if first + count <= visits && first + count <= self.v.len() && slot(first) == first {
             // In the window and in slot order (always, without a window): only the settled are
             // skipped (none without settling).
             let all = usize::MAX >> (usize::BITS as usize - count.clamp(1, usize::BITS as usize));
-            if now == u32::MAX {
+            if now == [u32::MAX; 2] {
                 return (all, 0);
             }
             let skipped = self.v.settled_until(first, count, now);
@@ -714,7 +724,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             let i = slot(first + k);
             let flags = self.v.flags[i];
             let outside = (first + k >= visits) & (flags & (BLENDING | COLLAPSING) == 0);
-            let skips = (flags & SETTLED != 0) & (self.v.expiry(i) >= now);
+            let skips = (flags & SETTLED != 0) & lives(self.v.expiry(i), now);
             asked |= usize::from(!outside & !skips) << k;
             settled += u32::from(!outside & skips);
         }
@@ -1097,11 +1107,12 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                         let room = match self.pair_parent(h, i) {
                             Some(p) => {
                                 let p = bounds_read(h, h.record(p), sphere_only);
-                                m.margins
-                                    .wanted(&p, (t, SLACK), (m.step, 4))
-                                    .within(m.scale)
+                                let lever = m.lever(p.center);
+                                let (wanted, turns) =
+                                    m.margins.wanted_turned(&p, (t, SLACK), (m.step, 4), lever);
+                                (wanted.within(m.scale), turns)
                             }
-                            None => f32::INFINITY,
+                            None => (f32::INFINITY, f32::INFINITY),
                         };
                         self.v.mark(i, m.mark(room));
                     }

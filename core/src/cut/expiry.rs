@@ -20,13 +20,25 @@
 //! frame), every vertex measures one frame in 16.
 //! There are no anchor frames, so no frame costs more than its neighbours.
 //!
+//! A second count runs beside the first: the camera's motion as seen from the camera
+//! (`super::rigid`), in turns, under which a point moves at most the turns times its distance
+//! from the model's centre (at least half the model's radius). Whether a vertex wants a split,
+//! whether its sphere is in view and whether its pair's parent is still wanted (but for its
+//! normal cone, which turns with the camera) depend only on distances a point keeps in the
+//! camera's frame, so their margins count there too, divided by that distance. A vertex is
+//! marked on the count on which its margins last more frames at the last frame's steps, with
+//! the count's bit in its expiry: for a camera circling the model, the turning count lets a
+//! vertex near the centre stay settled several times as long (the peer orbit asks 37% fewer
+//! vertices a frame than on the eye's path alone).
+//!
 //! Skipping changes no decision: every skipped answer is proven the same as asking would give
 //! (with a relative slack far above float rounding), so frames are the same with or without
 //! it, only faster. A change of the policy's envelope, the threshold or geomorphs on or off, a
 //! frame that skips nothing by design (a window of the active list) or a jump of the camera
 //! forgets every mark.
 //!
-//! The expiry shares its 16-bit field with the vertex's blend entry (`super::store`): a vertex
+//! The expiry (with its count's bit) shares its 16-bit field with the vertex's blend entry
+//! (`super::store`): a vertex
 //! in a geomorph is asked every frame, so it is never settled. With geomorphs a vertex settles
 //! only when whether it is seen (which decides whether a change around it blends) provably
 //! stays what it was in the frame before. Only for policies that do not judge triangles. Any
@@ -34,16 +46,31 @@
 //! mark on either child) clears its mark.
 
 use super::margin::{planes, sway, Margins, Planes};
+use super::rigid::{self, Axes};
 use super::RESTLESS;
 use crate::policy::{dot, sub, Envelope, View};
 
 /// Quanta of motion per unit of the model's bounding radius.
 const QUANTA_PER_RADIUS: f32 = 4096.0;
-/// When the count reaches this, it and every live expiry are lowered by it.
-pub(crate) const REBASE: u32 = 1 << 15;
-/// The longest margin kept, in quanta: expiries stay below `2 REBASE - 1`, which a 16-bit slot
-/// field holds besides its all-ones `NIL`.
+/// Quanta of the turning count per unit of its step (see [`rigid::step`]).
+const QUANTA_PER_TURN: f32 = 4096.0;
+/// The turning count's lever floor, in the model's radii: a vertex nearer the centre counts
+/// as this far from it.
+const LEVER: f32 = 0.5;
+/// When a count reaches this, it and every live expiry on it are lowered by it.
+pub(crate) const REBASE: u32 = 1 << 14;
+/// The longest margin kept, in quanta: expiries stay below `2 REBASE - 1`.
 const CAP: u32 = REBASE - 2;
+/// The tag bit of an expiry on the turning count; with an expiry below `2 REBASE - 1` a 16-bit
+/// slot field holds it besides its all-ones `NIL`.
+pub(crate) const TURNING: u32 = 1 << 15;
+
+/// Whether a settled vertex's tag `tag` has not expired at the counts `now` (travelled,
+/// turned).
+#[inline(always)]
+pub(crate) fn lives(tag: u32, now: [u32; 2]) -> bool {
+    (tag & (TURNING - 1)) >= now[(tag >> 15) as usize & 1]
+}
 /// A longer single step (a jump of the camera) forgets every mark.
 const JUMP: f32 = (1 << 14) as f32;
 
@@ -54,15 +81,16 @@ pub(crate) enum Renew {
     Keep,
     /// They are stale: clear every mark.
     Forget,
-    /// The count was lowered by [`REBASE`]: lower every live expiry as much, clear the
-    /// expired ones.
-    Rebase,
+    /// The counts (travelled, turned) were lowered by these, each 0 or [`REBASE`]: lower
+    /// every live expiry on each as much, clear the expired ones.
+    Rebase([u32; 2]),
 }
 
 /// What an asked vertex's measured margins make of it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum Mark {
-    /// Skipped until the motion count passes this.
+    /// Skipped until the count passes this: the travelled count's, or the turning count's
+    /// with the [`TURNING`] bit (see [`lives`]).
     Settled(u32),
     /// The margins cover less than a step of the camera (or are unproven): the next asks
     /// measure them only in turn, one frame in [`TURN`].
@@ -95,9 +123,9 @@ const SPARSE_TURN: u32 = 16;
 /// expiry.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Settling {
-    /// The camera's motion so far, in quanta: a settled vertex whose expiry is below it is
-    /// asked.
-    pub now: u32,
+    /// The camera's motion so far, in quanta, as travelled and as turned (see
+    /// [`rigid::step`]): a settled vertex whose expiry is below its count is asked.
+    pub now: [u32; 2],
     pub margins: Margins,
     /// What to do with the marks first.
     pub renew: Renew,
@@ -108,6 +136,11 @@ pub(crate) struct Settling {
     /// `scale` times its length.
     pub scale: f32,
     quantum: f32,
+    /// The camera's last step as turned (at least a quantum; infinite when it cannot be
+    /// counted this frame).
+    pub turn: f32,
+    /// The model's centre and the lever floor (see [`Settling::lever`]).
+    centre: ([f32; 3], f32),
     /// Frames since the marks were made (wrapping), for the restless vertices' turns.
     tick: u32,
     /// The last frame settled under an eighth of the vertices it measured.
@@ -128,15 +161,37 @@ impl Settling {
         }
     }
 
-    /// The mark of a vertex whose answers' margin is `margin` (model units; `-inf` when not
-    /// measured, NaN when unproven).
+    /// The mark of a vertex whose answers' margin is `margin` as the eye travels (model
+    /// units) and `turned` as the camera turns ([`Settling::lever`] units; `-inf` for either
+    /// when not measured, NaN when unproven): on the count it lasts the more frames on at the
+    /// last step, settled when that is at least one.
     #[inline(always)]
-    pub fn mark(&self, margin: f32) -> Mark {
-        if margin >= self.step {
-            Mark::Settled(self.now + ((margin / self.quantum) as u32).min(CAP))
+    pub fn mark(&self, (margin, turned): (f32, f32)) -> Mark {
+        let reach = CAP as f32 * QUANTA_PER_TURN.recip();
+        let frames = |m: f32, cap: f32, step: f32| {
+            if m >= step {
+                m.min(cap) / step
+            } else {
+                0.0
+            }
+        };
+        let travels = frames(margin, CAP as f32 * self.quantum, self.step);
+        if frames(turned, reach, self.turn) > travels {
+            let quanta = ((turned * QUANTA_PER_TURN) as u32).min(CAP);
+            Mark::Settled(TURNING | (self.now[1] + quanta))
+        } else if travels > 0.0 {
+            Mark::Settled(self.now[0] + ((margin / self.quantum) as u32).min(CAP))
         } else {
             Mark::Restless
         }
+    }
+
+    /// What a displacement margin of a vertex centred at `center` is divided by to count as
+    /// turned: its distance from the model's centre, at least the lever floor.
+    #[inline(always)]
+    pub fn lever(&self, center: [f32; 3]) -> f32 {
+        let r = sub(center, self.centre.0);
+        libm::sqrtf(dot(r, r)).max(self.centre.1)
     }
 }
 
@@ -147,10 +202,14 @@ pub(crate) struct Motion {
     off: bool,
     /// Whether the marks were made under the terms below.
     valid: bool,
-    now: u32,
+    /// The counts, travelled and turned.
+    now: [u32; 2],
     quantum: f32,
     eye: [f32; 3],
     planes: Planes,
+    /// The camera's axes at the last frame, when it had some (`has_axes`).
+    axes: Axes,
+    has_axes: bool,
     envelope: Envelope,
     threshold: f32,
     blends: bool,
@@ -227,10 +286,12 @@ impl Motion {
     pub const ZERO: Motion = Motion {
         off: false,
         valid: false,
-        now: 0,
+        now: [0; 2],
         quantum: 0.0,
         eye: [0.0; 3],
         planes: [[0.0; 4]; 5],
+        axes: Axes::ZERO,
+        has_axes: false,
         envelope: Envelope::ZERO,
         threshold: 0.0,
         blends: false,
@@ -268,9 +329,19 @@ impl Motion {
         // The step as the count weighs it (see `SwayScale`).
         let scale = self.scale_less_one + 1.0;
         let step = |scale: f32| moved.max(scale * swayed);
+        // And as turned, when both frames have axes.
+        let lever = model.1 * LEVER;
+        let axes = Axes::of(view, &now, model.0);
+        let turned = match (&axes, self.has_axes) {
+            (Some(b), true) => rigid::step(&self.axes, b, model.1, lever),
+            _ => f32::INFINITY,
+        };
+        let turns = libm::ceilf(turned * QUANTA_PER_TURN);
         let same =
             self.valid && envelope == self.envelope && t == self.threshold && blends == self.blends;
-        let continues = same && libm::ceilf(step(scale) / self.quantum) <= JUMP;
+        let continues = same
+            && libm::ceilf(step(scale) / self.quantum) <= JUMP
+            && (turns <= JUMP || turned == f32::INFINITY);
         if continues && envelope.frustum {
             self.seen.add(moved, swayed);
         }
@@ -286,7 +357,7 @@ impl Motion {
             self.checked = true;
         }
         let renew = if !continues || drifted.is_some() {
-            self.now = 0;
+            self.now = [0; 2];
             if let Some(r) = drifted {
                 self.scale_less_one = r - 1.0;
             }
@@ -299,12 +370,27 @@ impl Motion {
             };
             Renew::Forget
         } else {
-            self.now += libm::ceilf(step(scale) / self.quantum) as u32;
-            if self.now >= REBASE {
-                self.now -= REBASE;
-                Renew::Rebase
+            // Without axes this frame or the last the turn is unknown: the count moves by
+            // REBASE, which expires every mark on it (and nothing is marked on it this frame,
+            // its step being infinite).
+            let turns = if turned == f32::INFINITY {
+                REBASE as f32
             } else {
+                turns
+            };
+            let steps = [libm::ceilf(step(scale) / self.quantum), turns];
+            let mut by = [0; 2];
+            for k in 0..2 {
+                self.now[k] += steps[k] as u32;
+                if self.now[k] >= REBASE {
+                    self.now[k] -= REBASE;
+                    by[k] = REBASE;
+                }
+            }
+            if by == [0; 2] {
                 Renew::Keep
+            } else {
+                Renew::Rebase(by)
             }
         };
         let scale = self.scale_less_one + 1.0;
@@ -314,12 +400,16 @@ impl Motion {
             tick: self.tick.wrapping_add(1),
             eye: view.eye,
             planes: now,
+            axes: axes.unwrap_or(Axes::ZERO),
+            has_axes: axes.is_some(),
             envelope,
             threshold: t,
             blends,
             ..*self
         };
-        let reach = CAP as f32 * self.quantum;
+        // The eye travels at most this far while a mark lasts; as turned, a point moves at
+        // most as far again (at most CAP quanta of turns, times a lever within the model).
+        let reach = CAP as f32 * (self.quantum + model.1 / QUANTA_PER_TURN);
         Some(Settling {
             now: self.now,
             margins: Margins::new(view.eye, now, envelope, (t, slack), model, reach),
@@ -331,6 +421,8 @@ impl Motion {
             },
             quantum: self.quantum,
             scale,
+            turn: turned.max(QUANTA_PER_TURN.recip()),
+            centre: (model.0, lever),
             tick: u32::from(self.tick),
             sparse: self.sparse,
         })
@@ -392,13 +484,14 @@ mod tests {
         let mut m = Motion::ZERO;
         // The first frame forgets whatever was there; a quantum is a unit here.
         let first = begin(&mut m, 0.0, 1.0);
-        assert_eq!((first.renew, first.now), (Renew::Forget, 0));
+        assert_eq!((first.renew, first.now), (Renew::Forget, [0, 0]));
         // A still camera does not count.
-        assert_eq!(begin(&mut m, 0.0, 1.0).now, 0);
-        // The eye moves 2.5: at least three quanta (the planes sway at least as much).
+        assert_eq!(begin(&mut m, 0.0, 1.0).now, [0, 0]);
+        // The eye moves 2.5: at least three quanta (the planes sway at least as much), and the
+        // camera turns a little.
         let moved = begin(&mut m, 2.5, 1.0);
         assert_eq!(moved.renew, Renew::Keep);
-        assert!(moved.now >= 3, "{}", moved.now);
+        assert!(moved.now[0] >= 3 && moved.now[1] >= 1, "{:?}", moved.now);
         // Another threshold, a jump, or a frame without settling forget.
         assert_eq!(begin(&mut m, 2.5, 2.0).renew, Renew::Forget);
         assert_eq!(begin(&mut m, 1e9, 2.0).renew, Renew::Forget);
@@ -417,20 +510,32 @@ mod tests {
         let mut m = Motion::ZERO;
         begin(&mut m, 0.0, 1.0);
         let mut x = 0.0;
-        let mut last = 0;
-        for _ in 0..100 {
+        let mut last = [0, 0];
+        let mut rebased = [false; 2];
+        for _ in 0..400 {
             x += 1000.0;
             let s = begin(&mut m, x, 1.0);
-            assert!(s.now < REBASE);
-            if s.renew == Renew::Rebase {
-                assert!(s.now < last);
+            assert!(s.now.iter().all(|&n| n < REBASE));
+            let by = match s.renew {
+                Renew::Rebase(by) => by,
+                Renew::Keep => [0, 0],
+                Renew::Forget => panic!("forgot"),
+            };
+            for k in 0..2 {
+                if by[k] == REBASE {
+                    assert!(s.now[k] < last[k]);
+                    rebased[k] = true;
+                } else {
+                    assert_eq!(by[k], 0);
+                    assert!(s.now[k] > last[k]);
+                }
+            }
+            if rebased == [true; 2] {
                 return;
             }
-            assert_eq!(s.renew, Renew::Keep);
-            assert!(s.now > last);
             last = s.now;
         }
-        panic!("never rebased");
+        panic!("never rebased both counts");
     }
 
     #[test]
@@ -439,15 +544,27 @@ mod tests {
         begin(&mut m, 0.0, 1.0);
         let s = begin(&mut m, 10.0, 1.0);
         assert!(s.step >= 10.0);
-        assert_eq!(s.mark(0.9 * s.step), Mark::Restless);
-        assert_eq!(s.mark(f32::NAN), Mark::Restless);
-        assert_eq!(s.mark(f32::NEG_INFINITY), Mark::Restless);
-        assert_eq!(s.mark(100.0), Mark::Settled(s.now + 100));
-        // The longest margin kept still fits a 16-bit tag besides its NIL.
-        let Mark::Settled(far) = s.mark(f32::INFINITY) else {
-            panic!("an infinite margin settles");
-        };
-        assert!(far < u32::from(u16::MAX));
+        let none = f32::NEG_INFINITY;
+        assert_eq!(s.mark((0.9 * s.step, none)), Mark::Restless);
+        assert_eq!(s.mark((0.9 * s.step, 0.9 * s.turn)), Mark::Restless);
+        assert_eq!(s.mark((f32::NAN, f32::NAN)), Mark::Restless);
+        assert_eq!(s.mark((none, none)), Mark::Restless);
+        assert_eq!(s.mark((100.0, none)), Mark::Settled(s.now[0] + 100));
+        // On the count on which it lasts more frames.
+        assert_eq!(s.mark((100.0, 0.5 * s.turn)), Mark::Settled(s.now[0] + 100));
+        let turns = (100.0 / s.step) * 2.0 * s.turn;
+        let quanta = (turns * QUANTA_PER_TURN) as u32;
+        assert_eq!(
+            s.mark((100.0, turns)),
+            Mark::Settled(TURNING | (s.now[1] + quanta))
+        );
+        // The longest margin kept still fits a 16-bit tag besides its NIL, on either count.
+        for margins in [(f32::INFINITY, none), (none, f32::INFINITY)] {
+            let Mark::Settled(far) = s.mark(margins) else {
+                panic!("an infinite margin settles");
+            };
+            assert!(far < u32::from(u16::MAX));
+        }
         // A restless vertex measures one frame in four, staggered by slot.
         let turns = (0..8).filter(|&slot| s.measures(RESTLESS, slot)).count();
         assert_eq!(turns, 2);
@@ -509,13 +626,14 @@ mod tests {
         f += 1;
         let marked = frame(&mut m, f);
         let at = planes(&circling(f));
-        let Mark::Settled(until) = marked.mark(
+        let Mark::Settled(until) = marked.mark((
             Either {
                 eye: 0.0,
                 sway: room,
             }
             .within(marked.scale),
-        ) else {
+            f32::NEG_INFINITY,
+        )) else {
             panic!("a margin of many steps settles");
         };
         let mut settled = 0;
@@ -523,7 +641,7 @@ mod tests {
             f += 1;
             let s = frame(&mut m, f);
             assert_ne!(s.renew, Renew::Forget);
-            if s.now > until {
+            if s.now[0] > until {
                 break;
             }
             assert!(sway(&at, &planes(&circling(f)), MODEL) <= room, "frame {f}");

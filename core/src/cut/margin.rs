@@ -76,6 +76,13 @@ pub(crate) struct Both {
 }
 
 impl Either {
+    /// The one distance the vertex may move relative to the eye and the planes standing
+    /// still, as seen from the camera (`super::rigid`): either margin is such a distance.
+    #[inline(always)]
+    pub fn displaced(self) -> f32 {
+        self.eye.max(self.sway)
+    }
+
     /// Whether the answer holds for an eye within `reach` and planes within `sway`.
     #[inline(always)]
     pub fn holds(self, reach: f32, sway: f32) -> bool {
@@ -254,6 +261,24 @@ impl Margins {
     /// solved exactly; its along-axis term is tried at `step` times 1, 4, 16, ... (`levels`
     /// of them) and gives the largest that holds.
     pub fn wanted(&self, b: &Bounds, (t, slack): (f32, f32), (step, levels): (f32, u32)) -> Both {
+        self.wanted_turned(b, (t, slack), (step, levels), 1.0).0
+    }
+
+    /// [`Margins::wanted`], and how far the camera may turn while the parent stays wanted, in
+    /// turns (see `super::rigid`) for a centre `lever` from the model's (at least the lever
+    /// floor): its sphere seen and its error over `t * slack` while the centre moves at most
+    /// the turns times `lever`, and its normal cone not turned away while the axis turns as
+    /// far too (`s = rn - radius` grows by at most `shift (1 + turn) + d turn`, `d` by `shift`,
+    /// with `shift <= turns lever` and `turn <= turns <= 1`). The spheroid's along-axis term,
+    /// which needs the axis to stay where it is, is left out.
+    #[inline(always)]
+    pub fn wanted_turned(
+        &self,
+        b: &Bounds,
+        (t, slack): (f32, f32),
+        (step, levels): (f32, u32),
+        lever: f32,
+    ) -> (Both, f32) {
         let e = &self.envelope;
         let sway = match (e.frustum, self.visibility(b.center, b.radius)) {
             (false, _) => f32::INFINITY,
@@ -265,59 +290,89 @@ impl Margins {
         let rn = dot(r, b.axis);
         // Not facing away (`s <= 0` or `s <= (d - shift) cone_sin`, `s = rn - radius + shift`,
         // the shift being the reach plus slop): either holds for shifts up to its bound.
-        let facing = if e.back_face {
+        let (facing, facing_turned) = if e.back_face {
             let cs = b.cone_sin.max(0.0);
-            (b.radius - rn).max((d * cs - rn + b.radius) / (1.0 + cs)) - self.slop
+            let (g1, g2) = (b.radius - rn, d * cs - rn + b.radius);
+            (
+                g1.max(g2 / (1.0 + cs)) - self.slop,
+                ((g1 - self.slop) / (2.0 * lever + d))
+                    .max((g2 - self.slop) / ((2.0 + cs) * lever + d))
+                    .min(1.0),
+            )
         } else {
-            f32::INFINITY
+            (f32::INFINITY, f32::INFINITY)
         };
         let k = t * slack * (1.0 + SLACK);
-        let spheroid = self.spheroid(b, (d, rn), k, (step, levels));
+        let across = self.across(b, d, k);
+        let spheroid = self.spheroid(b, (d, rn), k, (step, levels), across);
         // Where the sphere can get relative to the near zone (`d - radius < near`): provably
         // inside for shifts below `edge / (1 + SLACK) - d`, provably outside up to
         // `d - edge (1 + SLACK)`.
         let edge = e.near + b.radius;
-        let error = if e.near > 0.0 {
-            if e.near_error > k {
-                (edge / (1.0 + SLACK) - d - self.slop).max(spheroid)
+        let error = |spheroid: f32| {
+            if e.near > 0.0 {
+                if e.near_error > k {
+                    (edge / (1.0 + SLACK) - d - self.slop).max(spheroid)
+                } else {
+                    lesser(spheroid, d - edge * (1.0 + SLACK) - self.slop)
+                }
             } else {
-                lesser(spheroid, d - edge * (1.0 + SLACK) - self.slop)
+                spheroid
             }
-        } else {
-            spheroid
         };
-        Both {
-            eye: lesser(facing, error),
-            sway,
-        }
+        let turned = lesser(facing_turned, lesser(error(across), sway) / lever);
+        (
+            Both {
+                eye: lesser(facing, error(spheroid)),
+                sway,
+            },
+            turned,
+        )
     }
 
-    /// How far the eye may move while the spheroid's lower bound, `max(b2 far^2, a2 p^2)
-    /// lower / far^4` with `far` the eye's greatest distance from the centre and `p` its least
-    /// from the axis (less what rounding can take from the policy's own sum), stays over `k`;
-    /// `-inf` when it never is.
-    fn spheroid(&self, b: &Bounds, (d, rn): (f32, f32), k: f32, (step, levels): (f32, u32)) -> f32 {
+    /// How far the eye may move while the spheroid's across-axis lower bound, `b2 lower /
+    /// far^2` with `far` the eye's greatest distance from the centre (less what rounding can
+    /// take from the policy's own sum), stays over `k`: `-inf` when it never is.
+    #[inline(always)]
+    fn across(&self, b: &Bounds, d: f32, k: f32) -> f32 {
         let lower = self.envelope.lower;
         // (Also when `lower` is NaN.)
         if lower.partial_cmp(&0.0) != Some(core::cmp::Ordering::Greater) {
             return f32::NEG_INFINITY;
         }
         let most = b.a2.max(b.b2);
-        // Across the axis: `(b2 - SLACK most) lower far^2 > k far^4` while `far^2 < (b2 -
-        // SLACK most) lower / k`.
+        // `(b2 - SLACK most) lower far^2 > k far^4` while `far^2 < (b2 - SLACK most) lower / k`.
         let across = (b.b2 - SLACK * most) * lower / k;
-        let mut margin = if across > 0.0 {
+        if across > 0.0 {
             libm::sqrtf(across) / (1.0 + SLACK) - d - self.slop
         } else {
             f32::NEG_INFINITY
-        };
+        }
+    }
+
+    /// How far the eye may move while the spheroid's lower bound, `max(b2 far^2, a2 p^2)
+    /// lower / far^4` with `far` the eye's greatest distance from the centre and `p` its least
+    /// from the axis (less what rounding can take from the policy's own sum), stays over `k`,
+    /// given the across-axis term's margin `across` ([`Margins::across`]); `-inf` when it never
+    /// is.
+    fn spheroid(
+        &self,
+        b: &Bounds,
+        (d, rn): (f32, f32),
+        k: f32,
+        (step, levels): (f32, u32),
+        across: f32,
+    ) -> f32 {
+        let lower = self.envelope.lower;
+        let mut margin = across;
         // Along the axis: `(a2 p^2 - SLACK most far^2) lower > k far^4`, which only gets
         // harder as the shift grows, and cannot hold beyond the across-axis term's reach when
         // `a2 <= b2` (`p <= far`): then no rung can add more than rounding (a sphere, the
-        // default bound, is such a spheroid).
+        // default bound, is such a spheroid). Without a positive `lower` no rung holds.
         if b.a2 <= b.b2 {
             return margin;
         }
+        let most = b.a2.max(b.b2);
         let axial = libm::sqrtf((d * d - rn * rn).max(0.0));
         let holds = |reach: f32| {
             let shift = reach + self.slop;
@@ -489,6 +544,68 @@ mod tests {
             ..b
         };
         assert!(m.averted(&nan).is_nan());
+    }
+
+    #[test]
+    fn a_parent_facing_the_eye_stays_so_while_the_camera_turns_less_than_its_margin() {
+        use crate::policy::{BackFace, Policy};
+        // The eye at z = 5 looks at the model's centre; the parent, off the centre, faces it
+        // within a cone of half-angle asin 0.3, its error far over the threshold.
+        let m = margins(Envelope {
+            back_face: true,
+            lower: 1.0,
+            ..Envelope::ZERO
+        });
+        let b = Bounds {
+            center: [0.3, 0.2, 0.0],
+            radius: 0.1,
+            axis: [0.6, 0.0, 0.8],
+            cone_sin: 0.3,
+            a2: 100.0,
+            b2: 100.0,
+        };
+        let (w, turns) = m.wanted_turned(&b, (1.0, 1.0), (0.1, 1), 0.5);
+        assert!(w.eye > 0.0 && turns > 0.05 && turns < 1.0, "{w:?} {turns}");
+        // The camera turned about the centre round six axes, by angles whose turn (`2 sin(a /
+        // 2)`) is within the margin: still facing. Round to the far side: turned away.
+        let seen = |axis: [f32; 3], angle: f32| {
+            let (c, s) = (libm::cosf(angle), libm::sinf(angle));
+            // Rodrigues' rotation of `p` about the unit `axis`.
+            let turn = |p: [f32; 3]| {
+                let k = axis;
+                let kxp = [
+                    k[1] * p[2] - k[2] * p[1],
+                    k[2] * p[0] - k[0] * p[2],
+                    k[0] * p[1] - k[1] * p[0],
+                ];
+                let kp = dot(k, p) * (1.0 - c);
+                core::array::from_fn(|i| p[i] * c + kxp[i] * s + k[i] * kp)
+            };
+            let v = View::look_at(
+                turn([0.0, 0.0, 5.0]),
+                [0.0; 3],
+                turn([0.0, 1.0, 0.0]),
+                1.0,
+                1.0,
+                480.0,
+            );
+            BackFace.demand(&b, &v).visible
+        };
+        let axes = [
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [-1.0, 0.0, 0.0],
+            [0.0, -1.0, 0.0],
+            [0.0, 0.0, -1.0],
+        ];
+        for axis in axes {
+            for k in 1..=20 {
+                let angle = 2.0 * libm::asinf(turns * k as f32 / 40.0);
+                assert!(seen(axis, angle), "{axis:?} {angle}");
+            }
+        }
+        assert!(!seen([0.0, 1.0, 0.0], core::f32::consts::PI));
     }
 
     #[test]

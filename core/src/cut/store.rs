@@ -12,7 +12,7 @@
 //! triangle record is 16 bytes: three corner slots, the three neighbouring triangles' slots
 //! (across edges `t[k] -> t[k + 1]`) and its id in the hierarchy's numbering.
 
-use super::expiry::Mark;
+use super::expiry::{lives, Mark, TURNING};
 use super::renumber::scatter;
 use super::slot::{load3, store3, SlotIndex};
 use super::{prev3, BLENDING, COLLAPSING, NIL, RESTLESS, SETTLED};
@@ -115,7 +115,8 @@ impl<const V: usize, I: SlotIndex> Vertices<V, I> {
         }
     }
 
-    /// The motion at which slot `s`'s answers expire, when it is settled (`s` in range).
+    /// The count at which slot `s`'s answers expire, when it is settled (`s` in range), with
+    /// the count's bit (see `super::expiry::lives`).
     #[inline(always)]
     pub fn expiry(&self, s: usize) -> u32 {
         self.tag[s].index() as u32
@@ -139,9 +140,9 @@ impl<const V: usize, I: SlotIndex> Vertices<V, I> {
     }
 
     /// Which of the `count` (at most `usize::BITS`) slots from `first` (in range) are settled
-    /// with an expiry the motion count `now` has not passed, as bits.
+    /// with an expiry its count in `now` has not passed, as bits.
     #[inline(always)]
-    pub fn settled_until(&self, first: usize, count: usize, now: u32) -> usize {
+    pub fn settled_until(&self, first: usize, count: usize, now: [u32; 2]) -> usize {
         let flags = &self.flags[first..first + count];
         let tags = &self.tag[first..first + count];
         // Eight slots at a time: a byte of 0 or 1 each (the SETTLED bits shifted down, and the
@@ -154,14 +155,14 @@ impl<const V: usize, I: SlotIndex> Vertices<V, I> {
         for (c, (f, x)) in fs.zip(xs).enumerate() {
             let f = u64::from_le_bytes(core::array::from_fn(|k| f[k]));
             let late = u64::from_le_bytes(core::array::from_fn(|k| {
-                u8::from(x[k].index() as u32 >= now)
+                u8::from(lives(x[k].index() as u32, now))
             }));
             let lanes = (f >> SETTLED.trailing_zeros()) & ONES & late;
             bits |= ((lanes.wrapping_mul(0x0102_0408_1020_4080) >> 56) as usize) << (8 * c);
         }
         for (k, (f, x)) in rest.enumerate() {
             let k = count / 8 * 8 + k;
-            bits |= usize::from((f & SETTLED != 0) & (x.index() as u32 >= now)) << k;
+            bits |= usize::from((f & SETTLED != 0) & lives(x.index() as u32, now)) << k;
         }
         bits
     }
@@ -174,16 +175,19 @@ impl<const V: usize, I: SlotIndex> Vertices<V, I> {
             .for_each(|f| *f &= !(SETTLED | RESTLESS));
     }
 
-    /// Lowers every live expiry by `by` after the motion count was lowered as much to `now`;
-    /// clears the marks that expired.
-    pub fn rebase(&mut self, now: u32, by: u32) {
+    /// Lowers every live expiry on each count by `by` after the count was lowered as much to
+    /// `now`; clears the marks that expired.
+    pub fn rebase(&mut self, now: [u32; 2], by: [u32; 2]) {
         let len = self.len();
         for (f, x) in self.flags[..len].iter_mut().zip(&mut self.tag[..len]) {
             if *f & SETTLED == 0 {
                 continue;
             }
-            match (x.index() as u32).checked_sub(by) {
-                Some(e) if e >= now => *x = I::store(e),
+            let tag = x.index() as u32;
+            let (count, e) = (tag & TURNING, tag & !TURNING);
+            let k = usize::from(count != 0);
+            match e.checked_sub(by[k]) {
+                Some(e) if e >= now[k] => *x = I::store(count | e),
                 _ => *f &= !SETTLED,
             }
         }
@@ -442,22 +446,24 @@ mod tests {
         for s in 0..200 {
             v.push(s, random() as u8);
             if random() % 3 != 0 {
-                v.mark(s as usize, Mark::Settled(random() % 400));
+                // On either count.
+                let count = if random() % 2 == 0 { TURNING } else { 0 };
+                v.mark(s as usize, Mark::Settled(count | (random() % 400)));
             }
         }
         for first in 0..70 {
             for count in 0..=(usize::BITS as usize).min(200 - first) {
-                for now in [0, 1, 150, 399, 400] {
+                for now in [[0, 0], [1, 150], [150, 1], [399, 400], [400, 399]] {
                     let mut want = 0usize;
                     for k in 0..count {
                         let s = first + k;
-                        let settled = v.flags[s] & SETTLED != 0 && v.expiry(s) >= now;
+                        let settled = v.flags[s] & SETTLED != 0 && lives(v.expiry(s), now);
                         want |= usize::from(settled) << k;
                     }
                     assert_eq!(
                         v.settled_until(first, count, now),
                         want,
-                        "{first} {count} {now}"
+                        "{first} {count} {now:?}"
                     );
                 }
             }
