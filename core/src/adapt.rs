@@ -1018,7 +1018,9 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         // A leaf a split makes is marked where it is judged, as next frame's walk would mark
         // it (without geomorphs, as there): a leaf's own answer never expires, so only a first
         // child's pair has a margin to measure (new parents are left to the walk: their margins
-        // are mostly under a step, just past the threshold that split their parent).
+        // are mostly under a step, just past the threshold that split their parent). A pair is
+        // marked on the travelled count only: its turning margin would cost more here, where a
+        // first frame makes thousands of leaves, than the walk saves by it.
         let settling = settling.filter(|_| frames == 0 && self.blends.len() == 0);
         let sphere_only = reads_spheres(policy);
         let mut traded = 0usize;
@@ -1107,10 +1109,8 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                         let room = match self.pair_parent(h, i) {
                             Some(p) => {
                                 let p = bounds_read(h, h.record(p), sphere_only);
-                                let lever = m.lever(p.center);
-                                let (wanted, turns) =
-                                    m.margins.wanted_turned(&p, (t, SLACK), (m.step, 4), lever);
-                                (wanted.within(m.scale), turns)
+                                let wanted = m.margins.wanted(&p, (t, SLACK), (m.step, 4));
+                                (wanted.within(m.scale), f32::NEG_INFINITY)
                             }
                             None => (f32::INFINITY, f32::INFINITY),
                         };

@@ -22,9 +22,9 @@
 //!
 //! A second count runs beside the first: the camera's motion as seen from the camera
 //! (`super::rigid`), in turns, under which a point moves at most the turns times its distance
-//! from the model's centre (at least half the model's radius). Whether a vertex wants a split,
-//! whether its sphere is in view and whether its pair's parent is still wanted (but for its
-//! normal cone, which turns with the camera) depend only on distances a point keeps in the
+//! from the model's centre (at least a quarter of the model's radius). Whether a vertex wants a
+//! split, whether its sphere is in view and whether its pair's parent is still wanted (but for
+//! its normal cone, which turns with the camera) depend only on distances a point keeps in the
 //! camera's frame, so their margins count there too, divided by that distance. A vertex is
 //! marked on the count on which its margins last more frames at the last frame's steps, with
 //! the count's bit in its expiry: for a camera circling the model, the turning count lets a
@@ -38,12 +38,12 @@
 //! forgets every mark.
 //!
 //! The expiry (with its count's bit) shares its 16-bit field with the vertex's blend entry
-//! (`super::store`): a vertex
-//! in a geomorph is asked every frame, so it is never settled. With geomorphs a vertex settles
-//! only when whether it is seen (which decides whether a change around it blends) provably
-//! stays what it was in the frame before. Only for policies that do not judge triangles. Any
-//! operation that changes a vertex's family (its sibling link, its node, its pair's illegal
-//! mark on either child) clears its mark.
+//! (`super::store`): a vertex in a geomorph is asked every frame, so it is never settled. With
+//! geomorphs a vertex settles only when whether it is seen (which decides whether a change
+//! around it blends) provably stays what it was in the frame before, and only on the first
+//! count. Only for policies that do not judge triangles. Any operation that changes a vertex's
+//! family (its sibling link, its node, its pair's illegal mark on either child) clears its
+//! mark.
 
 use super::margin::{planes, sway, Margins, Planes};
 use super::rigid::{self, Axes};
@@ -56,7 +56,7 @@ const QUANTA_PER_RADIUS: f32 = 4096.0;
 const QUANTA_PER_TURN: f32 = 4096.0;
 /// The turning count's lever floor, in the model's radii: a vertex nearer the centre counts
 /// as this far from it.
-const LEVER: f32 = 0.5;
+const LEVER: f32 = 0.25;
 /// When a count reaches this, it and every live expiry on it are lowered by it.
 pub(crate) const REBASE: u32 = 1 << 14;
 /// The longest margin kept, in quanta: expiries stay below `2 REBASE - 1`.
