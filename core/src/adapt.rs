@@ -541,7 +541,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                         (f32::NAN, f32::NAN)
                     };
                     if !blends {
-                        turned[n] = moved / m.lever(center);
+                        turned[n] = m.turned(moved, center);
                     }
                     margin[n] = match (blends, seen) {
                         (false, _) => own,

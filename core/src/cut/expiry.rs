@@ -69,7 +69,9 @@ pub(crate) const TURNING: u32 = 1 << 15;
 /// turned).
 #[inline(always)]
 pub(crate) fn lives(tag: u32, now: [u32; 2]) -> bool {
-    (tag & (TURNING - 1)) >= now[(tag >> 15) as usize & 1]
+    // The count picked without a branch or an indexed load (a lane of the eight-wide test).
+    let turning = ((tag >> 15) & 1).wrapping_neg();
+    (tag & (TURNING - 1)) >= now[0] ^ ((now[0] ^ now[1]) & turning)
 }
 /// A longer single step (a jump of the camera) forgets every mark.
 const JUMP: f32 = (1 << 14) as f32;
@@ -192,6 +194,17 @@ impl Settling {
     pub fn lever(&self, center: [f32; 3]) -> f32 {
         let r = sub(center, self.centre.0);
         libm::sqrtf(dot(r, r)).max(self.centre.1)
+    }
+
+    /// A displacement margin `moved` of a vertex centred at `center` as turned; `-inf` when it
+    /// could not cover the last turning step at any lever (not worth its square root).
+    #[inline(always)]
+    pub fn turned(&self, moved: f32, center: [f32; 3]) -> f32 {
+        if moved >= self.turn * self.centre.1 {
+            moved / self.lever(center)
+        } else {
+            f32::NEG_INFINITY
+        }
     }
 }
 
