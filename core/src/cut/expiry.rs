@@ -69,9 +69,10 @@ pub(crate) const TURNING: u32 = 1 << 15;
 /// turned).
 #[inline(always)]
 pub(crate) fn lives(tag: u32, now: [u32; 2]) -> bool {
-    // The count picked without a branch or an indexed load (a lane of the eight-wide test).
-    let turning = ((tag >> 15) & 1).wrapping_neg();
-    (tag & (TURNING - 1)) >= now[0] ^ ((now[0] ^ now[1]) & turning)
+    // The whole tag against its count's threshold, picked without a branch or an indexed load
+    // (a lane of the eight-wide test).
+    let turning = (tag >> 15).wrapping_neg();
+    tag >= now[0] ^ ((now[0] ^ (TURNING + now[1])) & turning)
 }
 /// A longer single step (a jump of the camera) forgets every mark.
 const JUMP: f32 = (1 << 14) as f32;
@@ -549,6 +550,20 @@ mod tests {
             last = s.now;
         }
         panic!("never rebased both counts");
+    }
+
+    #[test]
+    fn an_expiry_lives_until_its_own_count_passes_it() {
+        for other in [0, 99, 100, 101, REBASE - 1] {
+            assert!(lives(100, [100, other]));
+            assert!(!lives(100, [101, other]));
+            assert!(lives(TURNING | 100, [other, 100]));
+            assert!(!lives(TURNING | 100, [other, 101]));
+        }
+        // The largest expiries on either count, against the largest counts.
+        let last = 2 * REBASE - 2;
+        assert!(lives(last, [REBASE - 1, REBASE - 1]));
+        assert!(lives(TURNING | last, [REBASE - 1, REBASE - 1]));
     }
 
     #[test]
