@@ -71,8 +71,9 @@ pub(crate) const TURNING: u32 = 1 << 15;
 pub(crate) fn lives(tag: u32, now: [u32; 2]) -> bool {
     // The whole tag against its count's threshold, picked without a branch or an indexed load
     // (a lane of the eight-wide test).
+    // (`u32::MAX` counts, a frame that trusts no mark, keep no tag alive.)
     let turning = (tag >> 15).wrapping_neg();
-    tag >= now[0] ^ ((now[0] ^ (TURNING + now[1])) & turning)
+    tag >= now[0] ^ ((now[0] ^ TURNING.saturating_add(now[1])) & turning)
 }
 /// A longer single step (a jump of the camera) forgets every mark.
 const JUMP: f32 = (1 << 14) as f32;
@@ -560,10 +561,12 @@ mod tests {
             assert!(lives(TURNING | 100, [other, 100]));
             assert!(!lives(TURNING | 100, [other, 101]));
         }
-        // The largest expiries on either count, against the largest counts.
+        // The largest expiries on either count, against the largest counts; none against the
+        // counts of a frame that trusts no mark.
         let last = 2 * REBASE - 2;
         assert!(lives(last, [REBASE - 1, REBASE - 1]));
         assert!(lives(TURNING | last, [REBASE - 1, REBASE - 1]));
+        assert!(!lives(last, [u32::MAX; 2]) && !lives(TURNING | last, [u32::MAX; 2]));
     }
 
     #[test]
