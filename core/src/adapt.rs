@@ -643,7 +643,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                         let b = &parent_bounds[k];
                         let (wanted, turns) =
                             m.margins
-                                .wanted_turned(b, (t, SLACK), (m.step, 4), m.lever(b.center));
+                                .wanted_turned(b, (t, SLACK), (m.step, 4), m.levers(b.center));
                         let wanted = wanted.within(m.scale);
                         // Still wanted from where the eye is now: the pair stays.
                         kept[k] = wanted >= 0.0;

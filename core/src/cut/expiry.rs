@@ -145,6 +145,8 @@ pub(crate) struct Settling {
     pub turn: f32,
     /// The model's centre and the lever floor (see [`Settling::lever`]).
     centre: ([f32; 3], f32),
+    /// The eye's distance from the model's centre.
+    eye: f32,
     /// Frames since the marks were made (wrapping), for the restless vertices' turns.
     tick: u32,
     /// The last frame settled under an eighth of the vertices it measured.
@@ -196,6 +198,13 @@ impl Settling {
     pub fn lever(&self, center: [f32; 3]) -> f32 {
         let r = sub(center, self.centre.0);
         libm::sqrtf(dot(r, r)).max(self.centre.1)
+    }
+
+    /// What [`Margins::wanted_turned`] needs of a parent centred at `center`: its
+    /// [`Settling::lever`], the eye's distance from the model's centre and the lever floor.
+    #[inline(always)]
+    pub fn levers(&self, center: [f32; 3]) -> (f32, f32, f32) {
+        (self.lever(center), self.eye, self.centre.1)
     }
 
     /// A displacement margin `moved` of a vertex centred at `center` as turned; `-inf` when it
@@ -438,6 +447,10 @@ impl Motion {
             scale,
             turn: turned.max(QUANTA_PER_TURN.recip()),
             centre: (model.0, lever),
+            eye: {
+                let w = sub(model.0, view.eye);
+                libm::sqrtf(dot(w, w))
+            },
             tick: u32::from(self.tick),
             sparse: self.sparse,
         })

@@ -261,23 +261,26 @@ impl Margins {
     /// solved exactly; its along-axis term is tried at `step` times 1, 4, 16, ... (`levels`
     /// of them) and gives the largest that holds.
     pub fn wanted(&self, b: &Bounds, (t, slack): (f32, f32), (step, levels): (f32, u32)) -> Both {
-        self.wanted_turned(b, (t, slack), (step, levels), 1.0).0
+        self.wanted_turned(b, (t, slack), (step, levels), (1.0, 1.0, 1.0))
+            .0
     }
 
     /// [`Margins::wanted`], and how far the camera may turn while the parent stays wanted, in
-    /// turns (see `super::rigid`) for a centre `lever` from the model's (at least the lever
-    /// floor): its sphere seen and its error over `t * slack` while the centre moves at most
-    /// the turns times `lever`, and its normal cone not turned away while the axis turns as
-    /// far too (`s = rn - radius` grows by at most `shift (1 + turn) + d turn`, `d` by `shift`,
-    /// with `shift <= turns lever` and `turn <= turns <= 1`). The spheroid's along-axis term,
-    /// which needs the axis to stay where it is, is left out.
+    /// turns (see `super::rigid`), for a centre `lever` from the model's centre (at least the
+    /// lever floor `floor`, by which the model's centre shifts at most per turn) and an eye
+    /// `eye` from it: its sphere seen and its error over `t * slack` while the centre moves at
+    /// most the turns times `lever`, and its normal cone not turned away while the axis turns
+    /// as far too. With `u` the centre's offset from the model's and `w` the model's from the
+    /// eye, `rn = (u + w) . axis` and `u . axis` keeps under a rotation, so `s = rn - radius`
+    /// changes by at most `|w| turn + shift` and `d` by at most `|u| turn + shift`. The
+    /// spheroid's along-axis term, which needs the axis to stay where it is, is left out.
     #[inline(always)]
     pub fn wanted_turned(
         &self,
         b: &Bounds,
         (t, slack): (f32, f32),
         (step, levels): (f32, u32),
-        lever: f32,
+        (lever, eye, floor): (f32, f32, f32),
     ) -> (Both, f32) {
         let e = &self.envelope;
         let sway = match (e.frustum, self.visibility(b.center, b.radius)) {
@@ -295,9 +298,8 @@ impl Margins {
             let (g1, g2) = (b.radius - rn, d * cs - rn + b.radius);
             (
                 g1.max(g2 / (1.0 + cs)) - self.slop,
-                ((g1 - self.slop) / (2.0 * lever + d))
-                    .max((g2 - self.slop) / ((2.0 + cs) * lever + d))
-                    .min(1.0),
+                ((g1 - self.slop) / (eye + floor))
+                    .max((g2 - self.slop) / (eye + cs * lever + (1.0 + cs) * floor)),
             )
         } else {
             (f32::INFINITY, f32::INFINITY)
@@ -564,8 +566,8 @@ mod tests {
             a2: 100.0,
             b2: 100.0,
         };
-        let (w, turns) = m.wanted_turned(&b, (1.0, 1.0), (0.1, 1), 0.5);
-        assert!(w.eye > 0.0 && turns > 0.05 && turns < 1.0, "{w:?} {turns}");
+        let (w, turns) = m.wanted_turned(&b, (1.0, 1.0), (0.1, 1), (0.5, 5.0, 0.5));
+        assert!(w.eye > 0.0 && turns > 0.05, "{w:?} {turns}");
         // The camera turned about the centre round six axes, by angles whose turn (`2 sin(a /
         // 2)`) is within the margin: still facing. Round to the far side: turned away.
         let seen = |axis: [f32; 3], angle: f32| {
