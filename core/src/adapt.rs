@@ -432,7 +432,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         let mut slow = [0usize; BATCH];
         let mut pairs = [0usize; BATCH];
         let mut margin = [f32::NAN; BATCH];
-        // The same as turned (see `crate::cut::rigid`): vertices alone, without geomorphs.
+        // The same as turned (see `crate::cut::rigid`), without geomorphs.
         let mut turned = [f32::NAN; BATCH];
         let mut bounds = [Bounds::default(); BATCH];
         let mut demands = [Demand::NONE; BATCH];

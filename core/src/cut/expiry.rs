@@ -28,7 +28,7 @@
 //! camera's frame, so their margins count there too, divided by that distance. A vertex is
 //! marked on the count on which its margins last more frames at the last frame's steps, with
 //! the count's bit in its expiry: for a camera circling the model, the turning count lets a
-//! vertex near the centre stay settled several times as long (the peer orbit asks 37% fewer
+//! vertex near the centre stay settled several times as long (the peer orbit asks 38% fewer
 //! vertices a frame than on the eye's path alone).
 //!
 //! Skipping changes no decision: every skipped answer is proven the same as asking would give
@@ -70,8 +70,8 @@ pub(crate) const TURNING: u32 = 1 << 15;
 #[inline(always)]
 pub(crate) fn lives(tag: u32, now: [u32; 2]) -> bool {
     // The whole tag against its count's threshold, picked without a branch or an indexed load
-    // (a lane of the eight-wide test).
-    // (`u32::MAX` counts, a frame that trusts no mark, keep no tag alive.)
+    // (a lane of the eight-wide test); `u32::MAX` counts (a frame that trusts no mark) keep no
+    // tag alive.
     let turning = (tag >> 15).wrapping_neg();
     tag >= now[0] ^ ((now[0] ^ TURNING.saturating_add(now[1])) & turning)
 }
@@ -169,8 +169,8 @@ impl Settling {
 
     /// The mark of a vertex whose answers' margin is `margin` as the eye travels (model
     /// units) and `turned` as the camera turns ([`Settling::lever`] units; `-inf` for either
-    /// when not measured, NaN when unproven): on the count it lasts the more frames on at the
-    /// last step, settled when that is at least one.
+    /// when not measured, NaN when unproven): on the count on which it lasts more frames at
+    /// the last steps, settled when that is at least one frame.
     #[inline(always)]
     pub fn mark(&self, (margin, turned): (f32, f32)) -> Mark {
         let reach = CAP as f32 * QUANTA_PER_TURN.recip();
