@@ -10,7 +10,7 @@
 //! model while it looks at the centre turns by the angle it circles and shifts nothing, so a
 //! point at `r` from the centre moves `r / D` times as far as the eye, `D` the orbit's radius:
 //! the margins of a vertex near the centre last several times as many frames counted so as on
-//! the eye's path (`super::expiry`'s second clock).
+//! the eye's path (`super::expiry`'s second count).
 //!
 //! The frame is any orthonormal one fixed to the camera (built from the view's forward
 //! direction and its side planes): should the planes themselves change in it (a new aspect or
@@ -20,7 +20,7 @@ use super::margin::Planes;
 use crate::policy::{dot, sub, View};
 
 /// Float rounding allowed on the axes and on the centre's position in the camera's frame,
-/// relative (ten times a float's epsilon, far above what the few products commit).
+/// relative (about eight times a float's epsilon, far above what the few products commit).
 const ROUNDING: f32 = 1e-6;
 
 /// A view's axes and what stands still in them when the camera moves rigidly.
@@ -60,7 +60,7 @@ impl Axes {
         let length = libm::sqrtf(dot(x, x));
         let unit = libm::sqrtf(dot(f, f));
         // Far from degenerate, and from rounding mattering.
-        if !(length > 1e-3 && (unit - 1.0).abs() < 1e-5) {
+        if !(length > 1e-3 && libm::fabsf(unit - 1.0) < 1e-5) {
             return None;
         }
         let x = x.map(|c| c / length);
