@@ -370,8 +370,10 @@ impl Margins {
         // Along the axis: `(a2 p^2 - SLACK most far^2) lower > k far^4`, which only gets
         // harder as the shift grows, and cannot hold beyond the across-axis term's reach when
         // `a2 <= b2` (`p <= far`): then no rung can add more than rounding (a sphere, the
-        // default bound, is such a spheroid). Without a positive `lower` no rung holds.
-        if b.a2 <= b.b2 {
+        // default bound, is such a spheroid). Without a positive `lower` nothing is proven
+        // (and `across` is `-inf`).
+        let positive = lower.partial_cmp(&0.0) == Some(core::cmp::Ordering::Greater);
+        if !positive || b.a2 <= b.b2 {
             return margin;
         }
         let most = b.a2.max(b.b2);
