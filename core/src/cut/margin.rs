@@ -552,7 +552,7 @@ mod tests {
 
     #[test]
     fn a_parent_facing_the_eye_stays_so_while_the_camera_turns_less_than_its_margin() {
-        use crate::policy::{BackFace, Policy};
+        use crate::policy::{cross, BackFace, Policy};
         // The eye at z = 5 looks at the model's centre; the parent, off the centre, faces it
         // within a cone of half-angle asin 0.3, its error far over the threshold.
         let m = margins(Envelope {
@@ -576,14 +576,8 @@ mod tests {
             let (c, s) = (libm::cosf(angle), libm::sinf(angle));
             // Rodrigues' rotation of `p` about the unit `axis`.
             let turn = |p: [f32; 3]| {
-                let k = axis;
-                let kxp = [
-                    k[1] * p[2] - k[2] * p[1],
-                    k[2] * p[0] - k[0] * p[2],
-                    k[0] * p[1] - k[1] * p[0],
-                ];
-                let kp = dot(k, p) * (1.0 - c);
-                core::array::from_fn(|i| p[i] * c + kxp[i] * s + k[i] * kp)
+                let (kxp, kp) = (cross(axis, p), dot(axis, p) * (1.0 - c));
+                core::array::from_fn(|i| p[i] * c + kxp[i] * s + axis[i] * kp)
             };
             let v = View::look_at(
                 turn([0.0, 0.0, 5.0]),

@@ -17,7 +17,7 @@
 //! frustum scale), the change is counted in the step too, so the bound holds for any view.
 
 use super::margin::Planes;
-use crate::policy::{dot, sub, View};
+use crate::policy::{cross, dot, sub, View};
 
 /// Float rounding allowed on the axes and on the centre's position in the camera's frame,
 /// relative (about eight times a float's epsilon, far above what the few products commit).
@@ -57,19 +57,13 @@ impl Axes {
             side[1] - along * f[1],
             side[2] - along * f[2],
         ];
-        let length = libm::sqrtf(dot(x, x));
-        let unit = libm::sqrtf(dot(f, f));
+        let (length, unit) = (norm(x), norm(f));
         // Far from degenerate, and from rounding mattering.
         if !(length > 1e-3 && libm::fabsf(unit - 1.0) < 1e-5) {
             return None;
         }
         let x = x.map(|c| c / length);
-        let y = [
-            f[1] * x[2] - f[2] * x[1],
-            f[2] * x[0] - f[0] * x[2],
-            f[0] * x[1] - f[1] * x[0],
-        ];
-        let rows = [x, y, f];
+        let rows = [x, cross(f, x), f];
         let to = sub(center, view.eye);
         let planes = planes.map(|p| {
             let n = [p[0], p[1], p[2]];
