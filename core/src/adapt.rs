@@ -231,6 +231,35 @@ fn bounds_read(h: &HierarchyView<'_>, record: Record, sphere_only: bool) -> Boun
     }
 }
 
+/// The envelope the cut trusts of `policy` at `view` (none for a policy that judges triangles,
+/// whose demand moves with its neighbours), and what [`bound_proves_none`] reads of it: the
+/// upper bound's scale (infinite without an envelope) and the near zone beyond which it holds
+/// (everywhere without one).
+#[inline(always)]
+fn trusted_envelope<P: Policy>(policy: &P, view: &View) -> (Option<Envelope>, (f32, Envelope)) {
+    let envelope = if policy.judges_triangles() {
+        None
+    } else {
+        policy.envelope(view)
+    };
+    let upper = envelope.map_or(f32::INFINITY, |e| e.upper);
+    (envelope, (upper, envelope.unwrap_or(Envelope::ZERO)))
+}
+
+/// Whether the policy's envelope (its upper bound `upper`, which holds beyond `zone`'s near
+/// zone) proves that a vertex of spheroid radius `s` and bounding radius `radius`, at squared
+/// distance `d2` from the eye, wants no split at threshold `t`.
+#[inline(always)]
+fn bound_proves_none(
+    s: f32,
+    radius: f32,
+    d2: f32,
+    (upper, zone): (f32, &Envelope),
+    t: f32,
+) -> bool {
+    (s * s * upper * SLACK <= t * d2) & zone.beyond_near(d2, radius, SLACK)
+}
+
 /// Whether `policy` reads nothing of a vertex but its bounding sphere, for vertices and pairs
 /// alike (see [`Policy::sphere_only`]).
 #[inline(always)]
@@ -378,14 +407,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         // No geomorph runs or can start: no decision reaches a vertex but its own and its
         // pair's first child's, so a second child is done with as early as a lone vertex.
         let calm = !blends && self.blends.len() == 0;
-        let envelope = if policy.judges_triangles() {
-            None
-        } else {
-            policy.envelope(view)
-        };
-        let upper = envelope.map_or(f32::INFINITY, |e| e.upper);
-        // Where the upper bound holds: beyond the near zone (everywhere without one).
-        let zone = envelope.unwrap_or(Envelope::ZERO);
+        let (envelope, (upper, zone)) = trusted_envelope(policy, view);
         // A policy that reads only the bounding sphere is answered from the digest's copy of it:
         // the same floats the record decodes to, so the same demand, without reading the file.
         let sphere_only = reads_spheres(policy);
@@ -497,7 +519,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 };
                 let wants_none = match sphere {
                     Some(d) => d.error <= t,
-                    None => (s * s * upper * SLACK <= t * d2) & zone.beyond_near(d2, radius, SLACK),
+                    None => bound_proves_none(s, radius, d2, (upper, &zone), t),
                 };
                 let mate = self.v.mate(i);
                 let still = flags & (BLENDING | COLLAPSING) == 0;
@@ -1023,6 +1045,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         // first frame makes thousands of leaves, than the walk saves by it.
         let settling = settling.filter(|_| frames == 0 && self.blends.len() == 0);
         let sphere_only = reads_spheres(policy);
+        let (_, (upper, zone)) = trusted_envelope(policy, view);
         let mut traded = 0usize;
         let mut listed = false;
         // Without a budget, an operation cap, geomorphs (whose blends' room may run out) or a
@@ -1094,8 +1117,29 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                     if self.v.node.get(cs as usize) != Some(&c) {
                         continue;
                     }
-                    // Located once: its bounds and whether it splits.
-                    let d = self.judged(h, cs as usize, &h.bounds_at(record), view, policy);
+                    // Whether it splits, from its digest where that decides (a policy that reads
+                    // spheres gets the digest's, the record's floats; without geomorphs, an
+                    // envelope that proves no split is enough, as in the walk), else from its
+                    // record.
+                    let digest = &self.v.digest[cs as usize];
+                    let (center, radius) = (h.digest_center(digest), h.length(digest.radius));
+                    let proven = || {
+                        let r = sub(center, view.eye);
+                        let s = h.length(digest.spheroid);
+                        bound_proves_none(s, radius, dot(r, r), (upper, &zone), t)
+                    };
+                    let d = if !sphere_only && frames == 0 && proven() {
+                        Demand::NONE
+                    } else if sphere_only {
+                        let b = Bounds {
+                            center,
+                            radius,
+                            ..Bounds::default()
+                        };
+                        policy.demand(&b, view)
+                    } else {
+                        self.judged(h, cs as usize, &h.bounds_at(record), view, policy)
+                    };
                     let flags = &mut self.v.flags[cs as usize];
                     *flags = (*flags & !VISIBLE) | kept(d.visible, frames > 0) as u8;
                     if d.error > t && record.is_parent() {
