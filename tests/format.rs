@@ -40,6 +40,13 @@ fn walk(view: &HierarchyView<'_>) {
         let n = view.node(i);
         assert_eq!(view.vertex(i), (n.position, n.normal, n.color), "node {i}");
     }
+    // A pair's records located together are each located alone, for every node (a sibling
+    // pair's first child, the second, a leaf of the next kind block) and past the last.
+    for i in (0..view.nodes()).chain([view.nodes().saturating_sub(1), view.nodes(), NONE - 1, NONE])
+    {
+        let alone = [view.record(i), view.record(i.wrapping_add(1))];
+        assert_eq!(view.pair_records(i), alone, "node {i}");
+    }
     let mut parents = 0;
     for p in view.parent_nodes() {
         parents += 1;

@@ -1057,6 +1057,32 @@ impl<'a> HierarchyView<'a> {
         self.offsets[1] + i as usize * NODE_SIZE + rank as usize * (PARENT_SIZE - NODE_SIZE)
     }
 
+    /// The records of sibling pair `first` and `first + 1` ([`HierarchyView::split`]'s
+    /// children): [`HierarchyView::record`] of both, counting the parents before them once.
+    #[inline(always)]
+    #[must_use]
+    pub fn pair_records(&self, first: u32) -> [Record; 2] {
+        let second = first.wrapping_add(1);
+        let (parent, rank) = self.kind(first);
+        let located = |i: u32, parent: bool, rank: u32| {
+            if i >= self.nodes {
+                Record {
+                    offset: usize::MAX,
+                    parent: false,
+                }
+            } else {
+                Record {
+                    offset: self.record_offset(i, rank),
+                    parent,
+                }
+            }
+        };
+        [
+            located(first, parent, rank),
+            located(second, self.is_parent(second), rank + parent as u32),
+        ]
+    }
+
     /// The first byte of node `i`'s record (0 out of range): reading it brings the record into
     /// the cache. A caller that touches a batch of nodes before decoding them has the processor
     /// fetch all their records at once instead of one after the other.

@@ -190,7 +190,8 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             self.rename_vertex(h, ps as usize, node);
             return ([ps, ps], [h.record(node); 2]);
         };
-        let records = [h.record(c0), h.record(c1)];
+        // Siblings have adjacent ids (`c1 = c0 + 1`).
+        let records = h.pair_records(c0);
         self.link_children(h, [ps, c1s], records);
         if let Some(from) = start {
             self.start_blend_from(ps as usize, &from, frames, false);
