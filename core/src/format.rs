@@ -449,6 +449,7 @@ pub fn oct_encode(n: [f32; 3]) -> (i8, i8) {
 
 /// Decodes octahedral coordinates in `[-127, 127]` to a unit vector (one square root and one
 /// division: the policies decode an axis per vertex per frame).
+#[inline]
 pub fn oct_decode(x: i8, y: i8) -> [f32; 3] {
     let w = oct_unfold(x, y);
     // Never zero: the components' magnitudes add up to 127.
@@ -623,13 +624,20 @@ fn f32_at(b: &[u8], o: usize) -> f32 {
 /// read as ones.
 #[inline]
 fn bits_at(b: &[u8], bit: u64, width: u32) -> u32 {
+    word_at(b, bit) as u32 & low(width)
+}
+
+/// The 64 bits from bit `bit` of `b` on, shifted so that bit `bit` is bit 0 (at least 57 of
+/// them read from `b`); bytes past the end read as ones.
+#[inline]
+fn word_at(b: &[u8], bit: u64) -> u64 {
     let byte = usize::try_from(bit / 8).unwrap_or(usize::MAX);
     let word = match b.get(byte..byte.saturating_add(8)) {
         Some(s) => u64::from_le_bytes([s[0], s[1], s[2], s[3], s[4], s[5], s[6], s[7]]),
         // Near the end of the file: the slow window, ones past the end.
         None => window(b, bit & !7) as u64,
     };
-    (word >> (bit % 8)) as u32 & low(width)
+    word >> (bit % 8)
 }
 
 /// The low `width` bits set (all for 32 and more).
@@ -1311,7 +1319,7 @@ impl<'a> HierarchyView<'a> {
     }
 
     /// The split record of parent `p` (anything else reads as [`NONE`]s).
-    #[inline]
+    #[inline(always)]
     #[must_use]
     pub fn split(&self, p: u32) -> SplitView {
         let (parent, rank) = self.kind(p);
@@ -1324,10 +1332,14 @@ impl<'a> HierarchyView<'a> {
         }
         let wf = self.face_width;
         let at = self.offsets[4] as u64 * 8 + rank as u64 * split_bits(wf);
-        let neighbours = if 4 * wf + 7 <= 128 {
-            // The whole record in one 16-byte window (every hierarchy below a billion faces).
-            let w = window(self.bytes, at);
-            [0, 1, 2, 3].map(|k| id((w >> (k * wf)) as u32 & low(wf), wf))
+        let neighbours = if 2 * wf + 7 <= 64 {
+            // Two ids in each of two 64-bit words (every hierarchy below 2^28 faces).
+            let two = |bit: u64| {
+                let w = word_at(self.bytes, bit);
+                [w as u32, (w >> wf) as u32].map(|raw| id(raw & low(wf), wf))
+            };
+            let ([n0, n1], [n2, n3]) = (two(at), two(at + 2 * wf as u64));
+            [n0, n1, n2, n3]
         } else {
             [0, 1, 2, 3].map(|k| id(bits_at(self.bytes, at + k as u64 * wf as u64, wf), wf))
         };

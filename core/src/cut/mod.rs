@@ -513,6 +513,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
     }
 
     /// Rebuilds the node map over a span fit for `entries` active vertices, if it needs another.
+    #[inline(always)]
     pub(crate) fn respan_map(&mut self, entries: usize) {
         if self.map.should_resize(entries) {
             self.rebuild_map(entries);
@@ -520,6 +521,8 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
     }
 
     /// Empties the node map, sizes it for `entries` entries and enters every active vertex.
+    #[cold]
+    #[inline(never)]
     pub(crate) fn rebuild_map(&mut self, entries: usize) {
         self.map.reset(NodeMap::<F, I>::span_for(entries));
         for s in 0..self.v.len() as u32 {
@@ -529,6 +532,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
 
     /// Appends a vertex for `node` (visible, no blend, not linked); its slot, or `None` when
     /// the arena or the node map is full.
+    #[inline(always)]
     fn push_vertex(&mut self, node: u32) -> Option<u32> {
         let s = self.v.push(node, VISIBLE)?;
         if !self.map_insert(s) {
@@ -545,6 +549,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
     }
 
     /// [`Cut::rename_vertex`] without the links: the caller sets them.
+    #[inline(always)]
     fn reassign(&mut self, s: usize, node: u32) {
         self.map.remove(self.v.node[s], self.v.nodes());
         self.unlink_mate(s);
