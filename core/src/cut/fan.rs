@@ -88,7 +88,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             None => return false,
         };
         while g != NIL {
-            if out[..ccw_part].contains(&g) || out.push(g).is_err() {
+            if out[..ccw_part].iter().any(|&f| f == g) || out.push(g).is_err() {
                 return false;
             }
             g = match self.cw(g, v) {

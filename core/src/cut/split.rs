@@ -141,14 +141,16 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         if !reached && ns[0] != NIL {
             let mut f = ns[0];
             while f != NIL {
-                if moved.contains(&f) {
+                if moved.iter().any(|&g| g == f) {
                     return Err(Refused::Inconsistent);
                 }
                 moved.push(f).map_err(|_| Refused::Inconsistent)?;
                 f = self.cw(f, ps).ok_or(Refused::Inconsistent)?;
             }
         }
-        if (ns[1] != NIL && moved.contains(&ns[1])) || (ns[2] != NIL && moved.contains(&ns[2])) {
+        // (Searched by a loop of our own: the slice's `contains` is a call.)
+        let moves = |f: u32| f != NIL && moved.iter().any(|&g| g == f);
+        if moves(ns[1]) || moves(ns[2]) {
             return Err(Refused::Inconsistent);
         }
         Ok(SplitPlan {
