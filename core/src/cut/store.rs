@@ -150,6 +150,9 @@ impl<const V: usize, I: SlotIndex> Vertices<V, I> {
         // on bit `56 + i`, and no two products share a bit); the rest one at a time.
         const ONES: u64 = 0x0101_0101_0101_0101;
         let mut bits = 0usize;
+        if let Some(bits) = settled_word(flags, tags, now) {
+            return bits;
+        }
         let (fs, xs) = (flags.chunks_exact(8), tags.chunks_exact(8));
         let rest = fs.remainder().iter().zip(xs.remainder());
         for (c, (f, x)) in fs.zip(xs).enumerate() {
@@ -427,6 +430,42 @@ impl<const F: usize, I: SlotIndex> Triangles<F, I> {
     }
 }
 
+/// [`Vertices::settled_until`] of a whole word (`usize::BITS` slots) while the counts run, on
+/// targets with vectors: a settled tag fits 16 bits (an expiry below `2 REBASE - 1` and the
+/// count's bit), and so do both thresholds (not `u32::MAX` counts, a frame that trusts no
+/// mark), so the expiries are tested as lanes of 16 bits, which the compiler vectorizes, and
+/// their bytes gathered eight at a time as there. `None` when it does not apply.
+#[cfg(any(target_arch = "x86_64", target_arch = "aarch64"))]
+#[inline(always)]
+fn settled_word<I: SlotIndex>(flags: &[u8], tags: &[I], now: [u32; 2]) -> Option<usize> {
+    let count = flags.len();
+    let thresholds = [now[0], TURNING.saturating_add(now[1])].map(u16::try_from);
+    let ([Ok(t0), Ok(t1)], true) = (thresholds, count == usize::BITS as usize) else {
+        return None;
+    };
+    let d = t0 ^ t1;
+    let mut lanes = [0u8; 64];
+    for ((l, &f), &x) in lanes.iter_mut().zip(flags).zip(tags) {
+        let t = x.index() as u16;
+        let threshold = t0 ^ (d & (t >> 15).wrapping_neg());
+        *l = ((f >> SETTLED.trailing_zeros()) & 1) & u8::from(t >= threshold);
+    }
+    let mut bits = 0usize;
+    for (c, chunk) in lanes[..count].chunks_exact(8).enumerate() {
+        let w = u64::from_le_bytes(core::array::from_fn(|k| chunk[k]));
+        bits |= ((w.wrapping_mul(0x0102_0408_1020_4080) >> 56) as usize) << (8 * c);
+    }
+    Some(bits)
+}
+
+/// Without vectors (a Cortex-M) lanes of 16 bits cost more than the byte test of
+/// [`Vertices::settled_until`]: never applies.
+#[cfg(not(any(target_arch = "x86_64", target_arch = "aarch64")))]
+#[inline(always)]
+fn settled_word<I: SlotIndex>(_: &[u8], _: &[I], _: [u32; 2]) -> Option<usize> {
+    None
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -448,12 +487,31 @@ mod tests {
             if random() % 3 != 0 {
                 // On either count.
                 let count = if random() % 2 == 0 { TURNING } else { 0 };
-                v.mark(s as usize, Mark::Settled(count | (random() % 400)));
+                // Mostly near the counts below, some anywhere a count's expiry can be.
+                let until = if random() % 4 == 0 {
+                    random() % 0x7FFF
+                } else {
+                    random() % 400
+                };
+                v.mark(s as usize, Mark::Settled(count | until));
             }
         }
         for first in 0..70 {
             for count in 0..=(usize::BITS as usize).min(200 - first) {
-                for now in [[0, 0], [1, 150], [150, 1], [399, 400], [400, 399]] {
+                // Counts whose thresholds fit 16 bits (the whole word's vector test) and ones
+                // that do not (a frame that trusts no mark, a turning threshold past 16 bits).
+                for now in [
+                    [0, 0],
+                    [1, 150],
+                    [150, 1],
+                    [399, 400],
+                    [400, 399],
+                    [0x7FFE, 0x7FFF],
+                    [20_000, 30_000],
+                    [3, 0x8000],
+                    [70_000, 5],
+                    [u32::MAX, u32::MAX],
+                ] {
                     let mut want = 0usize;
                     for k in 0..count {
                         let s = first + k;
