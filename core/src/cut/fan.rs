@@ -13,6 +13,14 @@ use super::{Cut, NIL};
 /// rather than walked forever.
 pub const MAX_FAN: usize = 1024;
 
+/// Whether `fan` holds triangle `f`. A loop of our own, inlined where it is asked: the slice's
+/// `contains` is a call out of line, which costs more than the few triangles of a fan.
+#[inline(always)]
+#[allow(clippy::manual_contains)]
+pub(crate) fn holds(fan: &[u32], f: u32) -> bool {
+    fan.iter().any(|&g| g == f)
+}
+
 /// The triangle slots of one fan: scratch on the stack, never in the cut, so an uninitialised
 /// vector (making one writes no memory; an arena would zero its 4 KiB each time).
 pub(crate) type Fan = heapless::Vec<u32, MAX_FAN>;
@@ -88,7 +96,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             None => return false,
         };
         while g != NIL {
-            if out[..ccw_part].iter().any(|&f| f == g) || out.push(g).is_err() {
+            if holds(&out[..ccw_part], g) || out.push(g).is_err() {
                 return false;
             }
             g = match self.cw(g, v) {

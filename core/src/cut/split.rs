@@ -1,7 +1,7 @@
 //! Vertex splits: Hoppe's legality test (`vspl_legal`), the split itself (`apply_vspl`), and
 //! forced splits (`force_vsplit`; the merge-tree paper's forced refinement, §3.6).
 
-use super::fan::Fan;
+use super::fan::{holds, Fan};
 use super::slot::SlotIndex;
 use super::{next3, Cut, Refused, NIL};
 use crate::format::{HierarchyView, Record, NONE};
@@ -141,15 +141,14 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         if !reached && ns[0] != NIL {
             let mut f = ns[0];
             while f != NIL {
-                if moved.iter().any(|&g| g == f) {
+                if holds(moved, f) {
                     return Err(Refused::Inconsistent);
                 }
                 moved.push(f).map_err(|_| Refused::Inconsistent)?;
                 f = self.cw(f, ps).ok_or(Refused::Inconsistent)?;
             }
         }
-        // (Searched by a loop of our own: the slice's `contains` is a call.)
-        let moves = |f: u32| f != NIL && moved.iter().any(|&g| g == f);
+        let moves = |f: u32| f != NIL && holds(moved, f);
         if moves(ns[1]) || moves(ns[2]) {
             return Err(Refused::Inconsistent);
         }
