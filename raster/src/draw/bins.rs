@@ -375,18 +375,59 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
     /// statistics.
     #[inline(always)]
     fn for_each_row_span(&self, span: impl FnMut(usize, u16, u16)) -> DrawStats {
-        // As the triangle loop: with no vertex outside the clipping volume, no triangle's
-        // outcodes are read.
-        match self.outside {
-            0 => self.row_spans::<false>(span),
-            _ => self.row_spans::<true>(span),
+        // A model in view with back faces culled and no wireframe (the common case) has a loop
+        // of its own, which reads no outcode and counts only the front faces: 0.7 million
+        // fewer instructions a frame for the full bunny at 320x240 than the general loop with
+        // its outcodes skipped, whose flags and counters spilled to the stack.
+        let params = self.params;
+        if self.outside == 0 && params.cull_back_faces && params.wireframe.is_none() {
+            self.front_spans(span)
+        } else {
+            self.row_spans(span)
         }
     }
 
-    /// [`ShadedMesh::for_each_row_span`] with `CLIPS` false when no vertex is outside the
-    /// clipping volume.
+    /// [`ShadedMesh::for_each_row_span`] with no vertex outside the clipping volume, back faces
+    /// culled and no wireframe: a triangle is front-facing or culled, so only the front faces
+    /// are counted.
     #[inline(always)]
-    fn row_spans<const CLIPS: bool>(&self, mut span: impl FnMut(usize, u16, u16)) -> DrawStats {
+    fn front_spans(&self, mut span: impl FnMut(usize, u16, u16)) -> DrawStats {
+        let triangles = self.mesh.triangles();
+        let scratch = self.vertices;
+        let frame = Window::full(self.frame.0, self.frame.1);
+        let mut front = 0u32;
+        for (t, tri) in triangles.iter().enumerate() {
+            let (_, v) = corners(scratch, tri);
+            let xy = v.map(|v| [v.x, v.y]);
+            let area = signed_area2_xy(xy);
+            if !Facing::Front.draws(area) {
+                continue;
+            }
+            front += 1;
+            // The rows of the pixel centres it may cover: a band without them has nothing of
+            // it to fill.
+            if let Some([x0, x1, first, end]) = pixel_bounds(xy, &frame) {
+                // Bounds of one pixel centre: whether it covers that centre decides whether
+                // any band draws it (most such triangles of a detailed mesh on a small frame
+                // cover none).
+                let single = (x0 == x1) & (first == end);
+                if !single || covers_centre(clockwise(area, xy), x0, first) {
+                    span(t, first as u16, end as u16);
+                }
+            }
+        }
+        let submitted = triangles.len() as u32;
+        DrawStats {
+            submitted,
+            rasterized: front,
+            culled: submitted - front,
+            ..DrawStats::default()
+        }
+    }
+
+    /// [`ShadedMesh::for_each_row_span`] in general.
+    #[inline(always)]
+    fn row_spans(&self, mut span: impl FnMut(usize, u16, u16)) -> DrawStats {
         let triangles = self.mesh.triangles();
         let (params, scratch) = (self.params, self.vertices);
         let facing = Facing::culling(params.cull_back_faces);
@@ -400,7 +441,7 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
         };
         for (t, tri) in triangles.iter().enumerate() {
             let ([i0, i1, i2], v) = corners(scratch, tri);
-            let union = outcodes::<CLIPS>(&v);
+            let union = outcodes::<true>(&v);
             if union == 0 {
                 let xy = v.map(|v| [v.x, v.y]);
                 let area = signed_area2_xy(xy);
