@@ -149,6 +149,13 @@ pub fn signed_area2_xy(p: [[i32; 2]; 3]) -> i64 {
 /// ```
 #[inline(always)]
 pub fn pixel_bounds(p: [[i32; 2]; 3], window: &Window) -> Option<[i32; 4]> {
+    let [x0, x1, y0, y1] = pixel_box(p, window);
+    (x0 <= x1 && y0 <= y1).then_some([x0, x1, y0, y1])
+}
+
+/// [`pixel_bounds`] whether or not they hold a pixel: empty when `x0 > x1` or `y0 > y1`.
+#[inline(always)]
+pub(crate) fn pixel_box(p: [[i32; 2]; 3], window: &Window) -> [i32; 4] {
     let min_x = p[0][0].min(p[1][0]).min(p[2][0]);
     let max_x = p[0][0].max(p[1][0]).max(p[2][0]);
     let min_y = p[0][1].min(p[1][1]).min(p[2][1]);
@@ -160,7 +167,7 @@ pub fn pixel_bounds(p: [[i32; 2]; 3], window: &Window) -> Option<[i32; 4]> {
     let x1 = last_centre(max_x).min(wx.wrapping_add(window.width as i32).wrapping_sub(1));
     let y0 = first_centre(min_y).max(wy);
     let y1 = last_centre(max_y).min(wy.wrapping_add(window.height as i32).wrapping_sub(1));
-    (x0 <= x1 && y0 <= y1).then_some([x0, x1, y0, y1])
+    [x0, x1, y0, y1]
 }
 
 /// The first pixel whose centre (`i + 1/2`) is at or after snapped coordinate `c`. Wrapping, so

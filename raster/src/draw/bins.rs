@@ -17,7 +17,7 @@
 
 use super::{clockwise, corners, for_each_clipped, outcodes, Facing, Plain, Window, SUBPIXEL_BITS};
 use super::{needs_clipping, signed_area2_xy, DrawError, DrawStats, ShadedMesh};
-use crate::edge::{covers_centre, pixel_bounds, signed_area2};
+use crate::edge::{covers_centre, pixel_bounds, pixel_box, signed_area2};
 use crate::mesh::MeshSource;
 use crate::target::{Depth, Pixel, Target, TargetError};
 
@@ -299,7 +299,9 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
     fn bin_rows(&self, rows: &'a mut [u32]) -> (Bins<'a>, DrawStats) {
         const EMPTY: u32 = 1; // first row 1, last row 0
         rows.fill(EMPTY);
-        let stats = self.for_each_row_span(|t, first, last| rows[t] = pack_rows(first, last));
+        let stats = self.for_each_row_span(|t, first, last, keep| {
+            rows[t] = if keep { pack_rows(first, last) } else { EMPTY };
+        });
         // Each run of triangles that meet no row holds its remaining length, so that a band
         // steps over the run at once: the full-detail bunny on a small frame has five such
         // triangles to each one drawn.
@@ -330,15 +332,18 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
         starts.fill(0);
         let band_of = BandOf::new(band_rows);
         let mut len = 0;
-        let stats = self.for_each_row_span(|t, first, last| {
-            // In bounds: `rest` holds two entries per triangle.
+        let stats = self.for_each_row_span(|t, first, last, keep| {
+            // Written whether kept or not, and counted only if kept (without a branch). In
+            // bounds: `rest` holds two entries per triangle, and a triangle not kept has rows
+            // 0 and 0.
             let rows = pack_rows(first, last);
             rest[len] = t as u32;
             rest[len + 1] = rows;
-            len += 2;
+            len += 2 * usize::from(keep);
             let (a, b) = band_of.span(rows);
-            starts[a] = starts[a].wrapping_add(1);
-            starts[b + 1] = starts[b + 1].wrapping_sub(1);
+            let kept = u32::from(keep);
+            starts[a] = starts[a].wrapping_add(kept);
+            starts[b + 1] = starts[b + 1].wrapping_sub(kept);
         });
         let (pairs, entries) = rest.split_at_mut(len);
         let (mut count, mut total) = (0u32, 0usize);
@@ -370,11 +375,12 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
         (Bins::Pairs { pairs, lists }, stats)
     }
 
-    /// The culling part of the triangle loop, once: calls `span(t, first, last)` with the pixel
-    /// rows of each triangle `t` that meets a row (in order), and returns the frame's
-    /// statistics.
+    /// The culling part of the triangle loop, once: calls `span(t, first, last, true)` with the
+    /// pixel rows of each triangle `t` that meets a row (in order), and returns the frame's
+    /// statistics. It may also call `span(t, 0, 0, false)` for a triangle that meets none, to
+    /// be ignored.
     #[inline(always)]
-    fn for_each_row_span(&self, span: impl FnMut(usize, u16, u16)) -> DrawStats {
+    fn for_each_row_span(&self, span: impl FnMut(usize, u16, u16, bool)) -> DrawStats {
         // A model in view with back faces culled and no wireframe (the common case) has a loop
         // of its own, which reads no outcode and counts only the front faces: 0.7 million
         // fewer instructions a frame for the full bunny at 320x240 than the general loop with
@@ -391,7 +397,7 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
     /// culled and no wireframe: a triangle is front-facing or culled, so only the front faces
     /// are counted.
     #[inline(always)]
-    fn front_spans(&self, mut span: impl FnMut(usize, u16, u16)) -> DrawStats {
+    fn front_spans(&self, mut span: impl FnMut(usize, u16, u16, bool)) -> DrawStats {
         let triangles = self.mesh.triangles();
         let scratch = self.vertices;
         let frame = Window::full(self.frame.0, self.frame.1);
@@ -405,16 +411,18 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
             }
             front += 1;
             // The rows of the pixel centres it may cover: a band without them has nothing of
-            // it to fill.
-            if let Some([x0, x1, first, end]) = pixel_bounds(xy, &frame) {
-                // Bounds of one pixel centre: whether it covers that centre decides whether
-                // any band draws it (most such triangles of a detailed mesh on a small frame
-                // cover none).
-                let single = (x0 == x1) & (first == end);
-                if !single || covers_centre(clockwise(area, xy), x0, first) {
-                    span(t, first as u16, end as u16);
-                }
-            }
+            // it to fill. Bounds of one pixel centre: whether it covers that centre decides
+            // whether any band draws it (most such triangles of a detailed mesh on a small
+            // frame cover none). Without a branch: whether a small triangle's bounds hold a
+            // centre, and whether it covers it, are as good as random, so the centre is tested
+            // whatever the bounds (each vertex is inside the clipping volume, so every bound is
+            // within the guard band's range, and its edge functions fit).
+            let [x0, x1, first, end] = pixel_box(xy, &frame);
+            let any = (x0 <= x1) & (first <= end);
+            let single = (x0 == x1) & (first == end);
+            let keep = any & (!single | covers_centre(clockwise(area, xy), x0, first));
+            let (first, end) = if keep { (first, end) } else { (0, 0) };
+            span(t, first as u16, end as u16, keep);
         }
         let submitted = triangles.len() as u32;
         DrawStats {
@@ -427,7 +435,7 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
 
     /// [`ShadedMesh::for_each_row_span`] in general.
     #[inline(always)]
-    fn row_spans(&self, mut span: impl FnMut(usize, u16, u16)) -> DrawStats {
+    fn row_spans(&self, mut span: impl FnMut(usize, u16, u16, bool)) -> DrawStats {
         let triangles = self.mesh.triangles();
         let (params, scratch) = (self.params, self.vertices);
         let facing = Facing::culling(params.cull_back_faces);
@@ -462,7 +470,7 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
                         // on a small frame cover none).
                         let single = (x0 == x1) & (first == end);
                         if !single || covers_centre(clockwise(area, xy), x0, first) {
-                            span(t, first as u16, end as u16);
+                            span(t, first as u16, end as u16, true);
                         }
                     }
                     continue;
@@ -472,13 +480,13 @@ impl<'a, M: MeshSource> ShadedMesh<'a, M> {
                 let first = ys[0].min(ys[1]).min(ys[2]).max(0);
                 let end = ys[0].max(ys[1]).max(ys[2]).min(last);
                 if first <= end {
-                    span(t, first as u16, end as u16);
+                    span(t, first as u16, end as u16, true);
                 }
                 continue;
             }
             if needs_clipping(&v, union, &mut stats) {
                 self.count_clipped(&[i0, i1, i2], union, facing, &mut stats);
-                span(t, 0, last as u16);
+                span(t, 0, last as u16, true);
             }
         }
         stats
