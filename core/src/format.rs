@@ -1087,7 +1087,11 @@ impl<'a> HierarchyView<'a> {
         };
         [
             located(first, parent, rank),
-            located(second, self.is_parent(second), rank + parent as u32),
+            located(
+                second,
+                self.is_parent(second),
+                rank.wrapping_add(parent as u32),
+            ),
         ]
     }
 

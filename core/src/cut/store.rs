@@ -145,14 +145,14 @@ impl<const V: usize, I: SlotIndex> Vertices<V, I> {
     pub fn settled_until(&self, first: usize, count: usize, now: [u32; 2]) -> usize {
         let flags = &self.flags[first..first + count];
         let tags = &self.tag[first..first + count];
+        if let Some(bits) = settled_word(flags, tags, now) {
+            return bits;
+        }
         // Eight slots at a time: a byte of 0 or 1 each (the SETTLED bits shifted down, and the
         // expiries compared), gathered into eight bits by one multiplication (byte `i` lands
         // on bit `56 + i`, and no two products share a bit); the rest one at a time.
         const ONES: u64 = 0x0101_0101_0101_0101;
         let mut bits = 0usize;
-        if let Some(bits) = settled_word(flags, tags, now) {
-            return bits;
-        }
         let (fs, xs) = (flags.chunks_exact(8), tags.chunks_exact(8));
         let rest = fs.remainder().iter().zip(xs.remainder());
         for (c, (f, x)) in fs.zip(xs).enumerate() {
