@@ -260,6 +260,18 @@ fn bound_proves_none(
     (s * s * upper * SLACK <= t * d2) & zone.beyond_near(d2, radius, SLACK)
 }
 
+/// The demand of a policy that reads only spheres ([`reads_spheres`]) for a vertex whose
+/// sphere is `center` and `radius` (its digest's: the floats its record decodes to).
+#[inline(always)]
+fn sphere_demand<P: Policy>(policy: &P, (center, radius): ([f32; 3], f32), view: &View) -> Demand {
+    let b = Bounds {
+        center,
+        radius,
+        ..Bounds::default()
+    };
+    policy.demand(&b, view)
+}
+
 /// Whether `policy` reads nothing of a vertex but its bounding sphere, for vertices and pairs
 /// alike (see [`Policy::sphere_only`]).
 #[inline(always)]
@@ -508,12 +520,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 let r = sub(center, view.eye);
                 let d2 = dot(r, r);
                 let sphere = if sphere_only {
-                    let b = Bounds {
-                        center,
-                        radius,
-                        ..Bounds::default()
-                    };
-                    Some(policy.demand(&b, view))
+                    Some(sphere_demand(policy, (center, radius), view))
                 } else {
                     None
                 };
@@ -1131,12 +1138,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                     let d = if !sphere_only && frames == 0 && proven() {
                         Demand::NONE
                     } else if sphere_only {
-                        let b = Bounds {
-                            center,
-                            radius,
-                            ..Bounds::default()
-                        };
-                        policy.demand(&b, view)
+                        sphere_demand(policy, (center, radius), view)
                     } else {
                         self.judged(h, cs as usize, &h.bounds_at(record), view, policy)
                     };

@@ -149,8 +149,7 @@ impl<const V: usize, I: SlotIndex> Vertices<V, I> {
             return bits;
         }
         // Eight slots at a time: a byte of 0 or 1 each (the SETTLED bits shifted down, and the
-        // expiries compared), gathered into eight bits by one multiplication (byte `i` lands
-        // on bit `56 + i`, and no two products share a bit); the rest one at a time.
+        // expiries compared), gathered into eight bits; the rest one at a time.
         const ONES: u64 = 0x0101_0101_0101_0101;
         let mut bits = 0usize;
         let (fs, xs) = (flags.chunks_exact(8), tags.chunks_exact(8));
@@ -161,7 +160,7 @@ impl<const V: usize, I: SlotIndex> Vertices<V, I> {
                 u8::from(lives(x[k].index() as u32, now))
             }));
             let lanes = (f >> SETTLED.trailing_zeros()) & ONES & late;
-            bits |= ((lanes.wrapping_mul(0x0102_0408_1020_4080) >> 56) as usize) << (8 * c);
+            bits |= gathered(lanes) << (8 * c);
         }
         for (k, (f, x)) in rest.enumerate() {
             let k = count / 8 * 8 + k;
@@ -430,6 +429,13 @@ impl<const F: usize, I: SlotIndex> Triangles<F, I> {
     }
 }
 
+/// Eight bytes of 0 or 1 as eight bits, byte `i` to bit `i`, by one multiplication (byte `i`
+/// lands on bit `56 + i`, and no two products share a bit).
+#[inline(always)]
+fn gathered(bytes: u64) -> usize {
+    (bytes.wrapping_mul(0x0102_0408_1020_4080) >> 56) as usize
+}
+
 /// [`Vertices::settled_until`] of a whole word (`usize::BITS` slots) while the counts run, on
 /// targets with vectors: a settled tag fits 16 bits (an expiry below `2 REBASE - 1` and the
 /// count's bit), and so do both thresholds (not `u32::MAX` counts, a frame that trusts no
@@ -446,6 +452,7 @@ fn settled_word<I: SlotIndex>(flags: &[u8], tags: &[I], now: [u32; 2]) -> Option
     let d = t0 ^ t1;
     let mut lanes = [0u8; 64];
     for ((l, &f), &x) in lanes.iter_mut().zip(flags).zip(tags) {
+        // `lives` in 16 bits (as `lives` on 32-bit lanes, the frame takes 0.5% more).
         let t = x.index() as u16;
         let threshold = t0 ^ (d & (t >> 15).wrapping_neg());
         *l = ((f >> SETTLED.trailing_zeros()) & 1) & u8::from(t >= threshold);
@@ -453,7 +460,7 @@ fn settled_word<I: SlotIndex>(flags: &[u8], tags: &[I], now: [u32; 2]) -> Option
     let mut bits = 0usize;
     for (c, chunk) in lanes[..count].chunks_exact(8).enumerate() {
         let w = u64::from_le_bytes(core::array::from_fn(|k| chunk[k]));
-        bits |= ((w.wrapping_mul(0x0102_0408_1020_4080) >> 56) as usize) << (8 * c);
+        bits |= gathered(w) << (8 * c);
     }
     Some(bits)
 }
