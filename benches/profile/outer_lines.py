@@ -14,8 +14,9 @@ charges it to the outermost frame: the line of the function itself that the inst
 
 Arguments: the profile, the binary (built with line tables, e.g.
 `CARGO_PROFILE_RELEASE_DEBUG=line-tables-only`), a substring of the function's name, and
-optionally a divisor (frames) and how many lines to print (40). Prints instructions per divisor,
-the share, and the source line.
+optionally a divisor (frames), how many lines to print (40), and a function inlined into it
+(`force_split_at`) whose own lines to charge instead (the rest shows as `other`). Prints
+instructions per divisor, the share, and the source line.
 """
 
 import collections
@@ -67,19 +68,31 @@ def costs(path, name):
     return out
 
 
-def outermost(binary, addresses):
-    """Address -> the outermost `file:line` of its inlining chain."""
+def outermost(binary, addresses, within=None):
+    """Address -> the outermost `file:line` of its inlining chain, or with `within` the line of
+    the outermost frame whose function's name holds it (instructions outside it: `other`)."""
     query = "\n".join(f"0x{a:x}" for a in addresses)
     text = subprocess.run(
-        ["addr2line", "-e", binary, "-i", "-a"], input=query, capture_output=True, text=True
+        ["addr2line", "-e", binary, "-i", "-f", "-C", "-a"],
+        input=query,
+        capture_output=True,
+        text=True,
     ).stdout
     out = {}
     address = None
+    function = None
     for line in text.splitlines():
         if line.startswith("0x"):
             address = int(line, 16)
+            function = None
+            if within is not None:
+                out[address] = "other:?"
+        elif address is not None and function is None:
+            function = line
         elif address is not None:
-            out[address] = line.split(" ")[0]
+            if within is None or within in function:
+                out[address] = line.split(" ")[0]
+            function = None
     return out
 
 
@@ -90,9 +103,10 @@ def main():
     path, binary, name = sys.argv[1:4]
     divisor = float(sys.argv[4]) if len(sys.argv) > 4 else 1.0
     shown = int(sys.argv[5]) if len(sys.argv) > 5 else 40
+    within = sys.argv[6] if len(sys.argv) > 6 else None
     cost = costs(path, name)
     lines = collections.Counter()
-    for address, where in outermost(binary, sorted(cost)).items():
+    for address, where in outermost(binary, sorted(cost), within).items():
         lines[where] += cost[address]
     total = sum(cost.values())
     print(f"{total / divisor:.0f} instructions per divisor in functions matching {name!r}")
