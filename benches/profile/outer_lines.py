@@ -36,12 +36,14 @@ def costs(path, name):
     with open(path) as f:
         for line in f:
             line = line.rstrip("\n")
-            if line.startswith("fn="):
-                m = re.match(r"fn=\((\d+)\)(?: (.*))?", line)
+            if line.startswith(("fn=", "cfn=")):
+                # A name is given once, where its id first appears, which may be a call's.
+                m = re.match(r"c?fn=\((\d+)\)(?: (.*))?", line)
                 if m:
                     if m.group(2):
                         names[m.group(1)] = m.group(2)
-                    current = names.get(m.group(1), "")
+                    if line.startswith("fn="):
+                        current = names.get(m.group(1), "")
                 continue
             if line.startswith("calls="):
                 # The next cost line is the call's inclusive cost, not this function's own.
