@@ -9,7 +9,7 @@ use vdlod_core::adapt::Budget;
 use vdlod_core::build::{build, BuildOptions, InputMesh};
 use vdlod_core::cut::Cut;
 use vdlod_core::format::{crc32, HierarchyView, COUNT_OFFSETS, CRC_OFFSET, HEADER_SIZE, NONE};
-use vdlod_core::policy::{QRefine, View};
+use vdlod_core::policy::{MergeTree, QRefine, View};
 use vdlod_demo::mesh::{load_obj_bytes, COW_NAME, COW_OBJ};
 
 fn cow_bytes() -> &'static [u8] {
@@ -72,15 +72,26 @@ fn walk(view: &HierarchyView<'_>) {
 }
 
 /// A small cut over whatever parsed: refinement, a few frames from around and inside (its slots
-/// renumbered now and then), coarsening.
-/// Hostile files may be refused or leave the cut coarse, but nothing may panic.
-fn fly(view: &HierarchyView<'_>) {
+/// renumbered now and then), coarsening; then frames without geomorphs or a budget, in small
+/// steps (refinement depth first, new children decided from their digests, settled vertices
+/// skipped until their marks expire), under a policy that judges bounds and one that reads
+/// spheres only. Hostile files may be refused or leave the cut coarse, but nothing may panic,
+/// and the cut stays whole ([`Cut::check`]) after everything it does. Returns, for the frames
+/// without geomorphs under each policy, the splits, collapses and settled vertices they counted.
+fn fly(view: &HierarchyView<'_>) -> [[u32; 3]; 2] {
+    let mut counted = [[0u32; 3]; 2];
     let mut cut = Cut::<512, 1024, 128>::boxed();
     if cut.reset(view).is_err() {
-        return;
+        return counted;
     }
+    let whole = |cut: &Cut<512, 1024, 128>, what: &str| {
+        if let Err(d) = cut.check(view) {
+            panic!("{what}: {d:?}");
+        }
+    };
     cut.set_geomorph_frames(2);
     let _ = cut.refine_everything(view);
+    whole(&cut, "refine_everything");
     for i in 0..6 {
         let a = i as f32;
         let eye = [3.0 * a.cos(), 0.5 - 0.2 * a, 3.0 * a.sin() - 0.5 * a];
@@ -90,13 +101,42 @@ fn fly(view: &HierarchyView<'_>) {
             ..Budget::default()
         };
         let _ = cut.adapt(view, &v, &QRefine::new(0.5 + a), &budget);
+        whole(&cut, "adapt under a budget");
         if i % 2 == 1 {
             let _ = cut.renumber();
+            whole(&cut, "renumber");
         }
     }
     for p in view.parent_nodes().take(2000) {
         let _ = cut.collapse(view, p);
     }
+    whole(&cut, "collapse");
+    cut.set_geomorph_frames(0);
+    for i in 0..12 {
+        // Small steps, receding: marks are made and expire, and detail is given back.
+        let (a, d) = (0.03 * i as f32, 2.0 + 0.25 * (i % 8) as f32);
+        let eye = [d * a.cos(), 0.4, d * a.sin()];
+        let v = View::look_at(eye, [0.0; 3], [0.0, 1.0, 0.0], 1.0, 1.3, 240.0);
+        let (k, stats) = if i < 8 {
+            (
+                0,
+                cut.adapt(view, &v, &QRefine::new(0.5), &Budget::default()),
+            )
+        } else {
+            (
+                1,
+                cut.adapt(view, &v, &MergeTree { near: 2.5 }, &Budget::default()),
+            )
+        };
+        whole(&cut, "adapt without geomorphs or a budget");
+        for (c, n) in counted[k]
+            .iter_mut()
+            .zip([stats.vsplits, stats.ecols, stats.settled])
+        {
+            *c += n;
+        }
+    }
+    counted
 }
 
 /// Forges the checksum so that corruption reaches the structural checks.
@@ -112,6 +152,14 @@ fn the_valid_file_parses() {
     let view = HierarchyView::parse(cow_bytes()).unwrap();
     assert_eq!(view.leaves(), 2904);
     walk(&view);
+    // The hostile files' flight reaches what it is meant to on a valid one: both policies split,
+    // collapse and skip settled vertices.
+    for (policy, [splits, collapses, settled]) in ["QRefine", "MergeTree"].iter().zip(fly(&view)) {
+        assert!(
+            splits > 0 && collapses > 0 && settled > 0,
+            "{policy}: {splits} {collapses} {settled}"
+        );
+    }
 }
 
 proptest! {
