@@ -7,7 +7,8 @@ use glam::{Mat4, Vec3};
 use proptest::prelude::*;
 use vdlod_raster::edge::{fill_triangle, Facing, ScreenVertex, SUBPIXEL_ONE};
 use vdlod_raster::{
-    draw_indexed, DrawError, DrawParams, Mesh, Rgba8, ShadedVertex, Shading, Target, DEPTH_CLEAR,
+    draw_indexed, CheckedMesh, DrawError, DrawParams, IndexProof, Mesh, MeshSource, Rgba8,
+    ShadedVertex, Shading, SourceVertex, Target, DEPTH_CLEAR,
 };
 
 const BG: Rgba8 = Rgba8([0, 0, 0, 255]);
@@ -177,6 +178,14 @@ impl Guarded {
         mesh: &Mesh<'_>,
         params: &DrawParams,
     ) -> Result<vdlod_raster::DrawStats, DrawError> {
+        self.draw_source(mesh, params)
+    }
+
+    fn draw_source<M: MeshSource>(
+        &mut self,
+        mesh: &M,
+        params: &DrawParams,
+    ) -> Result<vdlod_raster::DrawStats, DrawError> {
         let n = self.w * self.h;
         let mut target = Target::new(
             &mut self.color[PAD..PAD + n],
@@ -186,7 +195,7 @@ impl Guarded {
         )
         .unwrap();
         target.clear(BG);
-        let mut scratch = vec![ShadedVertex::default(); mesh.positions.len()];
+        let mut scratch = vec![ShadedVertex::default(); mesh.vertex_count()];
         draw_indexed(&mut target, mesh, params, &mut scratch)
     }
 
@@ -313,6 +322,85 @@ fn huge_and_non_finite_coordinates_are_safe() {
     assert_eq!(stats.invalid, 2, "{stats:?}");
     // The huge triangle covers the whole view.
     assert_eq!(g.drawn(), 64 * 48);
+}
+
+/// A source that hands on a checked mesh's proof with triangles of its own.
+struct Forged<'a> {
+    mesh: Mesh<'a>,
+    proof: Option<IndexProof>,
+}
+
+impl MeshSource for Forged<'_> {
+    type Index = u32;
+    fn vertex_count(&self) -> usize {
+        self.mesh.vertex_count()
+    }
+    fn triangles(&self) -> &[[u32; 3]] {
+        self.mesh.triangles
+    }
+    fn vertex(&self, i: usize) -> SourceVertex {
+        self.mesh.vertex(i)
+    }
+    fn has_normals(&self) -> bool {
+        false
+    }
+    fn has_colors(&self) -> bool {
+        false
+    }
+    fn index_proof(&self) -> Option<IndexProof> {
+        self.proof
+    }
+}
+
+#[test]
+fn a_checked_mesh_draws_alike_and_its_proof_covers_only_itself() {
+    let n = 6u32;
+    let positions: Vec<[f32; 3]> = (0..=n)
+        .flat_map(|j| (0..=n).map(move |i| [i as f32 / 3.0 - 1.0, j as f32 / 4.0 - 0.7, 0.0]))
+        .collect();
+    let v = |i: u32, j: u32| j * (n + 1) + i;
+    let triangles: Vec<[u32; 3]> = (0..n)
+        .flat_map(|j| {
+            (0..n).flat_map(move |i| {
+                [
+                    [v(i, j), v(i + 1, j), v(i + 1, j + 1)],
+                    [v(i, j), v(i + 1, j + 1), v(i, j + 1)],
+                ]
+            })
+        })
+        .collect();
+    let mesh = Mesh {
+        positions: &positions,
+        triangles: &triangles,
+        ..Mesh::default()
+    };
+    let params = unlit(camera(Vec3::new(0.3, 0.2, 3.0)));
+    let checked = CheckedMesh::new(mesh).unwrap();
+    let (mut plain, mut once) = (Guarded::new(64, 48), Guarded::new(64, 48));
+    let stats = plain.draw(&mesh, &params).unwrap();
+    assert_eq!(once.draw_source(&checked, &params), Ok(stats));
+    assert!(stats.rasterized > 0 && plain.drawn() > 0, "{stats:?}");
+    assert!(plain.color == once.color && plain.depth == once.depth);
+    let proof = checked.index_proof().unwrap();
+    assert!(proof.covers(&checked) && proof.covers(&mesh));
+    // Handed on with other triangles, or over fewer vertices, the proof covers nothing: the
+    // draw checks the indices and names the offender, as without it.
+    let mut g = Guarded::new(8, 8);
+    for (vertices, triangles) in [(positions.len(), &[[0, 1, 99]][..]), (40, &triangles[..])] {
+        let forged = Forged {
+            mesh: Mesh {
+                positions: &positions[..vertices],
+                triangles,
+                ..Mesh::default()
+            },
+            proof: Some(proof),
+        };
+        assert!(!proof.covers(&forged));
+        assert!(matches!(
+            g.draw_source(&forged, &params),
+            Err(DrawError::IndexOutOfRange { .. })
+        ));
+    }
 }
 
 #[test]

@@ -26,7 +26,7 @@ use crate::edge::{
     pixel_bounds, scan, signed_area2, signed_area2_xy, Facing, Fragment, ScreenVertex,
     SUBPIXEL_BITS,
 };
-use crate::mesh::{MeshSource, Uv, VertexIndex};
+use crate::mesh::{check_indices, MeshSource, Uv, VertexIndex};
 use crate::target::{check_frame, Depth, Pixel, Target, TargetError, Window};
 use crate::vertex::{
     shade_vertices, to_clip, Light, PreparedLighting, ShadedVertex, VertexLighting, Viewport,
@@ -201,34 +201,11 @@ fn validate<M: MeshSource>(mesh: &M, params: &DrawParams, scratch: usize) -> Res
     if params.shading == Shading::Gouraud && !mesh.has_normals() {
         return Err(DrawError::MissingNormals);
     }
-    // Whether any index is out of range: a comparison and an `or` per index, no branch (the
-    // reduction runs in SIMD registers, where an unsigned maximum would cost twice as much on
-    // baseline x86-64); the offender is searched for only when there is one.
-    let Ok(limit) = u32::try_from(n) else {
-        return Ok(()); // every `u32` index is in range
-    };
-    let over = mesh
-        .triangles()
-        .as_flattened()
-        .iter()
-        .fold(0u32, |o, &i| o | (i.to_u32() >= limit) as u32);
-    if over == 0 {
+    // A mesh checked once (`CheckedMesh`) is not checked again.
+    if mesh.index_proof().is_some_and(|p| p.covers(mesh)) {
         return Ok(());
     }
-    for (triangle, tri) in mesh.triangles().iter().enumerate() {
-        if let Some(index) = tri
-            .map(VertexIndex::to_u32)
-            .into_iter()
-            .find(|&i| i as usize >= n)
-        {
-            return Err(DrawError::IndexOutOfRange {
-                triangle,
-                index,
-                vertices: n,
-            });
-        }
-    }
-    Ok(())
+    check_indices(mesh)
 }
 
 #[inline(always)]

@@ -60,7 +60,9 @@ pub use display::{flush, flush_with};
 pub use draw::{
     draw_indexed, shade, BinnedMesh, DrawError, DrawParams, DrawStats, ShadedMesh, Shading,
 };
-pub use mesh::{Mesh, MeshSource, SourceVertex, Uv, VertexBatch, VertexIndex, BATCH};
+pub use mesh::{
+    CheckedMesh, IndexProof, Mesh, MeshSource, SourceVertex, Uv, VertexBatch, VertexIndex, BATCH,
+};
 pub use target::{
     Depth, Pixel, Rgb565, Rgb565Be, Rgba8, Target, TargetError, Window, DEPTH_CLEAR, MAX_DIMENSION,
 };
