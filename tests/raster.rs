@@ -327,7 +327,7 @@ fn huge_and_non_finite_coordinates_are_safe() {
 /// A source that hands on a checked mesh's proof with triangles of its own.
 struct Forged<'a> {
     mesh: Mesh<'a>,
-    proof: Option<IndexProof>,
+    proof: Option<IndexProof<'a>>,
 }
 
 impl MeshSource for Forged<'_> {
@@ -347,7 +347,7 @@ impl MeshSource for Forged<'_> {
     fn has_colors(&self) -> bool {
         false
     }
-    fn index_proof(&self) -> Option<IndexProof> {
+    fn index_proof(&self) -> Option<IndexProof<'_>> {
         self.proof
     }
 }

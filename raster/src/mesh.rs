@@ -6,6 +6,8 @@
 //! vertex into RAM before a draw: the vertex stage asks the source for each vertex once, and the
 //! rare clipped or flat-shaded triangle asks for its corners' positions again.
 
+use core::marker::PhantomData;
+
 use crate::draw::DrawError;
 
 /// A vertex index type of a mesh's triangles: `u32`, or `u16` for meshes of up to 65,535
@@ -118,34 +120,44 @@ pub trait MeshSource {
     /// The proof that [`MeshSource::triangles`]' indices were checked, when they were
     /// ([`CheckedMesh`]); a draw then does not check them again. `None` by default: every draw
     /// checks them.
-    fn index_proof(&self) -> Option<IndexProof> {
+    fn index_proof(&self) -> Option<IndexProof<'_>> {
         None
     }
 }
 
-/// That a mesh's indices are all below its vertex count, made only by [`CheckedMesh::new`].
-/// It names what it checked (the triangles' address and count, and the vertex count), so a
-/// source that hands it on with other triangles or another vertex count has them checked again.
+/// That a mesh's indices are all below its vertex count, made only by a [`CheckedMesh`] and
+/// borrowing it (so no proof outlives the triangles it is about). It names what was checked
+/// (the triangles' address and count, and the vertex count), so a source that hands it on with
+/// other triangles or another vertex count has them checked again.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct IndexProof {
+pub struct IndexProof<'a> {
+    checked: Checked,
+    mesh: PhantomData<&'a ()>,
+}
+
+/// What a [`CheckedMesh`] checked.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Checked {
     triangles: usize,
     len: usize,
     vertices: usize,
 }
 
-impl IndexProof {
-    fn of<M: MeshSource + ?Sized>(mesh: &M) -> IndexProof {
+impl Checked {
+    fn of<M: MeshSource + ?Sized>(mesh: &M) -> Checked {
         let t = mesh.triangles();
-        IndexProof {
+        Checked {
             triangles: t.as_ptr() as usize,
             len: t.len(),
             vertices: mesh.vertex_count(),
         }
     }
+}
 
+impl IndexProof<'_> {
     /// Whether this proof is about `mesh`'s triangles and vertex count as they are now.
     pub fn covers<M: MeshSource + ?Sized>(&self, mesh: &M) -> bool {
-        *self == IndexProof::of(mesh)
+        self.checked == Checked::of(mesh)
     }
 }
 
@@ -203,7 +215,7 @@ pub(crate) fn check_indices<M: MeshSource + ?Sized>(mesh: &M) -> Result<(), Draw
 #[derive(Clone, Copy, Debug)]
 pub struct CheckedMesh<M> {
     mesh: M,
-    proof: IndexProof,
+    checked: Checked,
 }
 
 impl<M: MeshSource> CheckedMesh<M> {
@@ -211,8 +223,8 @@ impl<M: MeshSource> CheckedMesh<M> {
     pub fn new(mesh: M) -> Result<CheckedMesh<M>, DrawError> {
         mesh.check()?;
         check_indices(&mesh)?;
-        let proof = IndexProof::of(&mesh);
-        Ok(CheckedMesh { mesh, proof })
+        let checked = Checked::of(&mesh);
+        Ok(CheckedMesh { mesh, checked })
     }
 
     /// The mesh.
@@ -273,8 +285,11 @@ impl<M: MeshSource> MeshSource for CheckedMesh<M> {
         self.mesh.check()
     }
 
-    fn index_proof(&self) -> Option<IndexProof> {
-        Some(self.proof)
+    fn index_proof(&self) -> Option<IndexProof<'_>> {
+        Some(IndexProof {
+            checked: self.checked,
+            mesh: PhantomData,
+        })
     }
 }
 
