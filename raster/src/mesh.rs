@@ -131,33 +131,28 @@ pub trait MeshSource {
 /// other triangles or another vertex count has them checked again.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct IndexProof<'a> {
-    checked: Checked,
-    mesh: PhantomData<&'a ()>,
-}
-
-/// What a [`CheckedMesh`] checked.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-struct Checked {
     triangles: usize,
     len: usize,
     vertices: usize,
-}
-
-impl Checked {
-    fn of<M: MeshSource + ?Sized>(mesh: &M) -> Checked {
-        let t = mesh.triangles();
-        Checked {
-            triangles: t.as_ptr() as usize,
-            len: t.len(),
-            vertices: mesh.vertex_count(),
-        }
-    }
+    mesh: PhantomData<&'a ()>,
 }
 
 impl IndexProof<'_> {
+    /// What `mesh` holds now; a [`CheckedMesh`] keeps it and lends it out only for as long as
+    /// it is borrowed.
+    fn of<M: MeshSource + ?Sized>(mesh: &M) -> IndexProof<'static> {
+        let t = mesh.triangles();
+        IndexProof {
+            triangles: t.as_ptr() as usize,
+            len: t.len(),
+            vertices: mesh.vertex_count(),
+            mesh: PhantomData,
+        }
+    }
+
     /// Whether this proof is about `mesh`'s triangles and vertex count as they are now.
     pub fn covers<M: MeshSource + ?Sized>(&self, mesh: &M) -> bool {
-        self.checked == Checked::of(mesh)
+        *self == IndexProof::of(mesh)
     }
 }
 
@@ -215,7 +210,7 @@ pub(crate) fn check_indices<M: MeshSource + ?Sized>(mesh: &M) -> Result<(), Draw
 #[derive(Clone, Copy, Debug)]
 pub struct CheckedMesh<M> {
     mesh: M,
-    checked: Checked,
+    proof: IndexProof<'static>,
 }
 
 impl<M: MeshSource> CheckedMesh<M> {
@@ -223,8 +218,8 @@ impl<M: MeshSource> CheckedMesh<M> {
     pub fn new(mesh: M) -> Result<CheckedMesh<M>, DrawError> {
         mesh.check()?;
         check_indices(&mesh)?;
-        let checked = Checked::of(&mesh);
-        Ok(CheckedMesh { mesh, checked })
+        let proof = IndexProof::of(&mesh);
+        Ok(CheckedMesh { mesh, proof })
     }
 
     /// The mesh.
@@ -286,10 +281,7 @@ impl<M: MeshSource> MeshSource for CheckedMesh<M> {
     }
 
     fn index_proof(&self) -> Option<IndexProof<'_>> {
-        Some(IndexProof {
-            checked: self.checked,
-            mesh: PhantomData,
-        })
+        Some(self.proof)
     }
 }
 
