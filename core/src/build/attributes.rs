@@ -124,25 +124,47 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, mut e: Engine<'_>, on_border: &Border
     };
     for t in mesh.triangles {
         let n = face_normal(t);
-        for &v in t {
-            axis[v as usize] = add(axis[v as usize], n);
-            weight[v as usize] += len(n);
-            for &w in t {
-                radius[v as usize] = radius[v as usize].max(len(sub(at(&nodes, w), at(&nodes, v))));
-            }
+        let area = len(n);
+        let corner = t.map(|i| at(&nodes, i));
+        // Each edge's length once: measured either way it is the same number.
+        let edge: [f64; 3] = core::array::from_fn(|k| len(sub(corner[(k + 1) % 3], corner[k])));
+        for (k, &v) in t.iter().enumerate() {
+            let v = v as usize;
+            axis[v] = add(axis[v], n);
+            weight[v] += area;
+            radius[v] = radius[v].max(edge[k]).max(edge[(k + 2) % 3]);
         }
     }
     for a in axis.iter_mut().take(leaves) {
         *a = quantized_axis(normalize(*a).unwrap_or([0.0, 0.0, 1.0]));
     }
-    // The unit normals again rather than kept from the loop above (32 bytes a triangle).
+    // The cone's half-angle is the widest angle between the axis and a triangle's normal, the
+    // one of the smallest cosine: `atan2` only measures the triangles within `1e-9` of it
+    // (angles whose cosines differ by that differ by as much, far above the rounding of either
+    // measure, so the largest is among them), one or two of a vertex's six or so. The unit
+    // normals are made again rather than kept from the loop above (32 bytes a triangle); a
+    // degenerate triangle opens the cone wide (`-inf`: no cosine is that small).
+    let mut least = vec![f64::INFINITY; leaves];
     for t in mesh.triangles {
         let n = normalize(face_normal(t));
         for &v in t {
             let v = v as usize;
-            half[v] = half[v].max(n.map_or(core::f64::consts::PI, |n| angle(axis[v], n)));
+            least[v] = n.map_or(f64::NEG_INFINITY, |n| least[v].min(dot(axis[v], n)));
         }
     }
+    for t in mesh.triangles {
+        let n = normalize(face_normal(t));
+        for &v in t {
+            let v = v as usize;
+            let widest = match n {
+                None => core::f64::consts::PI,
+                Some(n) if dot(axis[v], n) <= least[v] + 1e-9 => angle(axis[v], n),
+                Some(_) => continue,
+            };
+            half[v] = half[v].max(widest);
+        }
+    }
+    drop(least);
     // Parents, in formation order (children first).
     for c in &e.collapses {
         let p = c.parent as usize;

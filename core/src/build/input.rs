@@ -189,121 +189,137 @@ pub(crate) fn checked(mesh: &InputMesh<'_>) -> Result<Borders, BuildError> {
         }
     }
 
-    // Duplicates: sort triangles by their sorted corners.
-    let keyed: Vec<([u32; 3], u32)> = mesh
-        .triangles
-        .iter()
-        .enumerate()
-        .map(|(t, tri)| {
-            let mut k = *tri;
-            k.sort_unstable();
-            (k, t as u32)
-        })
-        .collect();
-    let keyed = sorted_by_vertex(n, &keyed, |k| k.0[0]);
-    for w in keyed.windows(2) {
-        if w[0].0 == w[1].0 {
+    // Every check reads one table: for each vertex `v`, the link edges `x -> y` of its
+    // triangles `(v, x, y)`, sorted, with the triangle's index. Each check walks the whole table
+    // before the next starts, so the first offender is the one the order of the checks names.
+    let around = Around::new(n, mesh.triangles);
+    let mut scratch: Vec<(u32, u32, u32)> = Vec::new();
+
+    // Duplicates: a triangle is filed under its smallest corner; equal corner sets are then
+    // neighbours once that vertex's triangles are sorted by their other two corners.
+    for v in 0..n as u32 {
+        scratch.clear();
+        scratch.extend(
+            around
+                .of(v)
+                .iter()
+                .filter(|e| e.0 > v && e.1 > v)
+                .map(|&(x, y, t)| (x.min(y), x.max(y), t)),
+        );
+        scratch.sort_unstable();
+        if let Some(w) = scratch
+            .windows(2)
+            .find(|w| (w[0].0, w[0].1) == (w[1].0, w[1].1))
+        {
             return Err(BuildError::DuplicateTriangle {
-                triangle: w[0].1.max(w[1].1),
-                first: w[0].1.min(w[1].1),
+                triangle: w[1].2,
+                first: w[0].2,
             });
         }
     }
 
-    // Edges: (low, high, forward?) for each directed edge; equal undirected edges are adjacent.
-    let mut edges: Vec<(u32, u32, bool)> = Vec::with_capacity(mesh.triangles.len() * 3);
-    for tri in mesh.triangles {
-        for k in 0..3 {
-            let (a, b) = (tri[k], tri[(k + 1) % 3]);
-            edges.push((a.min(b), a.max(b), a < b));
-        }
-    }
-    let edges = sorted_by_vertex(n, &edges, |e| e.0);
+    // Edges, by their lower end `v`: the triangles `(v, x, y)` hold `v -> x` and `y -> v`; an
+    // edge must be in one triangle (a border) or in two, once in each direction.
     let mut on_border = Borders::new(n);
-    let mut i = 0;
-    while i < edges.len() {
-        let mut j = i + 1;
-        while j < edges.len() && edges[j].0 == edges[i].0 && edges[j].1 == edges[i].1 {
-            j += 1;
-        }
-        let (a, b) = (edges[i].0, edges[i].1);
-        match j - i {
-            1 => {
-                on_border.insert(a);
-                on_border.insert(b);
+    let mut ends: Vec<(u32, bool)> = Vec::new();
+    for v in 0..n as u32 {
+        ends.clear();
+        for &(x, y, _) in around.of(v) {
+            if x > v {
+                ends.push((x, true));
             }
-            2 if edges[i].2 != edges[i + 1].2 => {}
-            2 => return Err(BuildError::InconsistentOrientation { a, b }),
-            _ => return Err(BuildError::NonManifoldEdge { a, b }),
+            if y > v {
+                ends.push((y, false));
+            }
         }
-        i = j;
+        ends.sort_unstable();
+        let mut i = 0;
+        while i < ends.len() {
+            let b = ends[i].0;
+            let mut j = i + 1;
+            while j < ends.len() && ends[j].0 == b {
+                j += 1;
+            }
+            match j - i {
+                1 => {
+                    on_border.insert(v);
+                    on_border.insert(b);
+                }
+                2 if ends[i].1 != ends[i + 1].1 => {}
+                2 => return Err(BuildError::InconsistentOrientation { a: v, b }),
+                _ => return Err(BuildError::NonManifoldEdge { a: v, b }),
+            }
+            i = j;
+        }
     }
 
-    // Fans: around each vertex, the link edges (x -> y for triangle v, x, y) must form one chain.
-    let mut around: Vec<(u32, u32, u32)> = Vec::with_capacity(mesh.triangles.len() * 3);
-    for tri in mesh.triangles {
-        for k in 0..3 {
-            around.push((tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3]));
-        }
-    }
-    let around = sorted_by_vertex(n, &around, |a| a.0);
-    let mut i = 0;
-    while i < around.len() {
-        let v = around[i].0;
-        let mut j = i;
-        while j < around.len() && around[j].0 == v {
-            j += 1;
-        }
-        if !single_fan(&around[i..j]) {
+    // Fans: around each vertex, the link edges must form one chain.
+    for v in 0..n as u32 {
+        let link = around.of(v);
+        if !link.is_empty() && !single_fan(link) {
             return Err(BuildError::NonManifoldVertex { vertex: v });
         }
-        i = j;
     }
     Ok(on_border)
 }
 
-/// `items` in the order `sort_unstable` gives them, where each item's order starts with
-/// `vertex(item)`, a vertex below `n`: a counting sort on the vertex, then a sort of each
-/// vertex's few items (a handful per vertex, where one sort of them all compared across the
-/// whole mesh: several times faster on large meshes).
-fn sorted_by_vertex<T: Copy + Ord>(n: usize, items: &[T], vertex: impl Fn(&T) -> u32) -> Vec<T> {
-    let Some(&first) = items.first() else {
-        return Vec::new();
-    };
-    let mut start = vec![0u32; n + 1];
-    for item in items {
-        start[vertex(item) as usize + 1] += 1;
-    }
-    for v in 0..n {
-        start[v + 1] += start[v];
-    }
-    let mut next = start.clone();
-    let mut out = vec![first; items.len()];
-    for item in items {
-        let v = vertex(item) as usize;
-        out[next[v] as usize] = *item;
-        next[v] += 1;
-    }
-    for v in 0..n {
-        out[start[v] as usize..start[v + 1] as usize].sort_unstable();
-    }
-    out
+/// For each vertex `v`, the link edges `(x, y, t)` of the triangles `t = (v, x, y)` around it,
+/// sorted: one table in two flat arrays (a counting sort on the vertex, then a sort of each
+/// vertex's handful).
+struct Around {
+    start: Vec<u32>,
+    links: Vec<(u32, u32, u32)>,
 }
 
-/// Whether the link edges `x -> y` (sorted by `x`) of one vertex form a single path or cycle.
+impl Around {
+    /// The table of `triangles`, whose corners are all below `n`.
+    fn new(n: usize, triangles: &[[u32; 3]]) -> Around {
+        let mut start = vec![0u32; n + 1];
+        for tri in triangles {
+            for &v in tri {
+                start[v as usize + 1] += 1;
+            }
+        }
+        for v in 0..n {
+            start[v + 1] += start[v];
+        }
+        let mut next = start.clone();
+        let mut links = vec![(0, 0, 0); triangles.len() * 3];
+        for (t, tri) in triangles.iter().enumerate() {
+            for k in 0..3 {
+                let v = tri[k] as usize;
+                links[next[v] as usize] = (tri[(k + 1) % 3], tri[(k + 2) % 3], t as u32);
+                next[v] += 1;
+            }
+        }
+        drop(next);
+        for v in 0..n {
+            links[start[v] as usize..start[v + 1] as usize].sort_unstable();
+        }
+        Around { start, links }
+    }
+
+    /// The link edges of vertex `v`, sorted.
+    fn of(&self, v: u32) -> &[(u32, u32, u32)] {
+        let v = v as usize;
+        &self.links[self.start[v] as usize..self.start[v + 1] as usize]
+    }
+}
+
+/// Whether the link edges `(x, y, _)` (sorted by `x`) of one vertex form a single path or cycle.
 fn single_fan(link: &[(u32, u32, u32)]) -> bool {
     // With manifold edges each x starts at most one link edge. Walk from a start that no edge ends
     // at (an open fan) or from any edge (a closed one) and count the steps.
     let next = |x: u32| {
-        link.binary_search_by_key(&x, |e| e.1)
+        link.binary_search_by_key(&x, |e| e.0)
             .ok()
-            .map(|k| link[k].2)
+            .map(|k| link[k].1)
     };
     let start = link
         .iter()
-        .map(|e| e.1)
-        .find(|&x| !link.iter().any(|e| e.2 == x))
-        .unwrap_or(link[0].1);
+        .map(|e| e.0)
+        .find(|&x| !link.iter().any(|e| e.1 == x))
+        .unwrap_or(link[0].0);
     let mut x = start;
     let mut steps = 0;
     while let Some(y) = next(x) {
@@ -339,7 +355,7 @@ mod tests {
     ];
 
     #[test]
-    fn grouping_by_vertex_sorts_as_a_full_sort_does() {
+    fn the_table_around_each_vertex_is_a_full_sort_grouped() {
         // A small generator (xorshift), so the test needs no dependency.
         let mut x = 0x9E37_79B9u32;
         let mut next = |m: u32| {
@@ -348,15 +364,22 @@ mod tests {
             x ^= x << 5;
             x % m
         };
-        for n in [1usize, 2, 7, 50] {
-            let items: Vec<(u32, u32, bool)> = (0..300)
-                .map(|_| (next(n as u32), next(9), next(2) == 1))
-                .collect();
-            let mut full = items.clone();
+        for n in [3u32, 7, 50] {
+            let triangles: Vec<[u32; 3]> = (0..300).map(|_| [next(n), next(n), next(n)]).collect();
+            let mut full: Vec<(u32, u32, u32, u32)> = Vec::new();
+            for (t, tri) in triangles.iter().enumerate() {
+                for k in 0..3 {
+                    full.push((tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3], t as u32));
+                }
+            }
             full.sort_unstable();
-            assert_eq!(sorted_by_vertex(n, &items, |e| e.0), full, "{n}");
+            let around = Around::new(n as usize, &triangles);
+            let grouped: Vec<(u32, u32, u32, u32)> = (0..n)
+                .flat_map(|v| around.of(v).iter().map(move |&(x, y, t)| (v, x, y, t)))
+                .collect();
+            assert_eq!(grouped, full, "{n}");
         }
-        assert!(sorted_by_vertex(3, &[] as &[(u32, u32, bool)], |e| e.0).is_empty());
+        assert!(Around::new(3, &[]).of(2).is_empty());
     }
 
     #[test]
