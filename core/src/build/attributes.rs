@@ -18,7 +18,7 @@ use alloc::vec::Vec;
 
 use super::bound::{equation3, hoppe};
 use super::closest::{closest, point};
-use super::collapse::{kept, Engine};
+use super::collapse::{kept, Collapsed};
 use super::input::Borders;
 use super::vec3::{add, cross, dot, from_f32, len, normalize, scale, sub, Vec3d};
 use super::{ErrorBound, Hierarchy, InputMesh, Node, NONE};
@@ -57,9 +57,8 @@ fn angle(a: Vec3d, b: Vec3d) -> f64 {
 
 /// The hierarchy of the collapses `e` made on `mesh`, whose vertices on a border `on_border`
 /// names (as `input::checked` finds them).
-pub(crate) fn finish(mesh: &InputMesh<'_>, mut e: Engine<'_>, on_border: &Borders) -> Hierarchy {
-    let heap_pushes = e.queue.pushes();
-    e.release_work();
+pub(crate) fn finish(mesh: &InputMesh<'_>, mut e: Collapsed<'_>, on_border: &Borders) -> Hierarchy {
+    let heap_pushes = e.heap_pushes;
     let leaves = mesh.positions.len();
     let m = e.pos.len();
     let mut nodes: Vec<Node> = (0..m)

@@ -35,6 +35,32 @@ pub struct Collapse {
     pub neighbours: [u32; 4],
 }
 
+/// What a run of collapses leaves for the hierarchy to be made from ([`super::attributes`]),
+/// whichever engine made them.
+pub(crate) struct Collapsed<'o> {
+    pub opts: &'o BuildOptions,
+    /// Every vertex id's position: the input's, then one per collapse.
+    pub pos: Positions<'o>,
+    /// Colours in `0..=1` by vertex id; empty when the mesh has none.
+    pub color: Vec<Vec3d>,
+    /// The input's triangles with their corners renamed by the collapses, and which are left.
+    pub faces: Vec<[u32; 3]>,
+    pub face_alive: Vec<bool>,
+    pub collapses: Vec<Collapse>,
+    /// As [`Engine::fans`] (empty under [`ErrorBound::Offset`]).
+    pub fans: Vec<[u32; 3]>,
+    pub fan_ends: Vec<u32>,
+    /// Costs computed on the way: the work done ([`super::Hierarchy::heap_pushes`]).
+    pub heap_pushes: u64,
+}
+
+impl Collapsed<'_> {
+    /// Vertex `v`'s colour in `0..=1` (black when the mesh has none).
+    pub fn color_of(&self, v: u32) -> Vec3d {
+        self.color.get(v as usize).copied().unwrap_or([0.0; 3])
+    }
+}
+
 pub(crate) struct Engine<'o> {
     pub opts: &'o BuildOptions,
     pub pos: Positions<'o>,
@@ -261,24 +287,22 @@ impl<'o> Engine<'o> {
         e
     }
 
-    /// Frees what only the collapses need (the heap of costs, the rings, quadrics, areas and
-    /// the input surface), keeping what the hierarchy is made from: positions, colours, faces,
-    /// the collapse records and fans. Called once the last collapse is made, so that the
-    /// hierarchy's own arrays do not add to the engine's at the build's peak.
-    pub fn release_work(&mut self) {
-        self.queue = CostQueue::default();
-        self.deferred = Vec::new();
-        self.rejected = Rejected::default();
-        self.vfaces = Vec::new();
-        self.vverts = Vec::new();
-        self.quadric = Vec::new();
-        self.area = Vec::new();
-        self.slot = Vec::new();
-        self.marked = Vec::new();
-        self.alive = Vec::new();
-        self.surface = None;
-        self.scratch_faces = Vec::new();
-        self.scratch_ring = Vec::new();
+    /// What the collapses leave for the hierarchy (positions, colours, faces, the collapse
+    /// records and fans), all else (the heap of costs, the rings, quadrics, areas and the input
+    /// surface) freed, so that the hierarchy's own arrays do not add to the engine's at the
+    /// build's peak.
+    pub fn into_collapsed(self) -> Collapsed<'o> {
+        Collapsed {
+            heap_pushes: self.queue.pushes(),
+            opts: self.opts,
+            pos: self.pos,
+            color: self.color,
+            faces: self.faces,
+            face_alive: self.face_alive,
+            collapses: self.collapses,
+            fans: self.fans,
+            fan_ends: self.fan_ends,
+        }
     }
 
     /// Vertex `v`'s colour in `0..=1` (black when the mesh has none).

@@ -409,7 +409,7 @@ pub fn build(
         }
     }
     progress(Progress { done, total });
-    Ok(attributes::finish(mesh, engine, &on_border))
+    Ok(attributes::finish(mesh, engine.into_collapsed(), &on_border))
 }
 
 #[cfg(test)]
