@@ -3,8 +3,9 @@
 //!
 //! Meshes: the bunny (75,408 triangles) and the bunny after one step of Loop subdivision (301,632
 //! triangles, the stand-in for the merge-tree paper's 160k-face model). vdlod builds the whole
-//! forest (QEM cost, default options) down to the base mesh; meshopt's `simplify` is asked for the
-//! same number of triangles with no error limit. Each is run `RUNS` times; the table gives the
+//! forest (QEM cost, default options) down to the base mesh, and then the balanced forest
+//! (`balanced`, made in passes); meshopt's `simplify` is asked for the same number of triangles
+//! with no error limit. Each is run `RUNS` times; the table gives the
 //! median time and the peak heap in use during the call (from a counting allocator), plus the
 //! ratios vdlod / meshopt.
 //!
@@ -114,6 +115,25 @@ fn compare(name: &str, mesh: &IndexedMesh, runs: usize) {
         out.len() / 3,
         t_ours / t_theirs,
         m_ours as f64 / m_theirs as f64
+    );
+    // The balanced forest (`--balanced`, made in passes), beside the same meshopt run.
+    let (t_bal, m_bal, hb) = measure_runs(runs, || {
+        let opts = BuildOptions {
+            balanced: true,
+            ..BuildOptions::default()
+        };
+        build(&input, &opts, &mut |_| {}).expect("valid mesh")
+    });
+    println!(
+        "{:<24} {:>8} balanced | vdlod build {:>8.1} ms {:>7.1} MB -> base {:>5} tris | \
+         vdlod/meshopt time {:.1}x memory {:.1}x",
+        "",
+        "",
+        t_bal * 1e3,
+        m_bal as f64 / 1e6,
+        hb.base_triangles.len(),
+        t_bal / t_theirs,
+        m_bal as f64 / m_theirs as f64
     );
     let n = mesh.triangles.len() as f64;
     println!(

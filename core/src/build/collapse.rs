@@ -75,7 +75,6 @@ pub(crate) struct Engine<'o> {
     pub color: Vec<[f64; 3]>,
     pub faces: Vec<[u32; 3]>,
     pub face_alive: Vec<bool>,
-    marked: Vec<bool>,
     /// Live faces around each live vertex, by slot.
     vfaces: Vec<Vec<u32>>,
     /// Sorted neighbours of each live vertex, by slot, kept up to date by [`Engine::collapse`].
@@ -86,7 +85,6 @@ pub(crate) struct Engine<'o> {
     pub queue: CostQueue,
     /// [`CostQueue::pushes`] at the queue's last purge of merged vertices' entries.
     purged_at: u64,
-    deferred: Vec<(u32, u32)>,
     /// Edges found illegal, by endpoint: retried when a collapse changes that endpoint's ring.
     rejected: Rejected,
     pub collapses: Vec<Collapse>,
@@ -228,14 +226,12 @@ impl<'o> Engine<'o> {
             slot: (0..n as u32).collect(),
             color,
             face_alive: vec![true; faces.len()],
-            marked: vec![false; faces.len()],
             faces,
             alive: vfaces.iter().map(|f| !f.is_empty()).collect(),
             alive_count: 0,
             vfaces,
             queue: CostQueue::default(),
             purged_at: 0,
-            deferred: Vec::new(),
             rejected: Rejected::with_ids(2 * n),
             collapses: Vec::new(),
             fans: Vec::new(),
@@ -440,21 +436,11 @@ impl<'o> Engine<'o> {
     }
 
     /// Whether collapsing `a-b` into `v` keeps the mesh a manifold of the same topology with no
-    /// flipped or degenerate triangle. `Err(())` means legal but for region-of-influence marks.
-    pub fn legal(&self, a: u32, b: u32, v: Vec3d) -> Result<bool, ()> {
+    /// flipped or degenerate triangle.
+    pub fn legal(&self, a: u32, b: u32, v: Vec3d) -> bool {
         let (wings, count) = self.edge_faces(a, b);
         if count == 0 {
-            return Ok(false);
-        }
-        if self.opts.balanced {
-            // Cheapest test first: blocked edges wait for the next pass anyway.
-            let touched = self.vfaces[self.at(a)]
-                .iter()
-                .chain(&self.vfaces[self.at(b)])
-                .any(|&f| self.marked[f as usize]);
-            if touched {
-                return Err(());
-            }
+            return false;
         }
         let (na, nb) = (self.neighbours(a), self.neighbours(b));
         // Link condition: the common neighbours are exactly the wings (both rings are sorted,
@@ -465,7 +451,7 @@ impl<'o> Engine<'o> {
         while let (Some(&x), Some(&y)) = (na.get(i), nb.get(j)) {
             if x == y {
                 if !w.contains(&Some(x)) {
-                    return Ok(false);
+                    return false;
                 }
                 common += 1;
             }
@@ -473,12 +459,12 @@ impl<'o> Engine<'o> {
             j += usize::from(y <= x);
         }
         if common != w.iter().flatten().count() || (w[0].is_some() && w[0] == w[1]) {
-            return Ok(false);
+            return false;
         }
         let edge_on_border = count == 1;
         let (ba, bb) = (self.on_border(a), self.on_border(b));
         if ba && bb && !edge_on_border {
-            return Ok(false); // would pinch two borders (or a border and itself) together
+            return false; // would pinch two borders (or a border and itself) together
         }
         if edge_on_border {
             // A border loop of three edges would close up.
@@ -493,7 +479,7 @@ impl<'o> Engine<'o> {
                 .filter(|&x| x != a)
                 .collect();
             if oa.iter().any(|x| ob.contains(x)) {
-                return Ok(false);
+                return false;
             }
         }
         // Degrees: the merged vertex and the wings keep enough neighbours (this also stops a
@@ -505,7 +491,7 @@ impl<'o> Engine<'o> {
         let straight = |x: u32| usize::from(ruled && !self.corners[x as usize]);
         let straight_p = usize::from(ruled && !self.corner_at(a, b, v));
         if degree_p < if border_p { 2 + straight_p } else { 3 } {
-            return Ok(false);
+            return false;
         }
         for x in w.into_iter().flatten() {
             let ring = self.neighbours(x);
@@ -515,7 +501,7 @@ impl<'o> Engine<'o> {
                 4
             };
             if ring.len() < min {
-                return Ok(false);
+                return false;
             }
         }
         // No flipped or collapsed triangle, and none worse shaped than `min_shape` allows.
@@ -533,7 +519,7 @@ impl<'o> Engine<'o> {
                 let (lb, la) = (len(before), len(after));
                 let kept = la > 1e-12 * lb && dot(before, after) > 0.0;
                 if !kept {
-                    return Ok(false);
+                    return false;
                 }
                 if self.min_shape > 0.0 {
                     worst_before = worst_before.min(shape(t.map(|i| self.pos.get(i))));
@@ -541,7 +527,7 @@ impl<'o> Engine<'o> {
                 }
             }
         }
-        Ok(self.min_shape <= 0.0 || worst_after >= self.min_shape.min(worst_before))
+        self.min_shape <= 0.0 || worst_after >= self.min_shape.min(worst_before)
     }
 
     /// Collapses the cheapest legal edge; `false` when none is left.
@@ -568,33 +554,17 @@ impl<'o> Engine<'o> {
                 }
             }
             let Some((a, b)) = self.queue.pop() else {
-                if self.deferred.is_empty() {
-                    return false;
-                }
-                // Region-of-influence pass over (merge-tree paper §3.1): unmark and retry.
-                self.marked.iter_mut().for_each(|m| *m = false);
-                for (a, b) in core::mem::take(&mut self.deferred) {
-                    if self.alive[a as usize] && self.alive[b as usize] {
-                        self.push(a, b);
-                    }
-                }
-                continue;
+                return false;
             };
             if !self.alive[a as usize] || !self.alive[b as usize] {
                 continue;
             }
             let (v, _) = self.evaluate(a, b);
-            let legal = self.legal(a, b, v).map(|ok| ok && self.map_planar(a, b, v));
-            match legal {
-                Ok(true) => {
-                    self.collapse(a, b, v);
-                    return true;
-                }
-                Ok(false) => {
-                    self.rejected.add(a, b);
-                }
-                Err(()) => self.deferred.push((a, b)),
+            if self.legal(a, b, v) && self.map_planar(a, b, v) {
+                self.collapse(a, b, v);
+                return true;
             }
+            self.rejected.add(a, b);
         }
     }
 
@@ -704,11 +674,6 @@ impl<'o> Engine<'o> {
         }
         pf.sort_unstable();
         pf.dedup();
-        if self.opts.balanced {
-            for &f in &pf {
-                self.marked[f as usize] = true;
-            }
-        }
         if self.opts.bound != ErrorBound::Offset {
             self.fans.extend(pf.iter().map(|&f| self.faces[f as usize]));
             self.fan_ends.push(self.fans.len() as u32);

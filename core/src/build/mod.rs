@@ -12,7 +12,8 @@
 //! `Gerr^2 + length^2 + sqrt(length * dcolor)` (with `Gerr` the exact distance to the input
 //! surface, found through a grid of its triangles). With [`BuildOptions::balanced`], the merge-tree
 //! paper's region-of-influence marking keeps the forest shallow: a triangle touched by a collapse
-//! blocks further collapses around it until no unblocked collapse is left.
+//! blocks further collapses around it until no unblocked collapse is left, which the builder
+//! runs as passes over the edges sorted by cost (`passes.rs`).
 //!
 //! Each node then gets what the run-time tests need ([`Node`]): a bounding-sphere radius over its
 //! subtree's region (merge-tree §3.3), a cone of normals, an error bound ([`ErrorBound`]: the
@@ -45,6 +46,7 @@ pub(crate) mod closest;
 pub(crate) mod collapse;
 pub(crate) mod flatten;
 mod input;
+mod passes;
 mod positions;
 mod quadric;
 mod queue;
@@ -116,7 +118,9 @@ pub enum ErrorBound {
 pub struct BuildOptions {
     /// Collapse cost.
     pub cost: Cost,
-    /// Region-of-influence marking (merge-tree paper §3.1) for a balanced, shallow forest.
+    /// Region-of-influence marking (merge-tree paper §3.1) for a balanced, shallow forest: the
+    /// collapses run in passes, each collapsing, cheapest first, the edges whose regions no
+    /// other collapse of the pass has touched.
     pub balanced: bool,
     /// Stop when this many vertices are left (0: collapse while any collapse is legal).
     pub base_vertices: u32,
@@ -396,20 +400,31 @@ pub fn build(
     progress: &mut dyn FnMut(Progress),
 ) -> Result<Hierarchy, BuildError> {
     let on_border = input::checked(mesh)?;
-    let mut engine = collapse::Engine::new(mesh, opts);
     let target = (opts.base_vertices as usize).max(1);
-    let total = engine.alive_count.saturating_sub(target) as u32;
-    let step = (total / 200).max(1);
-    let mut done = 0u32;
-    progress(Progress { done, total });
-    while engine.alive_count > target && engine.step() {
-        done += 1;
-        if done.is_multiple_of(step) {
-            progress(Progress { done, total });
+    // The balanced forest is made in passes (each collapses the cheapest edges whose regions
+    // do not touch), the other by one collapse at a time from a heap of costs.
+    let collapsed = if opts.balanced {
+        let mut engine = passes::Passes::new(mesh, opts);
+        let total = engine.alive_count.saturating_sub(target) as u32;
+        progress(Progress { done: 0, total });
+        engine.run(target, &mut |done| progress(Progress { done, total }));
+        engine.into_collapsed()
+    } else {
+        let mut engine = collapse::Engine::new(mesh, opts);
+        let total = engine.alive_count.saturating_sub(target) as u32;
+        let step = (total / 200).max(1);
+        let mut done = 0u32;
+        progress(Progress { done, total });
+        while engine.alive_count > target && engine.step() {
+            done += 1;
+            if done.is_multiple_of(step) {
+                progress(Progress { done, total });
+            }
         }
-    }
-    progress(Progress { done, total });
-    Ok(attributes::finish(mesh, engine.into_collapsed(), &on_border))
+        progress(Progress { done, total });
+        engine.into_collapsed()
+    };
+    Ok(attributes::finish(mesh, collapsed, &on_border))
 }
 
 #[cfg(test)]

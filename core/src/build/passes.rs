@@ -1,0 +1,816 @@
+//! The balanced forest ([`super::BuildOptions::balanced`]) made in passes: the merge-tree
+//! paper's region-of-influence marking (El-Sana and Varshney, "Generalized View-Dependent
+//! Simplification", 1999, §3.1: a collapse blocks the collapses around it until no unblocked
+//! one is left), run the way meshoptimizer simplifies (Kapoulkine, meshoptimizer's `simplify`:
+//! the costs sorted once a pass over flat arrays, not kept in a heap).
+//!
+//! [`super::collapse::Engine`] keeps a heap of every edge's cost, collapses the cheapest legal
+//! edge and updates each vertex's lists of faces and neighbours as it goes; run balanced it also
+//! pushed every blocked edge again at each pass's end. Here each pass walks the edges in order of
+//! cost and collapses every legal edge whose region no earlier collapse of the pass touched: a
+//! collapse marks the corners of the triangles around its two ends, and an edge with an end or a
+//! wing marked waits for the next pass. What a collapse reads (the triangles around its ends and
+//! wings, their corners and positions) is therefore as the pass found it, so the triangles around
+//! each vertex sit in two flat arrays filed at the pass's start, and between passes only the
+//! marked vertices' lists are brought up to date. Costs are kept from pass to pass: only the edges
+//! of the vertices a pass made are measured again (no other edge's quadrics or ends changed), and
+//! merged into the sorted list. An edge found illegal is not tried again until a collapse touches
+//! one of its ends.
+//!
+//! The collapses are of the heap engine's kind (the same costs, placements, legality tests and
+//! records), so the hierarchy is made from them the same way ([`super::attributes`]). On the
+//! bunny a pass merges about an eighth of the live vertices, and 75 passes build the forest.
+
+use alloc::vec;
+use alloc::vec::Vec;
+
+use super::closest::Surface;
+use super::collapse::{kept, Collapse, Collapsed};
+use super::positions::Positions;
+use super::quadric::{place, Quadric};
+use super::vec3::{add, cross, dot, len, normalize, scale, sub, Vec3d};
+use super::{BuildOptions, Cost, ErrorBound, InputMesh, Placement, NONE};
+
+/// An edge waiting to collapse: its place in the order (its cost's `f32` bits above the count
+/// of costs measured before it, so that ties go to the older edge, as in the heap engine), its
+/// ends' vertex ids (`a < b`), and the pass that last found it illegal (0: never).
+#[derive(Clone, Copy, Debug)]
+struct Edge {
+    order: u64,
+    a: u32,
+    b: u32,
+    tried: u32,
+}
+
+/// What an edge's test found.
+enum Verdict {
+    /// An end or a wing is in a region this pass has touched: next pass.
+    Blocked,
+    /// Not legal as the mesh stands.
+    Illegal,
+    /// Legal: collapse it, the new vertex there.
+    Legal(Vec3d),
+}
+
+/// The engine. Inside it a live vertex is known by its *slot*, which a collapse's vertex
+/// takes over from its first end, so that the triangles' corners, the marks and the filing
+/// never need more than one entry per input vertex; vertex ids (which name one position for
+/// ever) appear only in the edges and the collapse records.
+pub(crate) struct Passes<'o> {
+    opts: &'o BuildOptions,
+    pos: Positions<'o>,
+    color: Vec<Vec3d>,
+    /// The input's triangles, their corners as slots.
+    faces: Vec<[u32; 3]>,
+    face_alive: Vec<bool>,
+    /// The live faces, compacted after each pass.
+    live: Vec<u32>,
+    collapses: Vec<Collapse>,
+    fans: Vec<[u32; 3]>,
+    fan_ends: Vec<u32>,
+    /// By slot: quadric, area, the live vertex in it, the pass that last touched its region
+    /// (0: none yet), and a scratch stamp for sets of neighbours.
+    quadric: Vec<Quadric>,
+    area: Vec<f64>,
+    owner: Vec<u32>,
+    mark: Vec<u32>,
+    stamp: Vec<u32>,
+    stamped: u32,
+    /// By vertex id: its slot, and whether it is live (has faces and has not merged).
+    slot: Vec<u32>,
+    alive: Vec<bool>,
+    pub alive_count: usize,
+    /// The slots of live vertices, compacted after each pass, and the live faces around each,
+    /// filed once a pass: slot `s`'s are `around[first[s]..end[s]]`, in face order.
+    live_slots: Vec<u32>,
+    first: Vec<u32>,
+    end: Vec<u32>,
+    around: Vec<u32>,
+    /// The slots this pass marked, each once.
+    touched: Vec<u32>,
+    /// Faces alive (three entries each in a compact filing).
+    faces_alive: usize,
+    /// The edges, cheapest first, and the list they are merged through.
+    edges: Vec<Edge>,
+    merged: Vec<Edge>,
+    /// Costs computed.
+    evaluations: u64,
+    surface: Option<Surface>,
+    pass: u32,
+}
+
+impl<'o> Passes<'o> {
+    /// The engine over `mesh` (which has passed the input checks), every edge measured.
+    pub fn new(mesh: &InputMesh<'o>, opts: &'o BuildOptions) -> Passes<'o> {
+        let n = mesh.positions.len();
+        let ids = n.saturating_sub(1);
+        let pos = Positions::new(mesh.positions, ids);
+        let faces = mesh.triangles.to_vec();
+        let mut quadric = vec![Quadric::default(); n];
+        let mut area = vec![0.0; n];
+        let mut alive = vec![false; n];
+        for tri in &faces {
+            let [a, b, c] = tri.map(|i| pos.get(i));
+            let q = Quadric::triangle(a, b, c);
+            let ar = 0.5 * len(cross(sub(b, a), sub(c, a)));
+            for &v in tri {
+                quadric[v as usize] = quadric[v as usize].add(&q);
+                area[v as usize] += ar / 3.0;
+                alive[v as usize] = true;
+            }
+        }
+        let mut color: Vec<Vec3d> = mesh.colors.map_or_else(Vec::new, |c| {
+            c.iter().map(|c| c.map(|v| v as f64 / 255.0)).collect()
+        });
+        color.reserve_exact(if color.is_empty() { 0 } else { ids });
+        alive.reserve_exact(ids);
+        let live_slots = (0..n as u32).filter(|&v| alive[v as usize]).collect();
+        let mut slot: Vec<u32> = (0..n as u32).collect();
+        slot.reserve_exact(ids);
+        let mut e = Passes {
+            opts,
+            pos,
+            color,
+            face_alive: vec![true; faces.len()],
+            live: (0..faces.len() as u32).collect(),
+            faces,
+            collapses: Vec::with_capacity(ids),
+            fans: Vec::new(),
+            fan_ends: Vec::new(),
+            quadric,
+            area,
+            owner: (0..n as u32).collect(),
+            mark: vec![0; n],
+            stamp: vec![0; n],
+            stamped: 0,
+            slot,
+            alive_count: alive.iter().filter(|&&a| a).count(),
+            alive,
+            live_slots,
+            first: vec![0; n],
+            end: vec![0; n],
+            around: Vec::new(),
+            touched: Vec::new(),
+            faces_alive: mesh.triangles.len(),
+            edges: Vec::new(),
+            merged: Vec::new(),
+            evaluations: 0,
+            surface: (opts.cost == Cost::Color)
+                .then(|| Surface::new(mesh.positions, mesh.triangles)),
+            pass: 0,
+        };
+        e.file_faces();
+        // Boundary quadrics keep open borders in place, as in the heap engine.
+        for f in 0..e.faces.len() {
+            let tri = e.faces[f];
+            for k in 0..3 {
+                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                if e.face_with_edge(b, a) == NONE {
+                    let n = normalize(e.face_normal(tri)).unwrap_or([0.0; 3]);
+                    let q = Quadric::boundary(e.pos.get(a), e.pos.get(b), n, 16.0);
+                    for v in [a, b] {
+                        e.quadric[v as usize] = e.quadric[v as usize].add(&q);
+                    }
+                }
+            }
+        }
+        let mut ring = Vec::new();
+        for v in 0..n as u32 {
+            if e.alive[v as usize] {
+                e.ring(v, &mut ring);
+                for &x in ring.iter().filter(|&&x| x > v) {
+                    let edge = e.edge(v, x);
+                    e.edges.push(edge);
+                }
+            }
+        }
+        let mut scratch = Vec::new();
+        sort_by_cost(&mut e.edges, &mut scratch);
+        e
+    }
+
+    /// Collapses pass after pass until `target` vertices are left or no collapse is legal;
+    /// `progress` hears the collapses done after each pass.
+    pub fn run(&mut self, target: usize, progress: &mut dyn FnMut(u32)) {
+        while self.alive_count > target {
+            self.pass += 1;
+            // A pass that made nothing marked nothing, so nothing was blocked: every edge left
+            // was tried and found illegal.
+            let made = self.pass_once(target);
+            progress(self.collapses.len() as u32);
+            if made == 0 {
+                break;
+            }
+            self.next_pass(made);
+        }
+    }
+
+    /// One pass over the sorted edges; returns the collapses it made.
+    fn pass_once(&mut self, target: usize) -> usize {
+        let k = self.pass;
+        let mut made = 0;
+        for i in 0..self.edges.len() {
+            if self.alive_count <= target {
+                break;
+            }
+            let Edge { a, b, tried, .. } = self.edges[i];
+            if !self.alive[a as usize] || !self.alive[b as usize] {
+                continue;
+            }
+            let (ma, mb) = (
+                self.mark[self.slot[a as usize] as usize],
+                self.mark[self.slot[b as usize] as usize],
+            );
+            if ma == k || mb == k || (tried != 0 && ma <= tried && mb <= tried) {
+                continue;
+            }
+            match self.judge(a, b) {
+                Verdict::Blocked => {}
+                Verdict::Illegal => self.edges[i].tried = k,
+                Verdict::Legal(v) => {
+                    self.collapse(a, b, v);
+                    made += 1;
+                }
+            }
+        }
+        made
+    }
+
+    /// Files the faces again and merges the new vertices' edges into the sorted list.
+    fn next_pass(&mut self, made: usize) {
+        let alive = &self.alive;
+        self.edges
+            .retain(|e| alive[e.a as usize] && alive[e.b as usize]);
+        self.refile();
+        let first_new = (self.pos.len() - made) as u32;
+        let mut fresh = Vec::new();
+        let mut ring = Vec::new();
+        for p in first_new..self.pos.len() as u32 {
+            self.ring(p, &mut ring);
+            for &x in &ring {
+                // Vertices made in one pass are never neighbours, but an edge is listed once.
+                if x < first_new || p < x {
+                    fresh.push(self.edge(p.min(x), p.max(x)));
+                }
+            }
+        }
+        sort_by_cost(&mut fresh, &mut self.merged);
+        let mut merged = core::mem::take(&mut self.merged);
+        merged.clear();
+        merged.reserve(self.edges.len() + fresh.len());
+        let (mut i, mut j) = (0, 0);
+        while i < self.edges.len() && j < fresh.len() {
+            if self.edges[i].order <= fresh[j].order {
+                merged.push(self.edges[i]);
+                i += 1;
+            } else {
+                merged.push(fresh[j]);
+                j += 1;
+            }
+        }
+        merged.extend_from_slice(&self.edges[i..]);
+        merged.extend_from_slice(&fresh[j..]);
+        self.merged = core::mem::replace(&mut self.edges, merged);
+    }
+
+    /// What the collapses leave for the hierarchy (the faces' corners as vertex ids again), all
+    /// else freed.
+    pub fn into_collapsed(self) -> Collapsed<'o> {
+        let owner = &self.owner;
+        let faces = self
+            .faces
+            .iter()
+            .zip(&self.face_alive)
+            .map(|(t, &alive)| {
+                if alive {
+                    t.map(|s| owner[s as usize])
+                } else {
+                    [NONE; 3]
+                }
+            })
+            .collect();
+        Collapsed {
+            heap_pushes: self.evaluations,
+            opts: self.opts,
+            pos: self.pos,
+            color: self.color,
+            faces,
+            face_alive: self.face_alive,
+            collapses: self.collapses,
+            fans: self.fans,
+            fan_ends: self.fan_ends,
+        }
+    }
+
+    /// Brings the filing up to date after a pass: only the slots the pass marked lost faces
+    /// (each collapse filed its new vertex's anew), so each of those drops its dead faces in
+    /// place; once the garbage left behind outgrows the live entries, everything is filed again.
+    fn refile(&mut self) {
+        if self.around.len() > 6 * self.faces_alive + 1024 {
+            self.touched.clear();
+            self.file_faces();
+            return;
+        }
+        for &s in &self.touched {
+            let s = s as usize;
+            if !self.alive[self.owner[s] as usize] {
+                continue;
+            }
+            let mut kept = self.first[s];
+            for i in self.first[s]..self.end[s] {
+                let f = self.around[i as usize];
+                self.around[kept as usize] = f;
+                kept += u32::from(self.face_alive[f as usize]);
+            }
+            self.end[s] = kept;
+        }
+        self.touched.clear();
+    }
+
+    /// Files every live face under its corners, in face order: a counting sort over the live
+    /// slots only (their number falls with every pass; the slots do not).
+    fn file_faces(&mut self) {
+        let face_alive = &self.face_alive;
+        self.live.retain(|&f| face_alive[f as usize]);
+        let (owner, alive) = (&self.owner, &self.alive);
+        self.live_slots
+            .retain(|&s| alive[owner[s as usize] as usize]);
+        let (first, end) = (&mut self.first, &mut self.end);
+        for &s in &self.live_slots {
+            end[s as usize] = 0;
+        }
+        for &f in &self.live {
+            for s in self.faces[f as usize] {
+                end[s as usize] += 1;
+            }
+        }
+        let mut at = 0;
+        for &s in &self.live_slots {
+            let s = s as usize;
+            first[s] = at;
+            at += end[s];
+            // `end` runs from the first as the slot fills.
+            end[s] = first[s];
+        }
+        self.around.clear();
+        self.around.resize(at as usize, 0);
+        for &f in &self.live {
+            for s in self.faces[f as usize] {
+                let at = &mut end[s as usize];
+                self.around[*at as usize] = f;
+                *at += 1;
+            }
+        }
+    }
+
+    /// The faces around slot `s` as filed at the pass's start.
+    fn faces_of(&self, s: u32) -> &[u32] {
+        let s = s as usize;
+        &self.around[self.first[s] as usize..self.end[s] as usize]
+    }
+
+    fn face_normal(&self, t: [u32; 3]) -> Vec3d {
+        let [a, b, c] = t.map(|s| self.pos.get(self.owner[s as usize]));
+        cross(sub(b, a), sub(c, a))
+    }
+
+    /// Vertex `v`'s neighbours (vertex ids), in any order, into `ring`.
+    fn ring(&mut self, v: u32, ring: &mut Vec<u32>) {
+        let s = self.slot[v as usize];
+        let tag = self.next_stamp();
+        self.stamp[s as usize] = tag;
+        ring.clear();
+        for i in self.first[s as usize]..self.end[s as usize] {
+            let f = self.around[i as usize];
+            for x in self.faces[f as usize] {
+                if self.stamp[x as usize] != tag {
+                    self.stamp[x as usize] = tag;
+                    ring.push(self.owner[x as usize]);
+                }
+            }
+        }
+    }
+
+    /// A stamp no slot carries yet.
+    fn next_stamp(&mut self) -> u32 {
+        self.stamped = self.stamped.wrapping_add(1);
+        if self.stamped == 0 {
+            self.stamp.iter_mut().for_each(|t| *t = 0);
+            self.stamped = 1;
+        }
+        self.stamped
+    }
+
+    /// Whether slot `s` is on a border, and its number of neighbours. In a manifold fan every
+    /// neighbour follows `s` in one triangle and precedes it in another, but for the two ends
+    /// of an open fan: the exclusive or of all of them is zero exactly when the fan is closed.
+    fn fan(&self, s: u32) -> (bool, usize) {
+        let faces = self.faces_of(s);
+        let mut x = 0;
+        for &f in faces {
+            if let Some((next, prev)) = after(self.faces[f as usize], s) {
+                x ^= next ^ prev;
+            }
+        }
+        (x != 0, faces.len() + usize::from(x != 0))
+    }
+
+    /// The two ends of slot `s`'s open fan (`s -> first` and `last -> s` have no twin).
+    fn fan_ends(&self, s: u32) -> [u32; 2] {
+        let faces = self.faces_of(s);
+        let mut ends = [NONE; 2];
+        for &f in faces {
+            if let Some((next, prev)) = after(self.faces[f as usize], s) {
+                let twin = |x: u32, first: bool| {
+                    faces.iter().any(|&g| {
+                        after(self.faces[g as usize], s).is_some_and(|(n, p)| {
+                            if first {
+                                p == x
+                            } else {
+                                n == x
+                            }
+                        })
+                    })
+                };
+                if !twin(next, true) {
+                    ends[0] = next;
+                }
+                if !twin(prev, false) {
+                    ends[1] = prev;
+                }
+            }
+        }
+        ends
+    }
+
+    /// The faces with directed edge `a -> b` and `b -> a` (slots), as (third corner of each or
+    /// NONE, number of faces on the edge).
+    fn edge_faces(&self, a: u32, b: u32) -> ([u32; 2], usize) {
+        let mut wings = [NONE; 2];
+        let mut count = 0;
+        for &f in self.faces_of(a) {
+            let Some((next, prev)) = after(self.faces[f as usize], a) else {
+                continue;
+            };
+            if next == b {
+                wings[0] = prev;
+                count += 1;
+            } else if prev == b {
+                wings[1] = next;
+                count += 1;
+            }
+        }
+        (wings, count)
+    }
+
+    /// The live face with directed edge `a -> b` (slots), or `NONE`.
+    fn face_with_edge(&self, a: u32, b: u32) -> u32 {
+        if a == NONE || b == NONE {
+            return NONE;
+        }
+        self.faces_of(a)
+            .iter()
+            .copied()
+            .find(|&f| after(self.faces[f as usize], a).is_some_and(|(next, _)| next == b))
+            .unwrap_or(NONE)
+    }
+
+    /// The edge `a-b` (vertex ids, `a < b`) with its cost.
+    fn edge(&mut self, a: u32, b: u32) -> Edge {
+        let (_, cost) = self.evaluate(a, b);
+        // Non-negative floats order like their bit patterns.
+        let key = if cost.is_finite() {
+            (cost.max(0.0) as f32).min(f32::MAX)
+        } else {
+            f32::MAX
+        };
+        let seq = self.evaluations as u32;
+        self.evaluations += 1;
+        Edge {
+            order: u64::from(key.to_bits()) << 32 | u64::from(seq),
+            a,
+            b,
+            tried: 0,
+        }
+    }
+
+    /// Where the merged vertex goes and what the collapse costs (the heap engine's rules).
+    fn evaluate(&self, a: u32, b: u32) -> (Vec3d, f64) {
+        let (pa, pb) = (self.pos.get(a), self.pos.get(b));
+        let (sa, sb) = (self.slot[a as usize], self.slot[b as usize]);
+        let q = self.quadric[sa as usize].add(&self.quadric[sb as usize]);
+        let len2 = dot(sub(pa, pb), sub(pa, pb));
+        let v = match (self.opts.placement, self.opts.cost) {
+            (Placement::Endpoint, _) if q.error(pb) < q.error(pa) => pb,
+            (Placement::Endpoint, _) => pa,
+            (Placement::Cost, Cost::Quadric) => place(&q, pa, pb),
+            (Placement::Cost, _) => scale(add(pa, pb), 0.5),
+        };
+        match self.opts.cost {
+            Cost::Quadric => (v, q.error(v)),
+            Cost::ShortestEdge => (v, len2),
+            Cost::Color => {
+                let gerr = self.surface.as_ref().map_or(0.0, |s| s.distance(v));
+                let color = |x: u32| self.color.get(x as usize).copied().unwrap_or([0.0; 3]);
+                let dc = len(sub(color(a), color(b)));
+                (v, gerr * gerr + len2 + libm::sqrt(libm::sqrt(len2) * dc))
+            }
+        }
+    }
+
+    /// Whether collapsing the edge `a-b` (vertex ids) keeps the mesh a manifold of the same
+    /// topology with no flipped or degenerate triangle (the heap engine's tests), or waits for
+    /// the next pass.
+    fn judge(&mut self, ia: u32, ib: u32) -> Verdict {
+        let (a, b) = (self.slot[ia as usize], self.slot[ib as usize]);
+        let (wings, count) = self.edge_faces(a, b);
+        if count == 0 {
+            return Verdict::Illegal;
+        }
+        let k = self.pass;
+        if wings
+            .iter()
+            .any(|&w| w != NONE && self.mark[w as usize] == k)
+        {
+            return Verdict::Blocked;
+        }
+        let (v, _) = self.evaluate(ia, ib);
+        if self.legal(a, b, v, wings, count) {
+            Verdict::Legal(v)
+        } else {
+            Verdict::Illegal
+        }
+    }
+
+    fn legal(&mut self, a: u32, b: u32, v: Vec3d, wings: [u32; 2], count: usize) -> bool {
+        // Link condition: the common neighbours are exactly the wings. The neighbours of `a`
+        // are stamped, then those of `b` looked up, each counted once.
+        let tag = self.next_stamp();
+        let seen = self.next_stamp();
+        for i in self.first[a as usize]..self.end[a as usize] {
+            let f = self.around[i as usize];
+            for x in self.faces[f as usize] {
+                self.stamp[x as usize] = tag;
+            }
+        }
+        let w = wings.map(|x| (x != NONE).then_some(x));
+        let mut common = 0;
+        for i in self.first[b as usize]..self.end[b as usize] {
+            let f = self.around[i as usize];
+            for x in self.faces[f as usize] {
+                if x == a || x == b || self.stamp[x as usize] != tag {
+                    continue;
+                }
+                if !w.contains(&Some(x)) {
+                    return false;
+                }
+                self.stamp[x as usize] = seen;
+                common += 1;
+            }
+        }
+        if common != w.iter().flatten().count() || (w[0].is_some() && w[0] == w[1]) {
+            return false;
+        }
+        let edge_on_border = count == 1;
+        let ((ba, ra), (bb, rb)) = (self.fan(a), self.fan(b));
+        if ba && bb && !edge_on_border {
+            return false; // would pinch two borders (or a border and itself) together
+        }
+        if edge_on_border {
+            // A border loop of three edges would close up.
+            let outer =
+                |s: u32, other: u32| self.fan_ends(s).map(|x| if x == other { NONE } else { x });
+            let (oa, ob) = (outer(a, b), outer(b, a));
+            if oa.iter().any(|&x| x != NONE && ob.contains(&x)) {
+                return false;
+            }
+        }
+        // Degrees: the merged vertex and the wings keep enough neighbours.
+        let degree_p = ra + rb - 2 - common;
+        if degree_p < if ba || bb { 2 } else { 3 } {
+            return false;
+        }
+        for x in w.into_iter().flatten() {
+            let (border, ring) = self.fan(x);
+            if ring < if border { 3 } else { 4 } {
+                return false;
+            }
+        }
+        // No flipped or collapsed triangle.
+        for s in [a, b] {
+            for &f in self.faces_of(s) {
+                let t = self.faces[f as usize];
+                if t.contains(&a) && t.contains(&b) {
+                    continue;
+                }
+                let before = self.face_normal(t);
+                let moved = t.map(|i| {
+                    if i == s {
+                        v
+                    } else {
+                        self.pos.get(self.owner[i as usize])
+                    }
+                });
+                let after = cross(sub(moved[1], moved[0]), sub(moved[2], moved[0]));
+                let (lb, la) = (len(before), len(after));
+                if !(la > 1e-12 * lb && dot(before, after) > 0.0) {
+                    return false;
+                }
+            }
+        }
+        true
+    }
+
+    /// Collapses `a-b` (vertex ids) into a new vertex at `v` and marks the region it touched.
+    fn collapse(&mut self, a: u32, b: u32, v: Vec3d) {
+        let k = self.pass;
+        let (sa, sb) = (self.slot[a as usize], self.slot[b as usize]);
+        let (wings, _) = self.edge_faces(sa, sb);
+        // Orient so that triangle (children[0], children[1], wings[0]) exists.
+        let (children, wings) = if wings[0] != NONE {
+            ([sa, sb], wings)
+        } else {
+            ([sb, sa], [wings[1], wings[0]])
+        };
+        let [c0, c1] = children;
+        let [w0, w1] = wings;
+        let faces = [self.face_with_edge(c0, c1), self.face_with_edge(c1, c0)];
+        let neighbours = [
+            self.face_with_edge(w0, c1),
+            self.face_with_edge(c0, w0),
+            self.face_with_edge(w1, c0),
+            self.face_with_edge(c1, w1),
+        ];
+        let id = |s: u32| {
+            if s == NONE {
+                NONE
+            } else {
+                self.owner[s as usize]
+            }
+        };
+        let record = Collapse {
+            parent: self.pos.len() as u32,
+            children: children.map(id),
+            wings: wings.map(id),
+            faces,
+            neighbours,
+        };
+        let p = record.parent;
+        let (ia, ib) = (a as usize, b as usize);
+        self.pos.push(v);
+        let (qa, qb) = (sa as usize, sb as usize);
+        let (area_a, area_b) = (self.area[qa], self.area[qb]);
+        self.quadric[qa] = self.quadric[qa].add(&self.quadric[qb]);
+        self.area[qa] = area_a + area_b;
+        self.slot.push(sa);
+        self.owner[qa] = p;
+        if !self.color.is_empty() {
+            let c = match kept(self.opts, v, [self.pos.get(a), self.pos.get(b)]) {
+                Some(j) => self.color[[ia, ib][j]],
+                None => {
+                    let (wa, wb) = (area_a.max(1e-30), area_b.max(1e-30));
+                    scale(
+                        add(scale(self.color[ia], wa), scale(self.color[ib], wb)),
+                        1.0 / (wa + wb),
+                    )
+                }
+            };
+            self.color.push(c);
+        }
+        // Mark the region (every corner of the faces around a and b), drop the two faces on
+        // the edge and move b's other faces to a's slot, which p now holds. The lists of a and
+        // b are read as filed: neither slot is filed again before the next pass.
+        for s in [sa, sb] {
+            for i in self.first[s as usize]..self.end[s as usize] {
+                let f = self.around[i as usize] as usize;
+                let t = self.faces[f];
+                for x in t {
+                    if self.mark[x as usize] != k {
+                        self.mark[x as usize] = k;
+                        self.touched.push(x);
+                    }
+                }
+                if t.contains(&sa) && t.contains(&sb) {
+                    self.face_alive[f] = false;
+                    self.faces_alive -= 1;
+                } else if s == sb {
+                    self.faces[f] = t.map(|x| if x == sb { sa } else { x });
+                }
+            }
+        }
+        if self.opts.bound != ErrorBound::Offset {
+            // The faces around p in face order, as the heap engine lists them.
+            let mut fan: Vec<u32> = self.faces_of(sa).to_vec();
+            fan.extend_from_slice(self.faces_of(sb));
+            fan.sort_unstable();
+            fan.dedup();
+            let owner = &self.owner;
+            for f in fan {
+                if self.face_alive[f as usize] {
+                    let t = self.faces[f as usize];
+                    self.fans.push(t.map(|s| owner[s as usize]));
+                }
+            }
+            self.fan_ends.push(self.fans.len() as u32);
+        }
+        // p's faces, filed anew at the end (the segments of a and b become garbage).
+        let from = self.around.len() as u32;
+        for s in [sa, sb] {
+            for i in self.first[s as usize]..self.end[s as usize] {
+                let f = self.around[i as usize];
+                if self.face_alive[f as usize] {
+                    self.around.push(f);
+                }
+            }
+        }
+        self.first[qa] = from;
+        self.end[qa] = self.around.len() as u32;
+        self.alive[ia] = false;
+        self.alive[ib] = false;
+        self.alive.push(true);
+        self.alive_count -= 1;
+        self.collapses.push(record);
+    }
+}
+
+/// Sorts `edges`, made in the order they were measured (so their sequence numbers rise), by
+/// cost: a stable radix sort on the cost's bits, a byte at a time, leaves the sequence numbers
+/// in order among equal costs. `scratch` is working room.
+fn sort_by_cost(edges: &mut Vec<Edge>, scratch: &mut Vec<Edge>) {
+    if edges.len() < 64 {
+        edges.sort_unstable_by_key(|e| e.order);
+        return;
+    }
+    for byte in 4..8 {
+        let digit = |e: &Edge| (e.order >> (8 * byte)) as usize & 0xff;
+        let mut start = [0usize; 257];
+        for e in edges.iter() {
+            start[digit(e) + 1] += 1;
+        }
+        if start[1..].contains(&edges.len()) {
+            continue; // every edge has this digit: nothing moves
+        }
+        for d in 0..256 {
+            start[d + 1] += start[d];
+        }
+        scratch.clear();
+        scratch.resize(edges.len(), edges[0]);
+        for e in edges.iter() {
+            let d = digit(e);
+            scratch[start[d]] = *e;
+            start[d] += 1;
+        }
+        core::mem::swap(edges, scratch);
+    }
+}
+
+/// The corners that follow `v` counter-clockwise in triangle `t` (`None` when `v` is not one).
+#[inline]
+fn after(t: [u32; 3], v: u32) -> Option<(u32, u32)> {
+    if t[0] == v {
+        Some((t[1], t[2]))
+    } else if t[1] == v {
+        Some((t[2], t[0]))
+    } else if t[2] == v {
+        Some((t[0], t[1]))
+    } else {
+        None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sorting_by_cost_keeps_the_measuring_order_among_equal_costs() {
+        // A small generator (xorshift), so the test needs no dependency.
+        let mut x = 0x2545_F491u32;
+        let mut next = |m: u32| {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            x % m
+        };
+        for n in [0usize, 1, 63, 64, 500, 5000] {
+            // Few distinct costs, so that many tie; some differ only in their top byte.
+            let mut edges: Vec<Edge> = (0..n as u32)
+                .map(|seq| {
+                    let key =
+                        [0, 1, 0x3f80_0000, 0x7f7f_ffff, 0x0100_0000][next(5) as usize] + next(3);
+                    Edge {
+                        order: u64::from(key) << 32 | u64::from(seq),
+                        a: next(100),
+                        b: 100 + next(100),
+                        tried: 0,
+                    }
+                })
+                .collect();
+            let mut expected: Vec<u64> = edges.iter().map(|e| e.order).collect();
+            expected.sort_unstable();
+            sort_by_cost(&mut edges, &mut Vec::new());
+            let got: Vec<u64> = edges.iter().map(|e| e.order).collect();
+            assert_eq!(got, expected, "{n}");
+        }
+    }
+}
