@@ -31,12 +31,13 @@ use super::quadric::{place, Quadric};
 use super::vec3::{add, cross, dot, len, normalize, scale, sub, Vec3d};
 use super::{BuildOptions, Cost, ErrorBound, InputMesh, Placement, NONE};
 
-/// An edge waiting to collapse: its place in the order (its cost's `f32` bits above the count
-/// of costs measured before it, so that ties go to the older edge, as in the heap engine), its
-/// ends' vertex ids (`a < b`), and the pass that last found it illegal (0: never).
-#[derive(Clone, Copy, Debug)]
+/// An edge waiting to collapse: its cost's `f32` bits (non-negative floats order like their
+/// bits), its ends' vertex ids (`a < b`), and the pass that last found it illegal (0: never).
+/// Among equal costs the edge measured first goes first, as in the heap engine: every sort and
+/// merge of the list is stable.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 struct Edge {
-    order: u64,
+    key: u32,
     a: u32,
     b: u32,
     tried: u32,
@@ -90,9 +91,8 @@ pub(crate) struct Passes<'o> {
     touched: Vec<u32>,
     /// Faces alive (three entries each in a compact filing).
     faces_alive: usize,
-    /// The edges, cheapest first, and the list they are merged through.
+    /// The edges, cheapest first.
     edges: Vec<Edge>,
-    merged: Vec<Edge>,
     /// Costs computed.
     evaluations: u64,
     surface: Option<Surface>,
@@ -153,7 +153,6 @@ impl<'o> Passes<'o> {
             touched: Vec::new(),
             faces_alive: mesh.triangles.len(),
             edges: Vec::new(),
-            merged: Vec::new(),
             evaluations: 0,
             surface: (opts.cost == Cost::Color)
                 .then(|| Surface::new(mesh.positions, mesh.triangles)),
@@ -254,23 +253,22 @@ impl<'o> Passes<'o> {
                 }
             }
         }
-        sort_by_cost(&mut fresh, &mut self.merged);
-        let mut merged = core::mem::take(&mut self.merged);
-        merged.clear();
-        merged.reserve(self.edges.len() + fresh.len());
-        let (mut i, mut j) = (0, 0);
-        while i < self.edges.len() && j < fresh.len() {
-            if self.edges[i].order <= fresh[j].order {
-                merged.push(self.edges[i]);
-                i += 1;
+        sort_by_cost(&mut fresh, &mut Vec::new());
+        // Merged from the back into the room `fresh` adds at the end: no second list. An old
+        // edge goes before a new one of the same cost.
+        let old = self.edges.len();
+        self.edges.resize(old + fresh.len(), Edge::default());
+        let (mut i, mut j, mut at) = (old, fresh.len(), old + fresh.len());
+        while j > 0 {
+            at -= 1;
+            if i > 0 && self.edges[i - 1].key > fresh[j - 1].key {
+                i -= 1;
+                self.edges[at] = self.edges[i];
             } else {
-                merged.push(fresh[j]);
-                j += 1;
+                j -= 1;
+                self.edges[at] = fresh[j];
             }
         }
-        merged.extend_from_slice(&self.edges[i..]);
-        merged.extend_from_slice(&fresh[j..]);
-        self.merged = core::mem::replace(&mut self.edges, merged);
     }
 
     /// What the collapses leave for the hierarchy (the faces' corners as vertex ids again), all
@@ -484,10 +482,9 @@ impl<'o> Passes<'o> {
         } else {
             f32::MAX
         };
-        let seq = self.evaluations as u32;
         self.evaluations += 1;
         Edge {
-            order: u64::from(key.to_bits()) << 32 | u64::from(seq),
+            key: key.to_bits(),
             a,
             b,
             tried: 0,
@@ -733,16 +730,24 @@ impl<'o> Passes<'o> {
     }
 }
 
-/// Sorts `edges`, made in the order they were measured (so their sequence numbers rise), by
-/// cost: a stable radix sort on the cost's bits, a byte at a time, leaves the sequence numbers
-/// in order among equal costs. `scratch` is working room.
+/// Sorts `edges` by cost, keeping the order they came in among equal costs: a radix sort on the
+/// cost's bits, a byte at a time (each pass stable), or an insertion sort of a few. `scratch` is
+/// working room.
 fn sort_by_cost(edges: &mut Vec<Edge>, scratch: &mut Vec<Edge>) {
     if edges.len() < 64 {
-        edges.sort_unstable_by_key(|e| e.order);
+        for i in 1..edges.len() {
+            let e = edges[i];
+            let mut j = i;
+            while j > 0 && edges[j - 1].key > e.key {
+                edges[j] = edges[j - 1];
+                j -= 1;
+            }
+            edges[j] = e;
+        }
         return;
     }
-    for byte in 4..8 {
-        let digit = |e: &Edge| (e.order >> (8 * byte)) as usize & 0xff;
+    for byte in 0..4 {
+        let digit = |e: &Edge| (e.key >> (8 * byte)) as usize & 0xff;
         let mut start = [0usize; 257];
         for e in edges.iter() {
             start[digit(e) + 1] += 1;
@@ -754,7 +759,7 @@ fn sort_by_cost(edges: &mut Vec<Edge>, scratch: &mut Vec<Edge>) {
             start[d + 1] += start[d];
         }
         scratch.clear();
-        scratch.resize(edges.len(), edges[0]);
+        scratch.resize(edges.len(), Edge::default());
         for e in edges.iter() {
             let d = digit(e);
             scratch[start[d]] = *e;
@@ -793,24 +798,20 @@ mod tests {
             x % m
         };
         for n in [0usize, 1, 63, 64, 500, 5000] {
-            // Few distinct costs, so that many tie; some differ only in their top byte.
+            // Few distinct costs, so that many tie; some differ only in one byte. The measuring
+            // order is in `a`.
             let mut edges: Vec<Edge> = (0..n as u32)
-                .map(|seq| {
-                    let key =
-                        [0, 1, 0x3f80_0000, 0x7f7f_ffff, 0x0100_0000][next(5) as usize] + next(3);
-                    Edge {
-                        order: u64::from(key) << 32 | u64::from(seq),
-                        a: next(100),
-                        b: 100 + next(100),
-                        tried: 0,
-                    }
+                .map(|a| Edge {
+                    key: [0, 1, 0x3f80_0000, 0x7f7f_ffff, 0x0100_0000][next(5) as usize] + next(3),
+                    a,
+                    b: n as u32 + next(100),
+                    tried: 0,
                 })
                 .collect();
-            let mut expected: Vec<u64> = edges.iter().map(|e| e.order).collect();
-            expected.sort_unstable();
+            let mut expected = edges.clone();
+            expected.sort_by_key(|e| e.key); // stable
             sort_by_cost(&mut edges, &mut Vec::new());
-            let got: Vec<u64> = edges.iter().map(|e| e.order).collect();
-            assert_eq!(got, expected, "{n}");
+            assert_eq!(edges, expected, "{n}");
         }
     }
 }
