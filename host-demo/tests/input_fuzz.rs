@@ -2,7 +2,7 @@
 //! mesh the hierarchy builder accepts, or an error; never a panic.
 
 use proptest::prelude::*;
-use vdlod_core::build::{validate, InputMesh};
+use vdlod_core::build::{build, rotate_to_min, validate, BuildOptions, InputMesh};
 use vdlod_demo::input::Soup;
 use vdlod_demo::mesh::{load_bytes, load_obj_bytes, IndexedMesh, LoadOptions};
 use vdlod_demo::repair::repair;
@@ -132,6 +132,24 @@ proptest! {
         if !mesh.triangles.is_empty() {
             let input = InputMesh { positions: &mesh.positions, colors: None, triangles: &mesh.triangles };
             prop_assert_eq!(validate(&input), Ok(()), "{}", repairs);
+            // Both engines (the heap's, and the balanced forest's passes) take what the repair
+            // gives (flat, folded, coincident corners) and make a forest that replays to it.
+            let mut expected: Vec<[u32; 3]> = mesh.triangles.iter().map(|&t| rotate_to_min(t)).collect();
+            expected.sort_unstable();
+            for balanced in [false, true] {
+                let opts = BuildOptions { balanced, ..BuildOptions::default() };
+                let h = build(&input, &opts, &mut |_| {});
+                prop_assert!(h.is_ok(), "balanced {}: {:?}", balanced, h.err());
+                let h = h.unwrap();
+                let mut replayed = h.refine_all();
+                replayed.sort_unstable();
+                prop_assert_eq!(&replayed, &expected, "balanced {}", balanced);
+                let mut base = h.collapse_all(&mesh.triangles);
+                base.sort_unstable();
+                let mut kept: Vec<[u32; 3]> = h.base_triangles.iter().map(|&t| rotate_to_min(t)).collect();
+                kept.sort_unstable();
+                prop_assert_eq!(base, kept, "balanced {}", balanced);
+            }
         }
         // Deterministic.
         prop_assert_eq!(repair(soup).0, mesh);
