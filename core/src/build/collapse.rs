@@ -342,18 +342,6 @@ impl<'o> Engine<'o> {
         (wings, count)
     }
 
-    /// The live face with directed edge `a -> b`, or `NONE`.
-    fn face_with_edge(&self, a: u32, b: u32) -> u32 {
-        if a == NONE || b == NONE {
-            return NONE;
-        }
-        self.vfaces[self.at(a)]
-            .iter()
-            .copied()
-            .find(|&f| after(self.faces[f as usize], a).is_some_and(|(next, _)| next == b))
-            .unwrap_or(NONE)
-    }
-
     fn boundary_neighbours(&self, v: u32) -> Vec<u32> {
         self.neighbours(v)
             .iter()
@@ -437,8 +425,15 @@ impl<'o> Engine<'o> {
 
     /// Whether collapsing `a-b` into `v` keeps the mesh a manifold of the same topology with no
     /// flipped or degenerate triangle.
+    #[cfg(test)]
     pub fn legal(&self, a: u32, b: u32, v: Vec3d) -> bool {
         let (wings, count) = self.edge_faces(a, b);
+        self.legal_on(a, b, v, wings, count)
+    }
+
+    /// Whether collapsing `a-b` into `v` is legal, given the third corners of its faces and their
+    /// number (`edge_faces`).
+    fn legal_on(&self, a: u32, b: u32, v: Vec3d, wings: [u32; 2], count: usize) -> bool {
         if count == 0 {
             return false;
         }
@@ -560,8 +555,9 @@ impl<'o> Engine<'o> {
                 continue;
             }
             let (v, _) = self.evaluate(a, b);
-            if self.legal(a, b, v) && self.map_planar(a, b, v) {
-                self.collapse(a, b, v);
+            let (wings, count) = self.edge_faces(a, b);
+            if self.legal_on(a, b, v, wings, count) && self.map_planar(a, b, v) {
+                self.collapse(a, b, v, wings);
                 return true;
             }
             self.rejected.add(a, b);
@@ -595,23 +591,49 @@ impl<'o> Engine<'o> {
         }
     }
 
-    fn collapse(&mut self, a: u32, b: u32, v: Vec3d) {
-        let (wings, _) = self.edge_faces(a, b);
+    /// The two faces on edge `c0-c1` (`c0 -> c1`, then `c1 -> c0`) and the four across their
+    /// outer edges (`w0 -> c1`, `c0 -> w0`, `w1 -> c0`, `c1 -> w1`), or `NONE`, from one walk
+    /// round each end: every face that holds one of those directed edges holds `c0` or `c1`, and
+    /// holds it once.
+    fn split_faces(&self, [c0, c1]: [u32; 2], [w0, w1]: [u32; 2]) -> ([u32; 2], [u32; 4]) {
+        let (mut faces, mut neighbours) = ([NONE; 2], [NONE; 4]);
+        for &f in &self.vfaces[self.at(c0)] {
+            if let Some((next, prev)) = after(self.faces[f as usize], c0) {
+                if next == c1 {
+                    faces[0] = f;
+                } else if next == w0 {
+                    neighbours[1] = f;
+                }
+                if prev == w1 {
+                    neighbours[2] = f;
+                }
+            }
+        }
+        for &f in &self.vfaces[self.at(c1)] {
+            if let Some((next, prev)) = after(self.faces[f as usize], c1) {
+                if next == c0 {
+                    faces[1] = f;
+                } else if next == w1 {
+                    neighbours[3] = f;
+                }
+                if prev == w0 {
+                    neighbours[0] = f;
+                }
+            }
+        }
+        (faces, neighbours)
+    }
+
+    /// Collapses `a-b` into a new vertex at `v`; `wings` are the third corners of the faces with
+    /// directed edges `a -> b` and `b -> a` ([`Engine::edge_faces`]).
+    fn collapse(&mut self, a: u32, b: u32, v: Vec3d, wings: [u32; 2]) {
         // Orient so that triangle (children[0], children[1], wings[0]) exists.
         let (children, wings) = if wings[0] != NONE {
             ([a, b], wings)
         } else {
             ([b, a], [wings[1], wings[0]])
         };
-        let [c0, c1] = children;
-        let [w0, w1] = wings;
-        let faces = [self.face_with_edge(c0, c1), self.face_with_edge(c1, c0)];
-        let neighbours = [
-            self.face_with_edge(w0, c1),
-            self.face_with_edge(c0, w0),
-            self.face_with_edge(w1, c0),
-            self.face_with_edge(c1, w1),
-        ];
+        let (faces, neighbours) = self.split_faces(children, wings);
         let p = self.pos.len() as u32;
         let (ia, ib) = (a as usize, b as usize);
         self.pos.push(v);
