@@ -688,8 +688,11 @@ impl<'o> Passes<'o> {
                     }
                 }
                 if t.contains(&sa) && t.contains(&sb) {
-                    self.face_alive[f] = false;
-                    self.faces_alive -= 1;
+                    // Filed under both ends: dropped on the first meeting.
+                    if self.face_alive[f] {
+                        self.face_alive[f] = false;
+                        self.faces_alive -= 1;
+                    }
                 } else if s == sb {
                     self.faces[f] = t.map(|x| if x == sb { sa } else { x });
                 }
