@@ -148,7 +148,7 @@ fn exactly(mut list: Vec<u32>, items: &[u32]) -> Vec<u32> {
 /// The corners that follow `v` counter-clockwise in triangle `t` (`None` when `v` is not one):
 /// a face of a vertex's list has it once, so one test finds which edges of the face are its.
 #[inline]
-fn after(t: [u32; 3], v: u32) -> Option<(u32, u32)> {
+pub(crate) fn after(t: [u32; 3], v: u32) -> Option<(u32, u32)> {
     if t[0] == v {
         Some((t[1], t[2]))
     } else if t[1] == v {
@@ -163,6 +163,111 @@ fn after(t: [u32; 3], v: u32) -> Option<(u32, u32)> {
 fn face_normal(p: &Positions<'_>, f: [u32; 3]) -> Vec3d {
     let [a, b, c] = f.map(|i| p.get(i));
     cross(sub(b, a), sub(c, a))
+}
+
+/// Where a collapse of `a-b` (at `pa` and `pb`, quadrics summed in `q`) puts its vertex, before
+/// any border rule: [`Placement`]'s choice for [`BuildOptions::cost`]. (These rules, shared by
+/// the heap engine and the passes, are inlined into each: out of line they cost the build a
+/// twentieth more instructions.)
+#[inline(always)]
+pub(crate) fn placement(opts: &BuildOptions, q: &Quadric, pa: Vec3d, pb: Vec3d) -> Vec3d {
+    match (opts.placement, opts.cost) {
+        (Placement::Endpoint, _) if q.error(pb) < q.error(pa) => pb,
+        (Placement::Endpoint, _) => pa,
+        (Placement::Cost, Cost::Quadric) => place(q, pa, pb),
+        (Placement::Cost, _) => scale(add(pa, pb), 0.5),
+    }
+}
+
+/// What collapsing `a-b` (ends at `pa` and `pb`, quadrics summed in `q`, `colors` their
+/// colours, asked only by [`Cost::Color`]) into a vertex at `v` costs under
+/// [`BuildOptions::cost`]; `surface` is the input's, for [`Cost::Color`].
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub(crate) fn cost_at(
+    opts: &BuildOptions,
+    q: &Quadric,
+    v: Vec3d,
+    [pa, pb]: [Vec3d; 2],
+    colors: impl FnOnce() -> [Vec3d; 2],
+    surface: Option<&Surface>,
+) -> f64 {
+    let len2 = dot(sub(pa, pb), sub(pa, pb));
+    match opts.cost {
+        Cost::Quadric => q.error(v),
+        Cost::ShortestEdge => len2,
+        Cost::Color => {
+            // The importance paper's Gerr^2 + length^2 + sqrt(length * dcolor): the new vertex
+            // at the edge's midpoint (its Fig. 2; or on an endpoint), Gerr its distance to the
+            // closest point of the input surface.
+            let gerr = surface.map_or(0.0, |s| s.distance(v));
+            let [ca, cb] = colors();
+            let dc = len(sub(ca, cb));
+            gerr * gerr + len2 + libm::sqrt(libm::sqrt(len2) * dc)
+        }
+    }
+}
+
+/// A cost as the order of collapses keys it: non-negative floats order like their bit
+/// patterns; anything not finite goes last.
+#[inline(always)]
+pub(crate) fn cost_key(cost: f64) -> u32 {
+    let key = if cost.is_finite() {
+        (cost.max(0.0) as f32).min(f32::MAX)
+    } else {
+        f32::MAX
+    };
+    key.to_bits()
+}
+
+/// The colour of the vertex merging ends of colours `ca` and `cb` at `pa` and `pb` (areas
+/// `area_a` and `area_b`) into `v`: the kept end's under [`Placement::Endpoint`], else the
+/// area-weighted mean.
+#[inline(always)]
+pub(crate) fn merged_color(
+    opts: &BuildOptions,
+    v: Vec3d,
+    [pa, pb]: [Vec3d; 2],
+    [ca, cb]: [Vec3d; 2],
+    [area_a, area_b]: [f64; 2],
+) -> Vec3d {
+    match kept(opts, v, [pa, pb]) {
+        Some(k) => [ca, cb][k],
+        None => {
+            let (wa, wb) = (area_a.max(1e-30), area_b.max(1e-30));
+            scale(add(scale(ca, wa), scale(cb, wb)), 1.0 / (wa + wb))
+        }
+    }
+}
+
+/// Whether a triangle keeps facing the same way, with an area, when its corners move from
+/// `before` to `after` (the flip test of a collapse).
+#[inline(always)]
+pub(crate) fn stays_up(before: [Vec3d; 3], after: [Vec3d; 3]) -> bool {
+    let n0 = cross(sub(before[1], before[0]), sub(before[2], before[0]));
+    let n1 = cross(sub(after[1], after[0]), sub(after[2], after[0]));
+    len(n1) > 1e-12 * len(n0) && dot(n0, n1) > 0.0
+}
+
+/// The faces with directed edge `a -> b` and `b -> a` among `around` (faces holding `a`), as
+/// (third corner of each or NONE, number of faces on the edge).
+#[inline(always)]
+pub(crate) fn edge_wings(faces: &[[u32; 3]], around: &[u32], a: u32, b: u32) -> ([u32; 2], usize) {
+    let mut wings = [NONE; 2];
+    let mut count = 0;
+    for &f in around {
+        let Some((next, prev)) = after(faces[f as usize], a) else {
+            continue;
+        };
+        if next == b {
+            wings[0] = prev;
+            count += 1;
+        } else if prev == b {
+            wings[1] = next;
+            count += 1;
+        }
+    }
+    (wings, count)
 }
 
 impl<'o> Engine<'o> {
@@ -324,22 +429,9 @@ impl<'o> Engine<'o> {
 
     /// The faces with directed edge `a -> b` and `b -> a`, as (third corner of the first or NONE,
     /// number of faces on the edge).
+    #[inline]
     fn edge_faces(&self, a: u32, b: u32) -> ([u32; 2], usize) {
-        let mut wings = [NONE; 2];
-        let mut count = 0;
-        for &f in &self.vfaces[self.at(a)] {
-            let Some((next, prev)) = after(self.faces[f as usize], a) else {
-                continue;
-            };
-            if next == b {
-                wings[0] = prev;
-                count += 1;
-            } else if prev == b {
-                wings[1] = next;
-                count += 1;
-            }
-        }
-        (wings, count)
+        edge_wings(&self.faces, &self.vfaces[self.at(a)], a, b)
     }
 
     fn boundary_neighbours(&self, v: u32) -> Vec<u32> {
@@ -380,13 +472,7 @@ impl<'o> Engine<'o> {
     pub fn evaluate(&self, a: u32, b: u32) -> (Vec3d, f64) {
         let (pa, pb) = (self.pos.get(a), self.pos.get(b));
         let q = self.quadric[self.at(a)].add(&self.quadric[self.at(b)]);
-        let len2 = dot(sub(pa, pb), sub(pa, pb));
-        let v = match (self.opts.placement, self.opts.cost) {
-            (Placement::Endpoint, _) if q.error(pb) < q.error(pa) => pb,
-            (Placement::Endpoint, _) => pa,
-            (Placement::Cost, Cost::Quadric) => place(&q, pa, pb),
-            (Placement::Cost, _) => scale(add(pa, pb), 0.5),
-        };
+        let v = placement(self.opts, &q, pa, pb);
         let v = if self.corners.is_empty() {
             v
         } else {
@@ -397,30 +483,16 @@ impl<'o> Engine<'o> {
                 _ => v,
             }
         };
-        match self.opts.cost {
-            Cost::Quadric => (v, q.error(v)),
-            Cost::ShortestEdge => (v, len2),
-            Cost::Color => {
-                // The importance paper's Gerr^2 + length^2 + sqrt(length * dcolor): the new
-                // vertex at the edge's midpoint (its Fig. 2; or on an endpoint), Gerr its
-                // distance to the closest point of the input surface.
-                let gerr = self.surface.as_ref().map_or(0.0, |s| s.distance(v));
-                let dc = len(sub(self.color_of(a), self.color_of(b)));
-                (v, gerr * gerr + len2 + libm::sqrt(libm::sqrt(len2) * dc))
-            }
-        }
+        let colors = || [self.color_of(a), self.color_of(b)];
+        let cost = cost_at(self.opts, &q, v, [pa, pb], colors, self.surface.as_ref());
+        (v, cost)
     }
 
     fn push(&mut self, a: u32, b: u32) {
         let (a, b) = (a.min(b), a.max(b));
         let (_, cost) = self.evaluate(a, b);
-        // Non-negative floats order like their bit patterns; ties go to the earlier push.
-        let key = if cost.is_finite() {
-            (cost.max(0.0) as f32).min(f32::MAX)
-        } else {
-            f32::MAX
-        };
-        self.queue.push(key.to_bits(), (a, b));
+        // Ties go to the earlier push.
+        self.queue.push(cost_key(cost), (a, b));
     }
 
     /// Whether collapsing `a-b` into `v` keeps the mesh a manifold of the same topology with no
@@ -508,16 +580,13 @@ impl<'o> Engine<'o> {
                 if t.contains(&a) && t.contains(&b) {
                     continue;
                 }
-                let before = face_normal(&self.pos, t);
+                let corners = t.map(|i| self.pos.get(i));
                 let moved = t.map(|i| if i == s { v } else { self.pos.get(i) });
-                let after = cross(sub(moved[1], moved[0]), sub(moved[2], moved[0]));
-                let (lb, la) = (len(before), len(after));
-                let kept = la > 1e-12 * lb && dot(before, after) > 0.0;
-                if !kept {
+                if !stays_up(corners, moved) {
                     return false;
                 }
                 if self.min_shape > 0.0 {
-                    worst_before = worst_before.min(shape(t.map(|i| self.pos.get(i))));
+                    worst_before = worst_before.min(shape(corners));
                     worst_after = worst_after.min(shape(moved));
                 }
             }
@@ -643,16 +712,13 @@ impl<'o> Engine<'o> {
         self.area[sa] = area_a + area_b;
         self.slot.push(sa as u32);
         if !self.color.is_empty() {
-            let c = match kept(self.opts, v, [self.pos.get(a), self.pos.get(b)]) {
-                Some(k) => self.color[[ia, ib][k]],
-                None => {
-                    let (wa, wb) = (area_a.max(1e-30), area_b.max(1e-30));
-                    scale(
-                        add(scale(self.color[ia], wa), scale(self.color[ib], wb)),
-                        1.0 / (wa + wb),
-                    )
-                }
-            };
+            let c = merged_color(
+                self.opts,
+                v,
+                [self.pos.get(a), self.pos.get(b)],
+                [self.color[ia], self.color[ib]],
+                [area_a, area_b],
+            );
             self.color.push(c);
         }
         if !self.corners.is_empty() {

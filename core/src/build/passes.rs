@@ -25,11 +25,13 @@ use alloc::vec;
 use alloc::vec::Vec;
 
 use super::closest::Surface;
-use super::collapse::{kept, Collapse, Collapsed};
+use super::collapse::{
+    after, cost_at, cost_key, edge_wings, merged_color, placement, stays_up, Collapse, Collapsed,
+};
 use super::positions::Positions;
-use super::quadric::{place, Quadric};
-use super::vec3::{add, cross, dot, len, normalize, scale, sub, Vec3d};
-use super::{BuildOptions, Cost, ErrorBound, InputMesh, Placement, NONE};
+use super::quadric::Quadric;
+use super::vec3::{cross, len, normalize, sub, Vec3d};
+use super::{BuildOptions, Cost, ErrorBound, InputMesh, NONE};
 
 /// An edge waiting to collapse: its cost's `f32` bits (non-negative floats order like their
 /// bits), its ends' vertex ids (`a < b`), and the pass that last found it illegal (0: never).
@@ -443,22 +445,9 @@ impl<'o> Passes<'o> {
 
     /// The faces with directed edge `a -> b` and `b -> a` (slots), as (third corner of each or
     /// NONE, number of faces on the edge).
+    #[inline]
     fn edge_faces(&self, a: u32, b: u32) -> ([u32; 2], usize) {
-        let mut wings = [NONE; 2];
-        let mut count = 0;
-        for &f in self.faces_of(a) {
-            let Some((next, prev)) = after(self.faces[f as usize], a) else {
-                continue;
-            };
-            if next == b {
-                wings[0] = prev;
-                count += 1;
-            } else if prev == b {
-                wings[1] = next;
-                count += 1;
-            }
-        }
-        (wings, count)
+        edge_wings(&self.faces, self.faces_of(a), a, b)
     }
 
     /// The live face with directed edge `a -> b` (slots), or `NONE`.
@@ -476,15 +465,9 @@ impl<'o> Passes<'o> {
     /// The edge `a-b` (vertex ids, `a < b`) with its cost.
     fn edge(&mut self, a: u32, b: u32) -> Edge {
         let (_, cost) = self.evaluate(a, b);
-        // Non-negative floats order like their bit patterns.
-        let key = if cost.is_finite() {
-            (cost.max(0.0) as f32).min(f32::MAX)
-        } else {
-            f32::MAX
-        };
         self.evaluations += 1;
         Edge {
-            key: key.to_bits(),
+            key: cost_key(cost),
             a,
             b,
             tried: 0,
@@ -496,23 +479,11 @@ impl<'o> Passes<'o> {
         let (pa, pb) = (self.pos.get(a), self.pos.get(b));
         let (sa, sb) = (self.slot[a as usize], self.slot[b as usize]);
         let q = self.quadric[sa as usize].add(&self.quadric[sb as usize]);
-        let len2 = dot(sub(pa, pb), sub(pa, pb));
-        let v = match (self.opts.placement, self.opts.cost) {
-            (Placement::Endpoint, _) if q.error(pb) < q.error(pa) => pb,
-            (Placement::Endpoint, _) => pa,
-            (Placement::Cost, Cost::Quadric) => place(&q, pa, pb),
-            (Placement::Cost, _) => scale(add(pa, pb), 0.5),
-        };
-        match self.opts.cost {
-            Cost::Quadric => (v, q.error(v)),
-            Cost::ShortestEdge => (v, len2),
-            Cost::Color => {
-                let gerr = self.surface.as_ref().map_or(0.0, |s| s.distance(v));
-                let color = |x: u32| self.color.get(x as usize).copied().unwrap_or([0.0; 3]);
-                let dc = len(sub(color(a), color(b)));
-                (v, gerr * gerr + len2 + libm::sqrt(libm::sqrt(len2) * dc))
-            }
-        }
+        let v = placement(self.opts, &q, pa, pb);
+        let color = |x: u32| self.color.get(x as usize).copied().unwrap_or([0.0; 3]);
+        let colors = || [color(a), color(b)];
+        let cost = cost_at(self.opts, &q, v, [pa, pb], colors, self.surface.as_ref());
+        (v, cost)
     }
 
     /// Whether collapsing the edge `a-b` (vertex ids) keeps the mesh a manifold of the same
@@ -600,17 +571,9 @@ impl<'o> Passes<'o> {
                 if t.contains(&a) && t.contains(&b) {
                     continue;
                 }
-                let before = self.face_normal(t);
-                let moved = t.map(|i| {
-                    if i == s {
-                        v
-                    } else {
-                        self.pos.get(self.owner[i as usize])
-                    }
-                });
-                let after = cross(sub(moved[1], moved[0]), sub(moved[2], moved[0]));
-                let (lb, la) = (len(before), len(after));
-                if !(la > 1e-12 * lb && dot(before, after) > 0.0) {
+                let at = |i: u32| self.pos.get(self.owner[i as usize]);
+                let moved = t.map(|i| if i == s { v } else { at(i) });
+                if !stays_up(t.map(at), moved) {
                     return false;
                 }
             }
@@ -662,16 +625,13 @@ impl<'o> Passes<'o> {
         self.slot.push(sa);
         self.owner[qa] = p;
         if !self.color.is_empty() {
-            let c = match kept(self.opts, v, [self.pos.get(a), self.pos.get(b)]) {
-                Some(j) => self.color[[ia, ib][j]],
-                None => {
-                    let (wa, wb) = (area_a.max(1e-30), area_b.max(1e-30));
-                    scale(
-                        add(scale(self.color[ia], wa), scale(self.color[ib], wb)),
-                        1.0 / (wa + wb),
-                    )
-                }
-            };
+            let c = merged_color(
+                self.opts,
+                v,
+                [self.pos.get(a), self.pos.get(b)],
+                [self.color[ia], self.color[ib]],
+                [area_a, area_b],
+            );
             self.color.push(c);
         }
         // Mark the region (every corner of the faces around a and b), drop the two faces on
@@ -769,20 +729,6 @@ fn sort_by_cost(edges: &mut Vec<Edge>, scratch: &mut Vec<Edge>) {
             start[d] += 1;
         }
         core::mem::swap(edges, scratch);
-    }
-}
-
-/// The corners that follow `v` counter-clockwise in triangle `t` (`None` when `v` is not one).
-#[inline]
-fn after(t: [u32; 3], v: u32) -> Option<(u32, u32)> {
-    if t[0] == v {
-        Some((t[1], t[2]))
-    } else if t[1] == v {
-        Some((t[2], t[0]))
-    } else if t[2] == v {
-        Some((t[0], t[1]))
-    } else {
-        None
     }
 }
 
