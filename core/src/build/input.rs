@@ -307,27 +307,33 @@ impl Around {
 }
 
 /// Whether the link edges `(x, y, _)` (sorted by `x`) of one vertex form a single path or cycle.
+/// They come from manifold, consistently oriented edges, so each `x` starts one link edge and
+/// each `y` ends one: the edges form paths and cycles, and the one through the first edge must
+/// hold them all. Walked forwards from there (a cycle closes; most vertices are inside the
+/// surface), then, when a path's end stopped the walk, backwards to its start.
 fn single_fan(link: &[(u32, u32, u32)]) -> bool {
-    // With manifold edges each x starts at most one link edge. Walk from a start that no edge ends
-    // at (an open fan) or from any edge (a closed one) and count the steps.
     let next = |x: u32| {
         link.binary_search_by_key(&x, |e| e.0)
             .ok()
             .map(|k| link[k].1)
     };
-    let start = link
-        .iter()
-        .map(|e| e.0)
-        .find(|&x| !link.iter().any(|e| e.1 == x))
-        .unwrap_or(link[0].0);
-    let mut x = start;
+    let start = link[0].0;
     let mut steps = 0;
+    let mut x = start;
     while let Some(y) = next(x) {
         steps += 1;
         if y == start || steps > link.len() {
-            break;
+            return steps == link.len();
         }
         x = y;
+    }
+    let mut y = start;
+    while let Some(e) = link.iter().find(|e| e.1 == y) {
+        steps += 1;
+        if steps > link.len() {
+            return false;
+        }
+        y = e.0;
     }
     steps == link.len()
 }
