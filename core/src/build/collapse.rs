@@ -783,13 +783,41 @@ impl<'o> Engine<'o> {
         self.rejected.take(b);
         // The ring of p: both rings but a and b. Its members swap a and b for p, which as the
         // newest vertex goes last and keeps their rings sorted.
+        // Both rings are sorted: one merge makes p's, sorted.
         let mut ring = core::mem::take(&mut self.scratch_ring);
         ring.clear();
-        ring.extend_from_slice(&self.vverts[sa]);
-        ring.extend_from_slice(&core::mem::take(&mut self.vverts[sb]));
-        ring.retain(|&x| x != a && x != b);
-        ring.sort_unstable();
-        ring.dedup();
+        let (ra, rb) = (&self.vverts[sa], &self.vverts[sb]);
+        let (mut i, mut j) = (0, 0);
+        loop {
+            let x = match (ra.get(i), rb.get(j)) {
+                (Some(&x), Some(&y)) if x < y => {
+                    i += 1;
+                    x
+                }
+                (Some(&x), Some(&y)) if y < x => {
+                    j += 1;
+                    y
+                }
+                (Some(&x), Some(_)) => {
+                    i += 1;
+                    j += 1;
+                    x
+                }
+                (Some(&x), None) => {
+                    i += 1;
+                    x
+                }
+                (None, Some(&y)) => {
+                    j += 1;
+                    y
+                }
+                (None, None) => break,
+            };
+            if x != a && x != b {
+                ring.push(x);
+            }
+        }
+        self.vverts[sb] = Vec::new();
         for &x in &ring {
             let slot = self.at(x);
             let r = &mut self.vverts[slot];
