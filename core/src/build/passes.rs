@@ -1,8 +1,8 @@
 //! The balanced forest ([`super::BuildOptions::balanced`]) made in passes: the merge-tree
-//! paper's region-of-influence marking (El-Sana and Varshney, "Generalized View-Dependent
-//! Simplification", 1999, §3.1: a collapse blocks the collapses around it until no unblocked
-//! one is left), run the way meshoptimizer simplifies (Kapoulkine, meshoptimizer's `simplify`:
-//! the costs sorted once a pass over flat arrays, not kept in a heap).
+//! paper's region-of-influence marking (Berkey and Song, "Dynamic View Dependent Level of
+//! Detail", §3.1: a collapse blocks the collapses around it until no unblocked one is left), run
+//! the way meshoptimizer simplifies (Kapoulkine, meshoptimizer's `simplify`: the costs sorted
+//! once a pass over flat arrays, not kept in a heap).
 //!
 //! [`super::collapse::Engine`] keeps a heap of every edge's cost, collapses the cheapest legal
 //! edge and updates each vertex's lists of faces and neighbours as it goes; run balanced it also
