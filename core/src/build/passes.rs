@@ -84,7 +84,7 @@ pub(crate) struct Passes<'o> {
     alive: Vec<bool>,
     pub alive_count: usize,
     /// The slots of live vertices, compacted after each pass, and the live faces around each,
-    /// filed once a pass: slot `s`'s are `around[first[s]..end[s]]`, in face order.
+    /// brought up to date between passes: slot `s`'s are `around[first[s]..end[s]]`.
     live_slots: Vec<u32>,
     first: Vec<u32>,
     end: Vec<u32>,
@@ -222,7 +222,9 @@ impl<'o> Passes<'o> {
                 self.mark[self.slot[a as usize] as usize],
                 self.mark[self.slot[b as usize] as usize],
             );
-            if ma == k || mb == k || (tried != 0 && ma <= tried && mb <= tried) {
+            // Tested in pass `tried` and found illegal: only a collapse that touched an end since
+            // (a mark from that pass, made after the test, or a later one) can have changed that.
+            if ma == k || mb == k || (tried != 0 && ma < tried && mb < tried) {
                 continue;
             }
             match self.judge(a, b) {
@@ -276,19 +278,14 @@ impl<'o> Passes<'o> {
     /// What the collapses leave for the hierarchy (the faces' corners as vertex ids again), all
     /// else freed.
     pub fn into_collapsed(self) -> Collapsed<'o> {
-        let owner = &self.owner;
-        let faces = self
-            .faces
-            .iter()
-            .zip(&self.face_alive)
-            .map(|(t, &alive)| {
-                if alive {
-                    t.map(|s| owner[s as usize])
-                } else {
-                    [NONE; 3]
-                }
-            })
-            .collect();
+        let mut faces = self.faces;
+        for (t, &alive) in faces.iter_mut().zip(&self.face_alive) {
+            *t = if alive {
+                t.map(|s| self.owner[s as usize])
+            } else {
+                [NONE; 3]
+            };
+        }
         Collapsed {
             heap_pushes: self.evaluations,
             opts: self.opts,
