@@ -240,6 +240,29 @@ pub(crate) fn merged_color(
     }
 }
 
+/// What a collapse adds up of its two `ends` (vertex id, slot, position): the first end's slot
+/// takes the summed quadric and area, and the colour of the vertex made at `v` is pushed (when
+/// the mesh has colours). Both engines keep quadrics and areas by slot, colours by vertex id.
+#[inline(always)]
+pub(crate) fn merge_sums(
+    opts: &BuildOptions,
+    quadric: &mut [Quadric],
+    area: &mut [f64],
+    color: &mut Vec<Vec3d>,
+    ends: [(u32, usize, Vec3d); 2],
+    v: Vec3d,
+) {
+    let [(a, sa, pa), (b, sb, pb)] = ends;
+    let (area_a, area_b) = (area[sa], area[sb]);
+    quadric[sa] = quadric[sa].add(&quadric[sb]);
+    area[sa] = area_a + area_b;
+    if !color.is_empty() {
+        let (ca, cb) = (color[a as usize], color[b as usize]);
+        let c = merged_color(opts, v, [pa, pb], [ca, cb], [area_a, area_b]);
+        color.push(c);
+    }
+}
+
 /// Whether a triangle keeps facing the same way, with an area, when its corners move from
 /// `before` to `after` (the flip test of a collapse).
 #[inline(always)]
@@ -705,22 +728,18 @@ impl<'o> Engine<'o> {
         let (faces, neighbours) = self.split_faces(children, wings);
         let p = self.pos.len() as u32;
         let (ia, ib) = (a as usize, b as usize);
-        self.pos.push(v);
         let (sa, sb) = (self.slot[ia] as usize, self.slot[ib] as usize);
-        let (area_a, area_b) = (self.area[sa], self.area[sb]);
-        self.quadric[sa] = self.quadric[sa].add(&self.quadric[sb]);
-        self.area[sa] = area_a + area_b;
+        let ends = [(a, sa, self.pos.get(a)), (b, sb, self.pos.get(b))];
+        merge_sums(
+            self.opts,
+            &mut self.quadric,
+            &mut self.area,
+            &mut self.color,
+            ends,
+            v,
+        );
+        self.pos.push(v);
         self.slot.push(sa as u32);
-        if !self.color.is_empty() {
-            let c = merged_color(
-                self.opts,
-                v,
-                [self.pos.get(a), self.pos.get(b)],
-                [self.color[ia], self.color[ib]],
-                [area_a, area_b],
-            );
-            self.color.push(c);
-        }
         if !self.corners.is_empty() {
             let corner = self.corner_at(a, b, v);
             self.corners.push(corner);

@@ -26,7 +26,7 @@ use alloc::vec::Vec;
 
 use super::closest::Surface;
 use super::collapse::{
-    after, cost_at, cost_key, edge_wings, merged_color, placement, stays_up, Collapse, Collapsed,
+    after, cost_at, cost_key, edge_wings, merge_sums, placement, stays_up, Collapse, Collapsed,
 };
 use super::positions::Positions;
 use super::quadric::Quadric;
@@ -615,22 +615,18 @@ impl<'o> Passes<'o> {
         let p = record.parent;
         let (ia, ib) = (a as usize, b as usize);
         self.pos.push(v);
-        let (qa, qb) = (sa as usize, sb as usize);
-        let (area_a, area_b) = (self.area[qa], self.area[qb]);
-        self.quadric[qa] = self.quadric[qa].add(&self.quadric[qb]);
-        self.area[qa] = area_a + area_b;
+        let qa = sa as usize;
+        let ends = [(a, qa, self.pos.get(a)), (b, sb as usize, self.pos.get(b))];
+        merge_sums(
+            self.opts,
+            &mut self.quadric,
+            &mut self.area,
+            &mut self.color,
+            ends,
+            v,
+        );
         self.slot.push(sa);
         self.owner[qa] = p;
-        if !self.color.is_empty() {
-            let c = merged_color(
-                self.opts,
-                v,
-                [self.pos.get(a), self.pos.get(b)],
-                [self.color[ia], self.color[ib]],
-                [area_a, area_b],
-            );
-            self.color.push(c);
-        }
         // Mark the region (every corner of the faces around a and b), drop the two faces on
         // the edge and move b's other faces to a's slot, which p now holds. The lists of a and
         // b are read as filed: neither slot is filed again before the next pass.
