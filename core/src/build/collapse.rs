@@ -240,6 +240,27 @@ pub(crate) fn merged_color(
     }
 }
 
+/// Each input vertex's quadric (the planes of its triangles, weighted by their areas) and a
+/// third of its triangles' areas, by vertex id, which is each engine's slot at the start.
+pub(crate) fn face_sums(
+    pos: &Positions<'_>,
+    faces: &[[u32; 3]],
+    n: usize,
+) -> (Vec<Quadric>, Vec<f64>) {
+    let mut quadric = vec![Quadric::default(); n];
+    let mut area = vec![0.0; n];
+    for tri in faces {
+        let [a, b, c] = tri.map(|i| pos.get(i));
+        let q = Quadric::triangle(a, b, c);
+        let ar = 0.5 * len(cross(sub(b, a), sub(c, a)));
+        for &v in tri {
+            quadric[v as usize] = quadric[v as usize].add(&q);
+            area[v as usize] += ar / 3.0;
+        }
+    }
+    (quadric, area)
+}
+
 /// What a collapse adds up of its two `ends` (vertex id, slot, position): the first end's slot
 /// takes the summed quadric and area, and the colour of the vertex made at `v` is pushed (when
 /// the mesh has colours). Both engines keep quadrics and areas by slot, colours by vertex id.
@@ -317,17 +338,7 @@ impl<'o> Engine<'o> {
                 vfaces[v as usize].push(f as u32);
             }
         }
-        let mut quadric = vec![Quadric::default(); n];
-        let mut area = vec![0.0; n];
-        for tri in &faces {
-            let [a, b, c] = tri.map(|i| pos.get(i));
-            let q = Quadric::triangle(a, b, c);
-            let ar = 0.5 * len(cross(sub(b, a), sub(c, a)));
-            for &v in tri {
-                quadric[v as usize] = quadric[v as usize].add(&q);
-                area[v as usize] += ar / 3.0;
-            }
-        }
+        let (quadric, area) = face_sums(&pos, &faces, n);
         // Colours in 0..=1, only when the mesh has them (none: black, and no array).
         let color = mesh.colors.map_or_else(Vec::new, |c| {
             c.iter().map(|c| c.map(|v| v as f64 / 255.0)).collect()

@@ -26,11 +26,12 @@ use alloc::vec::Vec;
 
 use super::closest::Surface;
 use super::collapse::{
-    after, cost_at, cost_key, edge_wings, merge_sums, placement, stays_up, Collapse, Collapsed,
+    after, cost_at, cost_key, edge_wings, face_sums, merge_sums, placement, stays_up, Collapse,
+    Collapsed,
 };
 use super::positions::Positions;
 use super::quadric::Quadric;
-use super::vec3::{cross, len, normalize, sub, Vec3d};
+use super::vec3::{cross, normalize, sub, Vec3d};
 use super::{BuildOptions, Cost, ErrorBound, InputMesh, NONE};
 
 /// An edge waiting to collapse: its cost's `f32` bits (non-negative floats order like their
@@ -108,18 +109,10 @@ impl<'o> Passes<'o> {
         let ids = n.saturating_sub(1);
         let pos = Positions::new(mesh.positions, ids);
         let faces = mesh.triangles.to_vec();
-        let mut quadric = vec![Quadric::default(); n];
-        let mut area = vec![0.0; n];
+        let (quadric, area) = face_sums(&pos, &faces, n);
         let mut alive = vec![false; n];
-        for tri in &faces {
-            let [a, b, c] = tri.map(|i| pos.get(i));
-            let q = Quadric::triangle(a, b, c);
-            let ar = 0.5 * len(cross(sub(b, a), sub(c, a)));
-            for &v in tri {
-                quadric[v as usize] = quadric[v as usize].add(&q);
-                area[v as usize] += ar / 3.0;
-                alive[v as usize] = true;
-            }
+        for &v in faces.iter().flatten() {
+            alive[v as usize] = true;
         }
         let mut color: Vec<Vec3d> = mesh.colors.map_or_else(Vec::new, |c| {
             c.iter().map(|c| c.map(|v| v as f64 / 255.0)).collect()
