@@ -18,7 +18,7 @@ use alloc::vec::Vec;
 
 use super::bound::{equation3, hoppe};
 use super::closest::{closest, point};
-use super::collapse::{kept, Collapsed};
+use super::collapse::{color_of, kept, Collapsed};
 use super::input::Borders;
 use super::vec3::{add, cross, dot, from_f32, len, normalize, scale, sub, Vec3d};
 use super::{ErrorBound, Hierarchy, InputMesh, Node, NONE};
@@ -71,9 +71,7 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, mut e: Collapsed<'_>, on_border: &Bor
             parent: NONE,
             children: [NONE; 2],
             wings: [NONE; 2],
-            color: e
-                .color_of(i as u32)
-                .map(|c| (c * 255.0 + 0.5).clamp(0.0, 255.0) as u8),
+            color: color_of(&e.color, i as u32).map(|c| (c * 255.0 + 0.5).clamp(0.0, 255.0) as u8),
             ..Node::default()
         })
         .collect();

@@ -54,11 +54,10 @@ pub(crate) struct Collapsed<'o> {
     pub heap_pushes: u64,
 }
 
-impl Collapsed<'_> {
-    /// Vertex `v`'s colour in `0..=1` (black when the mesh has none).
-    pub fn color_of(&self, v: u32) -> Vec3d {
-        self.color.get(v as usize).copied().unwrap_or([0.0; 3])
-    }
+/// Vertex `v`'s colour in `0..=1` among `color` (by vertex id; black when the mesh has none,
+/// and `color` is empty).
+pub(crate) fn color_of(color: &[Vec3d], v: u32) -> Vec3d {
+    color.get(v as usize).copied().unwrap_or([0.0; 3])
 }
 
 pub(crate) struct Engine<'o> {
@@ -71,7 +70,7 @@ pub(crate) struct Engine<'o> {
     area: Vec<f64>,
     /// The slot of each vertex id (meaningful while the vertex is live).
     slot: Vec<u32>,
-    /// Colours in `0..=1` by vertex id; empty when the mesh has none ([`Engine::color_of`]).
+    /// Colours in `0..=1` by vertex id; empty when the mesh has none ([`color_of`]).
     pub color: Vec<[f64; 3]>,
     pub faces: Vec<[u32; 3]>,
     pub face_alive: Vec<bool>,
@@ -314,6 +313,45 @@ pub(crate) fn edge_wings(faces: &[[u32; 3]], around: &[u32], a: u32, b: u32) -> 
     (wings, count)
 }
 
+/// The two faces on edge `c0-c1` (`c0 -> c1`, then `c1 -> c0`) and the four across their outer
+/// edges (`w0 -> c1`, `c0 -> w0`, `w1 -> c0`, `c1 -> w1`), or `NONE`, from one walk round each
+/// end (`around`: the faces holding `c0`, then `c1`): every face that holds one of those
+/// directed edges holds `c0` or `c1`, and holds it once. A split's records, as the file keeps
+/// them (Hoppe's `fn0..fn3`).
+pub(crate) fn split_faces(
+    faces: &[[u32; 3]],
+    around: [&[u32]; 2],
+    [c0, c1]: [u32; 2],
+    [w0, w1]: [u32; 2],
+) -> ([u32; 2], [u32; 4]) {
+    let (mut on_edge, mut neighbours) = ([NONE; 2], [NONE; 4]);
+    for &f in around[0] {
+        if let Some((next, prev)) = after(faces[f as usize], c0) {
+            if next == c1 {
+                on_edge[0] = f;
+            } else if next == w0 {
+                neighbours[1] = f;
+            }
+            if prev == w1 {
+                neighbours[2] = f;
+            }
+        }
+    }
+    for &f in around[1] {
+        if let Some((next, prev)) = after(faces[f as usize], c1) {
+            if next == c0 {
+                on_edge[1] = f;
+            } else if next == w1 {
+                neighbours[3] = f;
+            }
+            if prev == w0 {
+                neighbours[0] = f;
+            }
+        }
+    }
+    (on_edge, neighbours)
+}
+
 impl<'o> Engine<'o> {
     pub fn new(mesh: &InputMesh<'o>, opts: &'o BuildOptions) -> Engine<'o> {
         let n = mesh.positions.len();
@@ -440,11 +478,6 @@ impl<'o> Engine<'o> {
         }
     }
 
-    /// Vertex `v`'s colour in `0..=1` (black when the mesh has none).
-    pub fn color_of(&self, v: u32) -> Vec3d {
-        self.color.get(v as usize).copied().unwrap_or([0.0; 3])
-    }
-
     /// The slot of live vertex `v` (its quadric, area, faces and ring).
     fn at(&self, v: u32) -> usize {
         self.slot[v as usize] as usize
@@ -517,7 +550,7 @@ impl<'o> Engine<'o> {
                 _ => v,
             }
         };
-        let colors = || [self.color_of(a), self.color_of(b)];
+        let colors = || [color_of(&self.color, a), color_of(&self.color, b)];
         let cost = cost_at(self.opts, &q, v, [pa, pb], colors, self.surface.as_ref());
         (v, cost)
     }
@@ -694,39 +727,6 @@ impl<'o> Engine<'o> {
         }
     }
 
-    /// The two faces on edge `c0-c1` (`c0 -> c1`, then `c1 -> c0`) and the four across their
-    /// outer edges (`w0 -> c1`, `c0 -> w0`, `w1 -> c0`, `c1 -> w1`), or `NONE`, from one walk
-    /// round each end: every face that holds one of those directed edges holds `c0` or `c1`, and
-    /// holds it once.
-    fn split_faces(&self, [c0, c1]: [u32; 2], [w0, w1]: [u32; 2]) -> ([u32; 2], [u32; 4]) {
-        let (mut faces, mut neighbours) = ([NONE; 2], [NONE; 4]);
-        for &f in &self.vfaces[self.at(c0)] {
-            if let Some((next, prev)) = after(self.faces[f as usize], c0) {
-                if next == c1 {
-                    faces[0] = f;
-                } else if next == w0 {
-                    neighbours[1] = f;
-                }
-                if prev == w1 {
-                    neighbours[2] = f;
-                }
-            }
-        }
-        for &f in &self.vfaces[self.at(c1)] {
-            if let Some((next, prev)) = after(self.faces[f as usize], c1) {
-                if next == c0 {
-                    faces[1] = f;
-                } else if next == w1 {
-                    neighbours[3] = f;
-                }
-                if prev == w0 {
-                    neighbours[0] = f;
-                }
-            }
-        }
-        (faces, neighbours)
-    }
-
     /// Collapses `a-b` into a new vertex at `v`; `wings` are the third corners of the faces with
     /// directed edges `a -> b` and `b -> a` ([`Engine::edge_faces`]).
     fn collapse(&mut self, a: u32, b: u32, v: Vec3d, wings: [u32; 2]) {
@@ -736,7 +736,8 @@ impl<'o> Engine<'o> {
         } else {
             ([b, a], [wings[1], wings[0]])
         };
-        let (faces, neighbours) = self.split_faces(children, wings);
+        let around = children.map(|c| self.vfaces[self.at(c)].as_slice());
+        let (faces, neighbours) = split_faces(&self.faces, around, children, wings);
         let p = self.pos.len() as u32;
         let (ia, ib) = (a as usize, b as usize);
         let (sa, sb) = (self.slot[ia] as usize, self.slot[ib] as usize);

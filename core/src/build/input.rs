@@ -10,6 +10,8 @@ use alloc::vec;
 use alloc::vec::Vec;
 use core::fmt;
 
+use super::around::Around;
+
 /// An indexed triangle mesh to build a hierarchy from.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct InputMesh<'a> {
@@ -192,7 +194,7 @@ pub(crate) fn checked(mesh: &InputMesh<'_>) -> Result<Borders, BuildError> {
     // Every check reads one table: for each vertex `v`, the link edges `x -> y` of its
     // triangles `(v, x, y)`, sorted, with the triangle's index. Each check walks the whole table
     // before the next starts, so the first offender is the one the order of the checks names.
-    let around = Around::new(n, mesh.triangles);
+    let around = link_edges(n, mesh.triangles);
     let mut scratch: Vec<(u32, u32, u32)> = Vec::new();
 
     // Duplicates: a triangle is filed under its smallest corner; equal corner sets are then
@@ -264,46 +266,16 @@ pub(crate) fn checked(mesh: &InputMesh<'_>) -> Result<Borders, BuildError> {
 }
 
 /// For each vertex `v`, the link edges `(x, y, t)` of the triangles `t = (v, x, y)` around it,
-/// sorted: one table in two flat arrays (a counting sort on the vertex, then a sort of each
-/// vertex's handful).
-struct Around {
-    start: Vec<u32>,
-    links: Vec<(u32, u32, u32)>,
-}
-
-impl Around {
-    /// The table of `triangles`, whose corners are all below `n`.
-    fn new(n: usize, triangles: &[[u32; 3]]) -> Around {
-        let mut start = vec![0u32; n + 1];
-        for tri in triangles {
-            for &v in tri {
-                start[v as usize + 1] += 1;
-            }
-        }
-        for v in 0..n {
-            start[v + 1] += start[v];
-        }
-        let mut next = start.clone();
-        let mut links = vec![(0, 0, 0); triangles.len() * 3];
-        for (t, tri) in triangles.iter().enumerate() {
-            for k in 0..3 {
-                let v = tri[k] as usize;
-                links[next[v] as usize] = (tri[(k + 1) % 3], tri[(k + 2) % 3], t as u32);
-                next[v] += 1;
-            }
-        }
-        drop(next);
-        for v in 0..n {
-            links[start[v] as usize..start[v + 1] as usize].sort_unstable();
-        }
-        Around { start, links }
+/// sorted (each vertex's handful sorted after the filing).
+fn link_edges(n: usize, triangles: &[[u32; 3]]) -> Around<(u32, u32, u32)> {
+    let mut around = Around::filed(n, triangles, |t, k| {
+        let tri = triangles[t as usize];
+        (tri[(k + 1) % 3], tri[(k + 2) % 3], t)
+    });
+    for v in 0..n as u32 {
+        around.of_mut(v).sort_unstable();
     }
-
-    /// The link edges of vertex `v`, sorted.
-    fn of(&self, v: u32) -> &[(u32, u32, u32)] {
-        let v = v as usize;
-        &self.links[self.start[v] as usize..self.start[v + 1] as usize]
-    }
+    around
 }
 
 /// Whether the link edges `(x, y, _)` (sorted by `x`) of one vertex form a single path or cycle.
@@ -379,13 +351,13 @@ mod tests {
                 }
             }
             full.sort_unstable();
-            let around = Around::new(n as usize, &triangles);
+            let around = link_edges(n as usize, &triangles);
             let grouped: Vec<(u32, u32, u32, u32)> = (0..n)
                 .flat_map(|v| around.of(v).iter().map(move |&(x, y, t)| (v, x, y, t)))
                 .collect();
             assert_eq!(grouped, full, "{n}");
         }
-        assert!(Around::new(3, &[]).of(2).is_empty());
+        assert!(link_edges(3, &[]).of(2).is_empty());
     }
 
     #[test]

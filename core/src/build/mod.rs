@@ -40,6 +40,7 @@
 //! assert_eq!(full, expected);
 //! ```
 
+pub(crate) mod around;
 mod attributes;
 pub mod bound;
 pub(crate) mod closest;
@@ -404,7 +405,7 @@ pub fn build(
     // The balanced forest is made in passes (each collapses the cheapest edges whose regions
     // do not touch), the other by one collapse at a time from a heap of costs.
     let collapsed = if opts.balanced {
-        let mut engine = passes::Passes::new(mesh, opts);
+        let mut engine = passes::Passes::new(mesh, opts, &on_border);
         let total = engine.alive_count.saturating_sub(target) as u32;
         progress(Progress { done: 0, total });
         engine.run(target, &mut |done| progress(Progress { done, total }));

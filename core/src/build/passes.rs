@@ -26,9 +26,10 @@ use alloc::vec::Vec;
 
 use super::closest::Surface;
 use super::collapse::{
-    after, cost_at, cost_key, edge_wings, face_sums, merge_sums, placement, stays_up, Collapse,
-    Collapsed,
+    after, color_of, cost_at, cost_key, edge_wings, face_sums, merge_sums, placement, split_faces,
+    stays_up, Collapse, Collapsed,
 };
+use super::input::Borders;
 use super::positions::Positions;
 use super::quadric::Quadric;
 use super::vec3::{cross, normalize, sub, Vec3d};
@@ -52,8 +53,9 @@ enum Verdict {
     Blocked,
     /// Not legal as the mesh stands.
     Illegal,
-    /// Legal: collapse it, the new vertex there.
-    Legal(Vec3d),
+    /// Legal: collapse it, the new vertex there (and the edge's wings, as `edge_faces` found
+    /// them).
+    Legal(Vec3d, [u32; 2]),
 }
 
 /// The engine. Inside it a live vertex is known by its *slot*, which a collapse's vertex
@@ -103,8 +105,9 @@ pub(crate) struct Passes<'o> {
 }
 
 impl<'o> Passes<'o> {
-    /// The engine over `mesh` (which has passed the input checks), every edge measured.
-    pub fn new(mesh: &InputMesh<'o>, opts: &'o BuildOptions) -> Passes<'o> {
+    /// The engine over `mesh` (which has passed the input checks, and whose vertices on a
+    /// border they found), every edge measured.
+    pub fn new(mesh: &InputMesh<'o>, opts: &'o BuildOptions, on_border: &Borders) -> Passes<'o> {
         let n = mesh.positions.len();
         let ids = n.saturating_sub(1);
         let pos = Positions::new(mesh.positions, ids);
@@ -154,12 +157,13 @@ impl<'o> Passes<'o> {
             pass: 0,
         };
         e.file_faces();
-        // Boundary quadrics keep open borders in place, as in the heap engine.
+        // Boundary quadrics keep open borders in place, as in the heap engine. Both ends of a
+        // border edge are border vertices: that test spares the other edges a walk.
         for f in 0..e.faces.len() {
             let tri = e.faces[f];
             for k in 0..3 {
                 let (a, b) = (tri[k], tri[(k + 1) % 3]);
-                if e.face_with_edge(b, a) == NONE {
+                if on_border.contains(a) && on_border.contains(b) && e.edge_faces(a, b).1 == 1 {
                     let n = normalize(e.face_normal(tri)).unwrap_or([0.0; 3]);
                     let q = Quadric::boundary(e.pos.get(a), e.pos.get(b), n, 16.0);
                     for v in [a, b] {
@@ -223,8 +227,8 @@ impl<'o> Passes<'o> {
             match self.judge(a, b) {
                 Verdict::Blocked => {}
                 Verdict::Illegal => self.edges[i].tried = k,
-                Verdict::Legal(v) => {
-                    self.collapse(a, b, v);
+                Verdict::Legal(v, wings) => {
+                    self.collapse(a, b, v, wings);
                     made += 1;
                 }
             }
@@ -440,18 +444,6 @@ impl<'o> Passes<'o> {
         edge_wings(&self.faces, self.faces_of(a), a, b)
     }
 
-    /// The live face with directed edge `a -> b` (slots), or `NONE`.
-    fn face_with_edge(&self, a: u32, b: u32) -> u32 {
-        if a == NONE || b == NONE {
-            return NONE;
-        }
-        self.faces_of(a)
-            .iter()
-            .copied()
-            .find(|&f| after(self.faces[f as usize], a).is_some_and(|(next, _)| next == b))
-            .unwrap_or(NONE)
-    }
-
     /// The edge `a-b` (vertex ids, `a < b`) with its cost.
     fn edge(&mut self, a: u32, b: u32) -> Edge {
         let (_, cost) = self.evaluate(a, b);
@@ -470,8 +462,7 @@ impl<'o> Passes<'o> {
         let (sa, sb) = (self.slot[a as usize], self.slot[b as usize]);
         let q = self.quadric[sa as usize].add(&self.quadric[sb as usize]);
         let v = placement(self.opts, &q, pa, pb);
-        let color = |x: u32| self.color.get(x as usize).copied().unwrap_or([0.0; 3]);
-        let colors = || [color(a), color(b)];
+        let colors = || [color_of(&self.color, a), color_of(&self.color, b)];
         let cost = cost_at(self.opts, &q, v, [pa, pb], colors, self.surface.as_ref());
         (v, cost)
     }
@@ -494,7 +485,7 @@ impl<'o> Passes<'o> {
         }
         let (v, _) = self.evaluate(ia, ib);
         if self.legal(a, b, v, wings, count) {
-            Verdict::Legal(v)
+            Verdict::Legal(v, wings)
         } else {
             Verdict::Illegal
         }
@@ -571,26 +562,19 @@ impl<'o> Passes<'o> {
         true
     }
 
-    /// Collapses `a-b` (vertex ids) into a new vertex at `v` and marks the region it touched.
-    fn collapse(&mut self, a: u32, b: u32, v: Vec3d) {
+    /// Collapses `a-b` (vertex ids) into a new vertex at `v` and marks the region it touched;
+    /// `wings` are the third corners of the faces with directed edges `a -> b` and `b -> a`.
+    fn collapse(&mut self, a: u32, b: u32, v: Vec3d, wings: [u32; 2]) {
         let k = self.pass;
         let (sa, sb) = (self.slot[a as usize], self.slot[b as usize]);
-        let (wings, _) = self.edge_faces(sa, sb);
         // Orient so that triangle (children[0], children[1], wings[0]) exists.
         let (children, wings) = if wings[0] != NONE {
             ([sa, sb], wings)
         } else {
             ([sb, sa], [wings[1], wings[0]])
         };
-        let [c0, c1] = children;
-        let [w0, w1] = wings;
-        let faces = [self.face_with_edge(c0, c1), self.face_with_edge(c1, c0)];
-        let neighbours = [
-            self.face_with_edge(w0, c1),
-            self.face_with_edge(c0, w0),
-            self.face_with_edge(w1, c0),
-            self.face_with_edge(c1, w1),
-        ];
+        let around = children.map(|c| self.faces_of(c));
+        let (faces, neighbours) = split_faces(&self.faces, around, children, wings);
         let id = |s: u32| {
             if s == NONE {
                 NONE

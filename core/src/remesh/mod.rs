@@ -63,6 +63,7 @@ use alloc::vec;
 use alloc::vec::Vec;
 use core::fmt;
 
+use crate::build::around::Around;
 use crate::build::collapse::Engine;
 use crate::build::flatten::{area2, barycentric, PlanarCollapse, Uv};
 use crate::build::vec3::{dot, from_f32, sub};
@@ -324,7 +325,7 @@ fn relaxed(input: &InputMesh<'_>, mesh: &mut SemiRegular, on_input: &mut [(u32, 
             fixed[b as usize] = true;
         }
     }
-    let around = relax::Around::new(input.positions.len(), input.triangles);
+    let around = Around::triangles(input.positions.len(), input.triangles);
     let surface = crate::build::closest::Surface::new(input.positions, input.triangles);
     let mut relax = relax::Relax {
         input,
@@ -334,7 +335,7 @@ fn relaxed(input: &InputMesh<'_>, mesh: &mut SemiRegular, on_input: &mut [(u32, 
         snapped: vec![false; n],
         surface: &surface,
         normals: relax::Relax::normals(input),
-        around_remesh: relax::Around::new(n, &triangles),
+        around_remesh: Around::triangles(n, &triangles),
         reach: 0.0,
     };
     relax.run(RELAX_ROUNDS, false, &mut mesh.positions, on_input);

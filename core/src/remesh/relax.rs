@@ -15,6 +15,7 @@
 use alloc::vec;
 use alloc::vec::Vec;
 
+use crate::build::around::Around;
 use crate::build::closest::{closest, point, Surface};
 use crate::build::collapse::shape;
 use crate::build::vec3::{add, cross, dot, from_f32, normalize, scale, sub, Vec3d};
@@ -29,43 +30,10 @@ const UNTANGLE_TRIES: usize = 3;
 /// A remesh vertex's place on the input: a triangle and barycentric weights there.
 pub(super) type OnInput = (u32, [f64; 3]);
 
-/// The input's triangles around each vertex, as flat arrays.
-pub(super) struct Around {
-    starts: Vec<u32>,
-    faces: Vec<u32>,
-}
-
-impl Around {
-    pub(super) fn new(vertices: usize, triangles: &[[u32; 3]]) -> Around {
-        let mut starts = vec![0u32; vertices + 1];
-        for t in triangles {
-            for &v in t {
-                starts[v as usize + 1] += 1;
-            }
-        }
-        for v in 0..vertices {
-            starts[v + 1] += starts[v];
-        }
-        let mut fill = starts.clone();
-        let mut faces = vec![0u32; starts[vertices] as usize];
-        for (f, t) in triangles.iter().enumerate() {
-            for &v in t {
-                faces[fill[v as usize] as usize] = f as u32;
-                fill[v as usize] += 1;
-            }
-        }
-        Around { starts, faces }
-    }
-
-    pub(super) fn of(&self, v: u32) -> &[u32] {
-        &self.faces[self.starts[v as usize] as usize..self.starts[v as usize + 1] as usize]
-    }
-}
-
 /// What the relaxation works on.
 pub(super) struct Relax<'a> {
     pub input: &'a InputMesh<'a>,
-    pub around: &'a Around,
+    pub around: &'a Around<u32>,
     /// The remesh's finest triangles.
     pub triangles: &'a [[u32; 3]],
     /// Vertices that never move: the border's.
@@ -77,7 +45,7 @@ pub(super) struct Relax<'a> {
     /// The input triangles' unit normals.
     pub normals: Vec<Vec3d>,
     /// The remesh's triangles around each of its vertices.
-    pub around_remesh: Around,
+    pub around_remesh: Around<u32>,
     /// A gap from the input that an untangling move may open wherever it is, however close
     /// the triangles were (the snapping's reach).
     pub reach: f64,

@@ -3,6 +3,7 @@
 use alloc::vec::Vec;
 
 use super::*;
+use crate::build::around::Around;
 use crate::build::tests::{grid, input, sphere, topology};
 
 /// Checks what every remesh must be: the counts of its levels, its vertices on the input, the
@@ -212,9 +213,9 @@ fn a_folded_patch_is_untangled() {
     let mut positions = out.mesh.positions.clone();
     let mut on_input = out.on_input.clone();
     let n = positions.len();
-    let around = relax::Around::new(p.len(), &t);
+    let around = Around::triangles(p.len(), &t);
     let surface = crate::build::closest::Surface::new(&p, &t);
-    let around_remesh = relax::Around::new(n, &triangles);
+    let around_remesh = Around::triangles(n, &triangles);
     let mut fixed = vec![false; n];
     for v in 0..n as u32 {
         let star = around_remesh.of(v);
