@@ -69,6 +69,29 @@ impl Stored<'_> {
     }
 }
 
+/// A node's radius and normal cone as they are gathered: from its triangles for a leaf (and the
+/// least cosine between its axis and their normals), from its children for a parent.
+#[derive(Clone, Copy)]
+struct Gathered {
+    axis: Vec3d,
+    weight: f64,
+    radius: f64,
+    half: f64,
+    least: f64,
+}
+
+impl Default for Gathered {
+    fn default() -> Self {
+        Gathered {
+            axis: [0.0; 3],
+            weight: 0.0,
+            radius: 0.0,
+            half: 0.0,
+            least: f64::INFINITY,
+        }
+    }
+}
+
 /// Angle between two unit vectors.
 fn angle(a: Vec3d, b: Vec3d) -> f64 {
     libm::atan2(len(cross(a, b)), dot(a, b))
@@ -133,10 +156,9 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, mut e: Collapsed<'_>, on_border: &Bor
     drop(face_id);
 
     // Leaves: radius to the farthest neighbour, cone around the incident triangles' normals.
-    let mut radius = vec![0.0f64; m];
-    let mut axis = vec![[0.0f64; 3]; m];
-    let mut half = vec![0.0f64; m];
-    let mut weight = vec![0.0f64; m];
+    // Each node's terms side by side, so that a triangle's corners are three records read (the
+    // input's triangles come in no order of their vertices).
+    let mut g = vec![Gathered::default(); m];
     let face_normal = |t: &[u32; 3]| {
         let [a, b, c] = t.map(leaf);
         cross(sub(b, a), sub(c, a))
@@ -148,14 +170,14 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, mut e: Collapsed<'_>, on_border: &Bor
         // Each edge's length once: measured either way it is the same number.
         let edge: [f64; 3] = core::array::from_fn(|k| len(sub(corner[(k + 1) % 3], corner[k])));
         for (k, &v) in t.iter().enumerate() {
-            let v = v as usize;
-            axis[v] = add(axis[v], n);
-            weight[v] += area;
-            radius[v] = radius[v].max(edge[k]).max(edge[(k + 2) % 3]);
+            let g = &mut g[v as usize];
+            g.axis = add(g.axis, n);
+            g.weight += area;
+            g.radius = g.radius.max(edge[k]).max(edge[(k + 2) % 3]);
         }
     }
-    for a in axis.iter_mut().take(leaves) {
-        *a = quantized_axis(normalize(*a).unwrap_or([0.0, 0.0, 1.0]));
+    for g in g.iter_mut().take(leaves) {
+        g.axis = quantized_axis(normalize(g.axis).unwrap_or([0.0, 0.0, 1.0]));
     }
     // The cone's half-angle is the widest angle between the axis and a triangle's normal, the
     // one of the smallest cosine: `atan2` only measures the triangles within `1e-9` of it
@@ -163,46 +185,60 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, mut e: Collapsed<'_>, on_border: &Bor
     // measure, so the largest is among them), one or two of a vertex's six or so. The unit
     // normals are made again rather than kept from the loop above (32 bytes a triangle); a
     // degenerate triangle opens the cone wide (`-inf`: no cosine is that small).
-    let mut least = vec![f64::INFINITY; leaves];
     for t in mesh.triangles {
         let n = normalize(face_normal(t));
         for &v in t {
-            let v = v as usize;
-            least[v] = n.map_or(f64::NEG_INFINITY, |n| least[v].min(dot(axis[v], n)));
+            let g = &mut g[v as usize];
+            g.least = n.map_or(f64::NEG_INFINITY, |n| g.least.min(dot(g.axis, n)));
         }
     }
     for t in mesh.triangles {
         let n = normalize(face_normal(t));
         for &v in t {
-            let v = v as usize;
+            let g = &mut g[v as usize];
             let widest = match n {
                 None => core::f64::consts::PI,
-                Some(n) if dot(axis[v], n) <= least[v] + 1e-9 => angle(axis[v], n),
+                Some(n) if dot(g.axis, n) <= g.least + 1e-9 => angle(g.axis, n),
                 Some(_) => continue,
             };
-            half[v] = half[v].max(widest);
+            g.half = g.half.max(widest);
         }
     }
-    drop(least);
     // Parents, in formation order (children first).
     for c in &e.collapses {
         let p = c.parent as usize;
-        let [a, b] = c.children.map(|x| x as usize);
-        let pos = |i: usize| at(i as u32);
-        radius[p] =
-            (len(sub(pos(a), pos(p))) + radius[a]).max(len(sub(pos(b), pos(p))) + radius[b]);
-        weight[p] = weight[a] + weight[b];
+        let [a, b] = c.children.map(|x| g[x as usize]);
+        let [pa, pb] = c.children.map(at);
+        let at_p = at(p as u32);
+        let radius = (len(sub(pa, at_p)) + a.radius).max(len(sub(pb, at_p)) + b.radius);
         let sum = add(
-            scale(axis[a], weight[a].max(1e-30)),
-            scale(axis[b], weight[b].max(1e-30)),
+            scale(a.axis, a.weight.max(1e-30)),
+            scale(b.axis, b.weight.max(1e-30)),
         );
-        axis[p] = match kept(e.opts, pos(p), [pos(a), pos(b)]) {
-            Some(k) => axis[[a, b][k]],
-            None => quantized_axis(normalize(sum).unwrap_or(axis[a])),
+        let axis = match kept(e.opts, at_p, [pa, pb]) {
+            Some(k) => [a, b][k].axis,
+            None => quantized_axis(normalize(sum).unwrap_or(a.axis)),
         };
-        half[p] = (angle(axis[p], axis[a]) + half[a]).max(angle(axis[p], axis[b]) + half[b]);
+        g[p] = Gathered {
+            axis,
+            weight: a.weight + b.weight,
+            radius,
+            half: (angle(axis, a.axis) + a.half).max(angle(axis, b.axis) + b.half),
+            least: f64::INFINITY,
+        };
     }
-    drop(weight);
+    // Into the nodes as stored; the axis is an `f32` octahedral code's, so the node's normal
+    // is the axis exactly and the error bounds below read it there.
+    for (node, g) in nodes.iter_mut().zip(&g) {
+        node.radius = up(g.radius);
+        node.normal = to_f32(g.axis);
+        node.cone_sin = if g.half < core::f64::consts::FRAC_PI_2 {
+            up(libm::sin(g.half)).min(1.0)
+        } else {
+            1.0
+        };
+    }
+    drop(g);
 
     // Depth, top-down: a parent always has a larger id than its children.
     for p in (leaves..m).rev() {
@@ -238,7 +274,7 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, mut e: Collapsed<'_>, on_border: &Bor
     let mut errors: Vec<(f32, f32)> = Vec::new();
     for (k, c) in e.collapses.iter().enumerate() {
         let p = c.parent as usize;
-        let n = axis[p];
+        let n = from_f32(nodes[p].normal);
         let (s, t) = range[p];
         let below = &order[s as usize..t as usize];
         let own = if e.opts.bound == ErrorBound::Offset {
@@ -259,15 +295,6 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, mut e: Collapsed<'_>, on_border: &Bor
         };
         let [c0, c1] = c.children.map(|x| nodes[x as usize].spheroid);
         nodes[p].spheroid = core::array::from_fn(|i| own[i].max(c0[i]).max(c1[i]));
-    }
-    for (i, node) in nodes.iter_mut().enumerate() {
-        node.radius = up(radius[i]);
-        node.normal = to_f32(axis[i]);
-        node.cone_sin = if half[i] < core::f64::consts::FRAC_PI_2 {
-            up(libm::sin(half[i])).min(1.0)
-        } else {
-            1.0
-        };
     }
 
     let base_triangles = e
