@@ -69,27 +69,14 @@ impl Stored<'_> {
     }
 }
 
-/// A node's radius and normal cone as they are gathered: from its triangles for a leaf (and the
-/// least cosine between its axis and their normals), from its children for a parent.
-#[derive(Clone, Copy)]
+/// A node's radius and normal cone as they are gathered: from its triangles for a leaf, from
+/// its children for a parent.
+#[derive(Clone, Copy, Default)]
 struct Gathered {
     axis: Vec3d,
     weight: f64,
     radius: f64,
     half: f64,
-    least: f64,
-}
-
-impl Default for Gathered {
-    fn default() -> Self {
-        Gathered {
-            axis: [0.0; 3],
-            weight: 0.0,
-            radius: 0.0,
-            half: 0.0,
-            least: f64::INFINITY,
-        }
-    }
 }
 
 /// Angle between two unit vectors.
@@ -103,8 +90,17 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, mut e: Collapsed<'_>, on_border: &Bor
     let heap_pushes = e.heap_pushes;
     let leaves = mesh.positions.len();
     let m = e.pos.len();
-    // The made positions rounded as stored, and the collapse-time ones freed before the nodes
-    // are made (this is where the build's memory peaks).
+    // The made positions rounded as stored, and the collapse-time ones freed.
+    // The base mesh, and the collapsed faces freed, before the nodes are made (this is where the
+    // build's memory peaks).
+    let base_triangles = e
+        .faces
+        .iter()
+        .zip(&e.face_alive)
+        .filter(|(_, &alive)| alive)
+        .map(|(t, _)| *t)
+        .collect();
+    e.faces = Vec::new();
     let stored = Stored {
         input: mesh.positions,
         made: (leaves..m).map(|i| to_f32(e.pos.get(i as u32))).collect(),
@@ -127,7 +123,7 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, mut e: Collapsed<'_>, on_border: &Bor
     e.color = Vec::new();
     // Triangle ids as the file numbers them: the base triangles first, then two per split.
     let base_count = e.face_alive.iter().filter(|&&a| a).count() as u32;
-    let mut face_id = vec![NONE; e.faces.len()];
+    let mut face_id = vec![NONE; e.face_alive.len()];
     let mut next = 0;
     for (f, &alive) in e.face_alive.iter().enumerate() {
         if alive {
@@ -185,25 +181,27 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, mut e: Collapsed<'_>, on_border: &Bor
     // measure, so the largest is among them), one or two of a vertex's six or so. The unit
     // normals are made again rather than kept from the loop above (32 bytes a triangle); a
     // degenerate triangle opens the cone wide (`-inf`: no cosine is that small).
+    let mut least = vec![f64::INFINITY; leaves];
     for t in mesh.triangles {
         let n = normalize(face_normal(t));
         for &v in t {
-            let g = &mut g[v as usize];
-            g.least = n.map_or(f64::NEG_INFINITY, |n| g.least.min(dot(g.axis, n)));
+            let (g, least) = (&g[v as usize], &mut least[v as usize]);
+            *least = n.map_or(f64::NEG_INFINITY, |n| least.min(dot(g.axis, n)));
         }
     }
     for t in mesh.triangles {
         let n = normalize(face_normal(t));
         for &v in t {
-            let g = &mut g[v as usize];
+            let (g, least) = (&mut g[v as usize], least[v as usize]);
             let widest = match n {
                 None => core::f64::consts::PI,
-                Some(n) if dot(g.axis, n) <= g.least + 1e-9 => angle(g.axis, n),
+                Some(n) if dot(g.axis, n) <= least + 1e-9 => angle(g.axis, n),
                 Some(_) => continue,
             };
             g.half = g.half.max(widest);
         }
     }
+    drop(least);
     // Parents, in formation order (children first).
     for c in &e.collapses {
         let p = c.parent as usize;
@@ -224,7 +222,6 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, mut e: Collapsed<'_>, on_border: &Bor
             weight: a.weight + b.weight,
             radius,
             half: (angle(axis, a.axis) + a.half).max(angle(axis, b.axis) + b.half),
-            least: f64::INFINITY,
         };
     }
     // Into the nodes as stored; the axis is an `f32` octahedral code's, so the node's normal
@@ -296,14 +293,6 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, mut e: Collapsed<'_>, on_border: &Bor
         let [c0, c1] = c.children.map(|x| nodes[x as usize].spheroid);
         nodes[p].spheroid = core::array::from_fn(|i| own[i].max(c0[i]).max(c1[i]));
     }
-
-    let base_triangles = e
-        .faces
-        .iter()
-        .zip(&e.face_alive)
-        .filter(|(_, &alive)| alive)
-        .map(|(t, _)| *t)
-        .collect();
     Hierarchy {
         bound: e.opts.bound,
         leaves: leaves as u32,
