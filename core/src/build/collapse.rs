@@ -10,6 +10,7 @@
 use alloc::vec;
 use alloc::vec::Vec;
 
+use super::chunks::Chunks;
 use super::closest::Surface;
 use super::flatten::{flatten, PlanarCollapse};
 use super::positions::Positions;
@@ -86,7 +87,7 @@ pub(crate) struct Engine<'o> {
     purged_at: u64,
     /// Edges found illegal, by endpoint: retried when a collapse changes that endpoint's ring.
     rejected: Rejected,
-    pub collapses: Vec<Collapse>,
+    pub collapses: Chunks<Collapse>,
     /// For error bounds measured as residuals ([`ErrorBound::Spheroid`], [`ErrorBound::Hoppe`]):
     /// the triangles around each collapse's new vertex as it made them, collapse `k`'s at
     /// `fans[fan_ends[k - 1]..fan_ends[k]]` (vertex ids name one position for ever).
@@ -410,7 +411,7 @@ impl<'o> Engine<'o> {
             queue: CostQueue::default(),
             purged_at: 0,
             rejected: Rejected::with_ids(2 * n),
-            collapses: Vec::new(),
+            collapses: Chunks::for_about(n),
             fans: Vec::new(),
             fan_ends: Vec::new(),
             surface: (opts.cost == Cost::Color)
@@ -423,13 +424,13 @@ impl<'o> Engine<'o> {
         };
         e.alive_count = e.alive.iter().filter(|&&a| a).count();
         // Every collapse makes one vertex id and at most n - 1 are made: the per-id arrays are
-        // sized once, so that none doubles (and, while it is copied, holds both sizes) mid-build.
+        // sized once, so that none doubles (and, while it is copied, holds both sizes) mid-build;
+        // the collapse records grow by chunks ([`Chunks`]).
         let ids = n.saturating_sub(1);
         e.slot.reserve_exact(ids);
         e.color
             .reserve_exact(if e.color.is_empty() { 0 } else { ids });
         e.alive.reserve_exact(ids);
-        e.collapses.reserve_exact(ids);
         // Boundary quadrics keep open borders in place: on a border edge, the face itself is
         // the only one. Both its ends are border vertices, which have fewer faces than
         // neighbours: that test spares the other edges the search of a fan.
@@ -465,17 +466,27 @@ impl<'o> Engine<'o> {
     /// surface) freed, so that the hierarchy's own arrays do not add to the engine's at the
     /// build's peak.
     pub fn into_collapsed(self) -> Collapsed<'o> {
-        Collapsed {
+        let (mut collapsed, records) = self.into_parts();
+        // The rest of the engine is gone: the records can be joined.
+        collapsed.collapses = records.into_vec();
+        collapsed
+    }
+
+    /// [`Engine::into_collapsed`] but for the collapse records, still in chunks; the rest of
+    /// the engine is freed on return.
+    fn into_parts(self) -> (Collapsed<'o>, Chunks<Collapse>) {
+        let collapsed = Collapsed {
             heap_pushes: self.queue.pushes(),
             opts: self.opts,
             pos: self.pos,
             color: self.color,
             faces: self.faces,
             face_alive: self.face_alive,
-            collapses: self.collapses,
+            collapses: Vec::new(),
             fans: self.fans,
             fan_ends: self.fan_ends,
-        }
+        };
+        (collapsed, self.collapses)
     }
 
     /// The slot of live vertex `v` (its quadric, area, faces and ring).

@@ -42,6 +42,7 @@
 
 pub(crate) mod around;
 mod attributes;
+mod chunks;
 pub mod bound;
 pub(crate) mod closest;
 pub(crate) mod collapse;
