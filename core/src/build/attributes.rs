@@ -109,48 +109,6 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, mut e: Collapsed<'_>, on_border: &Bor
     let at = |i: u32| stored.at(i);
     // The input's triangles and the leaves below a node are the input's own vertices.
     let leaf = |i: u32| from_f32(mesh.positions[i as usize]);
-    let mut nodes: Vec<Node> = (0..m)
-        .map(|i| Node {
-            position: stored.get(i as u32),
-            parent: NONE,
-            children: [NONE; 2],
-            wings: [NONE; 2],
-            color: color_of(&e.color, i as u32).map(|c| (c * 255.0 + 0.5).clamp(0.0, 255.0) as u8),
-            ..Node::default()
-        })
-        .collect();
-    // The colours are in the nodes now.
-    e.color = Vec::new();
-    // Triangle ids as the file numbers them: the base triangles first, then two per split.
-    let base_count = e.face_alive.iter().filter(|&&a| a).count() as u32;
-    let mut face_id = vec![NONE; e.face_alive.len()];
-    let mut next = 0;
-    for (f, &alive) in e.face_alive.iter().enumerate() {
-        if alive {
-            face_id[f] = next;
-            next += 1;
-        }
-    }
-    for (s, c) in e.collapses.iter().enumerate() {
-        for (k, &f) in c.faces.iter().enumerate() {
-            if let Some(id) = face_id.get_mut(f as usize) {
-                *id = base_count + 2 * s as u32 + k as u32;
-            }
-        }
-    }
-    for c in &e.collapses {
-        let p = c.parent as usize;
-        nodes[p].children = c.children;
-        nodes[p].wings = c.wings;
-        nodes[p].neighbours = c
-            .neighbours
-            .map(|f| face_id.get(f as usize).copied().unwrap_or(NONE));
-        for ch in c.children {
-            nodes[ch as usize].parent = c.parent;
-        }
-    }
-    drop(face_id);
-
     // Leaves: radius to the farthest neighbour, cone around the incident triangles' normals.
     // Each node's terms side by side, so that a triangle's corners are three records read (the
     // input's triangles come in no order of their vertices).
@@ -224,18 +182,67 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, mut e: Collapsed<'_>, on_border: &Bor
             half: (angle(axis, a.axis) + a.half).max(angle(axis, b.axis) + b.half),
         };
     }
-    // Into the nodes as stored; the axis is an `f32` octahedral code's, so the node's normal
-    // is the axis exactly and the error bounds below read it there.
-    for (node, g) in nodes.iter_mut().zip(&g) {
-        node.radius = up(g.radius);
-        node.normal = to_f32(g.axis);
-        node.cone_sin = if g.half < core::f64::consts::FRAC_PI_2 {
-            up(libm::sin(g.half)).min(1.0)
-        } else {
-            1.0
-        };
-    }
+    // As the nodes store them; the axis is an `f32` octahedral code's, so the node's normal is
+    // the axis exactly and the error bounds below read it there. (Made before the nodes, this
+    // gathering does not add to their memory, where the build's peaks.)
+    let cones: Vec<(f32, [f32; 3], f32)> = g
+        .iter()
+        .map(|g| {
+            let sin = if g.half < core::f64::consts::FRAC_PI_2 {
+                up(libm::sin(g.half)).min(1.0)
+            } else {
+                1.0
+            };
+            (up(g.radius), to_f32(g.axis), sin)
+        })
+        .collect();
     drop(g);
+    let mut nodes: Vec<Node> = (0..m)
+        .map(|i| Node {
+            position: stored.get(i as u32),
+            radius: cones[i].0,
+            normal: cones[i].1,
+            cone_sin: cones[i].2,
+            parent: NONE,
+            children: [NONE; 2],
+            wings: [NONE; 2],
+            color: color_of(&e.color, i as u32).map(|c| (c * 255.0 + 0.5).clamp(0.0, 255.0) as u8),
+            ..Node::default()
+        })
+        .collect();
+    // The colours and cones are in the nodes now.
+    e.color = Vec::new();
+    drop(cones);
+    // Triangle ids as the file numbers them: the base triangles first, then two per split.
+    let base_count = e.face_alive.iter().filter(|&&a| a).count() as u32;
+    let mut face_id = vec![NONE; e.face_alive.len()];
+    let mut next = 0;
+    for (f, &alive) in e.face_alive.iter().enumerate() {
+        if alive {
+            face_id[f] = next;
+            next += 1;
+        }
+    }
+    for (s, c) in e.collapses.iter().enumerate() {
+        for (k, &f) in c.faces.iter().enumerate() {
+            if let Some(id) = face_id.get_mut(f as usize) {
+                *id = base_count + 2 * s as u32 + k as u32;
+            }
+        }
+    }
+    for c in &e.collapses {
+        let p = c.parent as usize;
+        nodes[p].children = c.children;
+        nodes[p].wings = c.wings;
+        nodes[p].neighbours = c
+            .neighbours
+            .map(|f| face_id.get(f as usize).copied().unwrap_or(NONE));
+        for ch in c.children {
+            nodes[ch as usize].parent = c.parent;
+        }
+    }
+    drop(face_id);
+
 
     // Depth, top-down: a parent always has a larger id than its children.
     for p in (leaves..m).rev() {

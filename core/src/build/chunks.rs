@@ -1,41 +1,54 @@
 //! A list that grows a chunk at a time and never copies what it holds.
 //!
-//! The collapse engine makes one record a collapse while the build's memory is near its peak:
-//! reserved for every collapse at the start, the records' room (44 bytes an input vertex) was
-//! part of that peak; grown as a `Vec` doubles, each doubling would hold the old and the new
-//! room at once. Chunks add only what the collapses fill, and are joined into one `Vec` when the
-//! engine's own arrays are gone.
+//! The collapse engines make a record and a position a collapse while the build's memory is
+//! near its peak: reserved for every collapse at the start, their room (68 bytes an input
+//! vertex) was part of that peak; grown as a `Vec` doubles, each doubling would hold the old and
+//! the new room at once. Chunks add only what the collapses fill (and the records are joined
+//! into one `Vec` when the engine's own arrays are gone).
 
 use alloc::vec::Vec;
 
-/// Items in order, in chunks of a fixed size.
+/// Items in order, in chunks of `1 << shift` items.
 pub(crate) struct Chunks<T> {
     chunks: Vec<Vec<T>>,
-    chunk: usize,
+    shift: u32,
     len: usize,
 }
 
 impl<T> Chunks<T> {
-    /// Empty, for about `expected` items: a sixteenth of them a chunk (at least 64).
+    /// Empty, for about `expected` items: about a sixteenth of them a chunk (a power of two, at
+    /// least 64).
     pub fn for_about(expected: usize) -> Chunks<T> {
         Chunks {
             chunks: Vec::new(),
-            chunk: (expected / 16).max(64),
+            shift: (expected / 16).max(64).ilog2(),
             len: 0,
         }
     }
 
     /// Appends `item`.
     pub fn push(&mut self, item: T) {
+        let chunk = 1 << self.shift;
         match self.chunks.last_mut() {
-            Some(last) if last.len() < self.chunk => last.push(item),
+            Some(last) if last.len() < chunk => last.push(item),
             _ => {
-                let mut fresh = Vec::with_capacity(self.chunk);
+                let mut fresh = Vec::with_capacity(chunk);
                 fresh.push(item);
                 self.chunks.push(fresh);
             }
         }
         self.len += 1;
+    }
+
+    /// Item `i` (panics past the end, as indexing a slice would).
+    #[inline]
+    pub fn at(&self, i: usize) -> &T {
+        &self.chunks[i >> self.shift][i & ((1 << self.shift) - 1)]
+    }
+
+    /// Items pushed.
+    pub fn len(&self) -> usize {
+        self.len
     }
 
     /// The last item pushed.
@@ -66,6 +79,10 @@ mod tests {
             for k in 0..count {
                 chunks.push(k);
                 assert_eq!(chunks.last(), Some(&k));
+                assert_eq!(chunks.len(), k + 1);
+            }
+            for k in 0..count {
+                assert_eq!(*chunks.at(k), k);
             }
             let all = chunks.into_vec();
             assert_eq!(all, (0..count).collect::<Vec<_>>());
