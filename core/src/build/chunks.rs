@@ -1,10 +1,10 @@
 //! A list that grows a chunk at a time and never copies what it holds.
 //!
-//! The collapse engines make a record and a position a collapse while the build's memory is
-//! near its peak: reserved for every collapse at the start, their room (68 bytes an input
-//! vertex) was part of that peak; grown as a `Vec` doubles, each doubling would hold the old and
-//! the new room at once. Chunks add only what the collapses fill (and the records are joined
-//! into one `Vec` when the engine's own arrays are gone).
+//! The collapse engine makes one record a collapse while the build's memory is near its peak:
+//! reserved for every collapse at the start, the records' room (44 bytes an input vertex) was
+//! part of that peak; grown as a `Vec` doubles, each doubling would hold the old and the new
+//! room at once. Chunks add only what the collapses fill, and are joined into one `Vec` when the
+//! engine's own arrays are gone.
 
 use alloc::vec::Vec;
 
@@ -40,16 +40,6 @@ impl<T> Chunks<T> {
         self.len += 1;
     }
 
-    /// Item `i` (panics past the end, as indexing a slice would).
-    #[inline]
-    pub fn at(&self, i: usize) -> &T {
-        &self.chunks[i >> self.shift][i & ((1 << self.shift) - 1)]
-    }
-
-    /// Items pushed.
-    pub fn len(&self) -> usize {
-        self.len
-    }
 
     /// The last item pushed.
     pub fn last(&self) -> Option<&T> {
@@ -79,10 +69,6 @@ mod tests {
             for k in 0..count {
                 chunks.push(k);
                 assert_eq!(chunks.last(), Some(&k));
-                assert_eq!(chunks.len(), k + 1);
-            }
-            for k in 0..count {
-                assert_eq!(*chunks.at(k), k);
             }
             let all = chunks.into_vec();
             assert_eq!(all, (0..count).collect::<Vec<_>>());
