@@ -243,7 +243,6 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, mut e: Collapsed<'_>, on_border: &Bor
     }
     drop(face_id);
 
-
     // Depth, top-down: a parent always has a larger id than its children.
     for p in (leaves..m).rev() {
         let d = nodes[p].depth.saturating_add(1);

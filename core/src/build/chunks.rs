@@ -8,38 +8,35 @@
 
 use alloc::vec::Vec;
 
-/// Items in order, in chunks of `1 << shift` items.
+/// Items in order, in chunks of `chunk` items.
 pub(crate) struct Chunks<T> {
     chunks: Vec<Vec<T>>,
-    shift: u32,
+    chunk: usize,
     len: usize,
 }
 
 impl<T> Chunks<T> {
-    /// Empty, for about `expected` items: about a sixteenth of them a chunk (a power of two, at
-    /// least 64).
+    /// Empty, for about `expected` items: a sixteenth of them a chunk (at least 64).
     pub fn for_about(expected: usize) -> Chunks<T> {
         Chunks {
             chunks: Vec::new(),
-            shift: (expected / 16).max(64).ilog2(),
+            chunk: (expected / 16).max(64),
             len: 0,
         }
     }
 
     /// Appends `item`.
     pub fn push(&mut self, item: T) {
-        let chunk = 1 << self.shift;
         match self.chunks.last_mut() {
-            Some(last) if last.len() < chunk => last.push(item),
+            Some(last) if last.len() < self.chunk => last.push(item),
             _ => {
-                let mut fresh = Vec::with_capacity(chunk);
+                let mut fresh = Vec::with_capacity(self.chunk);
                 fresh.push(item);
                 self.chunks.push(fresh);
             }
         }
         self.len += 1;
     }
-
 
     /// The last item pushed.
     pub fn last(&self) -> Option<&T> {

@@ -42,8 +42,8 @@
 
 pub(crate) mod around;
 mod attributes;
-mod chunks;
 pub mod bound;
+mod chunks;
 pub(crate) mod closest;
 pub(crate) mod collapse;
 pub(crate) mod flatten;
