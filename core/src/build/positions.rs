@@ -4,7 +4,7 @@
 //! The builder's memory peaks as its collapses start, when no vertex has been made yet: a copy of
 //! the input's positions in `f64`, with room reserved for the made ones beside it, held 48 bytes
 //! an input vertex there; this holds 24 bytes a made vertex, room for them reserved at the start
-//! (kept in chunks, which the collapse records are, the reads of a position cost 5% more
+//! (kept in chunks, which the collapse records are, the reads of a position cost 3% more
 //! instructions to save 1% of the peak).
 
 use alloc::vec::Vec;
