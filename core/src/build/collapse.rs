@@ -240,30 +240,37 @@ pub(crate) fn merged_color(
     }
 }
 
-/// Each input vertex's quadric (the planes of its triangles, weighted by their areas) and a
-/// third of its triangles' areas, by vertex id, which is each engine's slot at the start.
+/// Each input vertex's quadric (the planes of its triangles, weighted by their areas) and, when
+/// the mesh is `colored`, a third of its triangles' areas (which weigh merged colours, and
+/// nothing else: none without colours), by vertex id, which is each engine's slot at the start.
 pub(crate) fn face_sums(
     pos: &Positions<'_>,
     faces: &[[u32; 3]],
     n: usize,
+    colored: bool,
 ) -> (Vec<Quadric>, Vec<f64>) {
     let mut quadric = vec![Quadric::default(); n];
-    let mut area = vec![0.0; n];
+    let mut area = if colored { vec![0.0; n] } else { Vec::new() };
     for tri in faces {
         let [a, b, c] = tri.map(|i| pos.get(i));
         let q = Quadric::triangle(a, b, c);
-        let ar = 0.5 * len(cross(sub(b, a), sub(c, a)));
         for &v in tri {
             quadric[v as usize] = quadric[v as usize].add(&q);
-            area[v as usize] += ar / 3.0;
+        }
+        if colored {
+            let ar = 0.5 * len(cross(sub(b, a), sub(c, a)));
+            for &v in tri {
+                area[v as usize] += ar / 3.0;
+            }
         }
     }
     (quadric, area)
 }
 
 /// What a collapse adds up of its two `ends` (vertex id, slot, position): the first end's slot
-/// takes the summed quadric and area, and the colour of the vertex made at `v` is pushed (when
-/// the mesh has colours). Both engines keep quadrics and areas by slot, colours by vertex id.
+/// takes the summed quadric and, when the mesh has colours, the summed area, and the colour of
+/// the vertex made at `v` is pushed. Both engines keep quadrics and areas by slot, colours by
+/// vertex id.
 #[inline(always)]
 pub(crate) fn merge_sums(
     opts: &BuildOptions,
@@ -274,10 +281,10 @@ pub(crate) fn merge_sums(
     v: Vec3d,
 ) {
     let [(a, sa, pa), (b, sb, pb)] = ends;
-    let (area_a, area_b) = (area[sa], area[sb]);
     quadric[sa] = quadric[sa].add(&quadric[sb]);
-    area[sa] = area_a + area_b;
     if !color.is_empty() {
+        let (area_a, area_b) = (area[sa], area[sb]);
+        area[sa] = area_a + area_b;
         let (ca, cb) = (color[a as usize], color[b as usize]);
         let c = merged_color(opts, v, [pa, pb], [ca, cb], [area_a, area_b]);
         color.push(c);
@@ -377,11 +384,11 @@ impl<'o> Engine<'o> {
                 vfaces[v as usize].push(f as u32);
             }
         }
-        let (quadric, area) = face_sums(&pos, &faces, n);
         // Colours in 0..=1, only when the mesh has them (none: black, and no array).
-        let color = mesh.colors.map_or_else(Vec::new, |c| {
+        let color: Vec<Vec3d> = mesh.colors.map_or_else(Vec::new, |c| {
             c.iter().map(|c| c.map(|v| v as f64 / 255.0)).collect()
         });
+        let (quadric, area) = face_sums(&pos, &faces, n, !color.is_empty());
         let mut ring = Vec::new();
         let vverts: Vec<Vec<u32>> = (0..n as u32)
             .zip(&vfaces)

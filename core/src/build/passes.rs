@@ -112,14 +112,14 @@ impl<'o> Passes<'o> {
         let ids = n.saturating_sub(1);
         let pos = Positions::new(mesh.positions, ids);
         let faces = mesh.triangles.to_vec();
-        let (quadric, area) = face_sums(&pos, &faces, n);
+        let mut color: Vec<Vec3d> = mesh.colors.map_or_else(Vec::new, |c| {
+            c.iter().map(|c| c.map(|v| v as f64 / 255.0)).collect()
+        });
+        let (quadric, area) = face_sums(&pos, &faces, n, !color.is_empty());
         let mut alive = vec![false; n];
         for &v in faces.iter().flatten() {
             alive[v as usize] = true;
         }
-        let mut color: Vec<Vec3d> = mesh.colors.map_or_else(Vec::new, |c| {
-            c.iter().map(|c| c.map(|v| v as f64 / 255.0)).collect()
-        });
         color.reserve_exact(if color.is_empty() { 0 } else { ids });
         alive.reserve_exact(ids);
         let live_slots = (0..n as u32).filter(|&v| alive[v as usize]).collect();
