@@ -914,7 +914,8 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 }
             }
             let seen = e >= 0.0 && (fa | fb) & WAS_VISIBLE != 0;
-            let split = h.split(p);
+            // `a` is the first child: its pair's split is found without counting parents.
+            let split = h.pair_split(self.v.node[a]);
             let legal = self.collapse_legal_at(&split, a as u32, b as u32, &mut fans);
             if legal.is_err() && !blending {
                 self.block(a, b);
@@ -934,7 +935,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                     frame.stats.ecols += 1;
                     frame.ops += 1;
                     self.list_new_pair(h, view, policy, s as usize, frame);
-                    self.list_unblocked(h, view, policy, s, &mut fans, frame);
+                    self.list_unblocked(h, view, policy, &fans, frame);
                 }
                 Err(_) => {
                     // Arrived, but the neighbourhood changed meanwhile: blend back.
@@ -973,35 +974,19 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         }
     }
 
-    /// After a collapse into slot `s`: lists the pairs around it whose illegal mark the collapse
-    /// cleared (`fans.unblocked`; all pairs around it when it could not remember them all), when
-    /// their parent is no longer needed: they may be legal now.
+    /// After a collapse: lists the pairs whose illegal mark it cleared (`fans.unblocked`, see
+    /// `Cut::unblock_relinked`), when their parent is no longer needed: they may be legal now.
     fn list_unblocked<P: Policy>(
         &mut self,
         h: &HierarchyView<'_>,
         view: &View,
         policy: &P,
-        s: u32,
-        fans: &mut PairFans,
+        fans: &PairFans,
         frame: &mut Frame,
     ) {
-        if !fans.overflow {
-            for k in 0..fans.unblocked.len() {
-                if let Some(x) = self.slot(fans.unblocked[k]) {
-                    self.list_new_pair(h, view, policy, x as usize, frame);
-                }
-            }
-            return;
-        }
-        let fan = &mut fans.fans[0];
-        if !self.complete_fan(s, fan) {
-            return;
-        }
-        for k in 0..fan.len() {
-            for x in self.t.at(fan[k]) {
-                if x != s {
-                    self.list_new_pair(h, view, policy, x as usize, frame);
-                }
+        for &first in &fans.unblocked {
+            if let Some(x) = self.slot(first) {
+                self.list_new_pair(h, view, policy, x as usize, frame);
             }
         }
     }

@@ -581,6 +581,13 @@ pub struct SplitView {
 }
 
 impl SplitView {
+    /// No split: what a leaf (or an id out of range) has.
+    pub const NONE: SplitView = SplitView {
+        children: [NONE; 2],
+        faces: [NONE; 2],
+        neighbours: [NONE; 4],
+    };
+
     /// Whether the split adds a second triangle (it is not on a border).
     #[inline]
     #[must_use]
@@ -955,6 +962,16 @@ impl<'a> HierarchyView<'a> {
         (0..self.nodes).filter(|&i| !self.is_parent(i))
     }
 
+    /// The children of the split that adds triangle `face` (the `k`-th pair for the `k`-th
+    /// split's triangles: nothing is read), or `None` for a base triangle (and for ids out of
+    /// range).
+    #[inline]
+    #[must_use]
+    pub fn face_children(&self, face: u32) -> Option<[u32; 2]> {
+        let k = face.checked_sub(self.base_triangles)? / 2;
+        (k < self.nodes - self.leaves).then(|| self.pair(k))
+    }
+
     /// The parent whose split adds triangle `face`, or `None` for a base triangle (and for ids out
     /// of range).
     #[inline]
@@ -1326,14 +1343,27 @@ impl<'a> HierarchyView<'a> {
     #[inline(always)]
     #[must_use]
     pub fn split(&self, p: u32) -> SplitView {
-        let (parent, rank) = self.kind(p);
-        if !parent {
-            return SplitView {
-                children: [NONE; 2],
-                faces: [NONE; 2],
-                neighbours: [NONE; 4],
-            };
+        match self.kind(p) {
+            (true, rank) => self.split_at(rank),
+            _ => SplitView::NONE,
         }
+    }
+
+    /// [`HierarchyView::split`] of the parent of the sibling pair whose first child is `first`
+    /// ([`SplitView::NONE`] for a root or an id out of range): the `k`-th pair's parent is the
+    /// `k`-th parent, so its split is found without counting the parents before it.
+    #[inline]
+    #[must_use]
+    pub fn pair_split(&self, first: u32) -> SplitView {
+        if first < self.roots || first >= self.nodes {
+            return SplitView::NONE;
+        }
+        self.split_at((first - self.roots) / 2)
+    }
+
+    /// The split of the parent of rank `rank` (the `rank`-th parent in id order).
+    #[inline(always)]
+    fn split_at(&self, rank: u32) -> SplitView {
         let wf = self.face_width;
         let at = self.offsets[4] as u64 * 8 + rank as u64 * split_bits(wf);
         let neighbours = if 2 * wf + 7 <= 64 {

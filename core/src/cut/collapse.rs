@@ -49,15 +49,11 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         b: u32,
         fans: &mut PairFans,
     ) -> Result<CollapsePlan, Refused> {
-        let [fan_a, fan_b] = &mut fans.fans;
-        if !self.complete_fan(a, fan_a) {
-            return Err(Refused::Inconsistent);
-        }
+        // Only `b`'s triangles are renamed, so `a`'s fan is walked only as far as `fl` (most
+        // collapses tried are refused by `fl`'s neighbours).
         let id = s.faces[0];
-        let fl = fan_a
-            .iter()
-            .copied()
-            .find(|&f| self.t.id[f as usize] == id)
+        let fl = self
+            .find_around(a, |f| self.t.id[f as usize] == id)
             .ok_or(Refused::Illegal)?;
         let t = self.t.at(fl);
         let k = corner(t, a).ok_or(Refused::Inconsistent)?;
@@ -98,7 +94,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         }
         // Renaming b and moving the last vertex into b's slot must reach every triangle.
         let last = self.v.len() as u32 - 1;
-        if !self.complete_fan(b, fan_b) || !self.fan_complete(last) {
+        if !self.complete_fan(b, &mut fans.fans[1]) || !self.fan_complete(last) {
             return Err(Refused::Inconsistent);
         }
         Ok(CollapsePlan {
@@ -124,32 +120,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             left: fl,
             right: fr,
         } = plan;
-        let [fan_a, fan_b] = &fans.fans;
-        // Collapses around here may become legal: clear the marks on every corner of the
-        // triangles around both vertices (the parent's fan and its neighbours), and remember
-        // whose mark was cleared.
-        fans.unblocked.clear();
-        fans.overflow = false;
-        for &f in fan_a.iter().chain(fan_b.iter()) {
-            for v in self.t.at(f) {
-                let Some(flags) = self.v.flags.get_mut(v as usize) else {
-                    continue;
-                };
-                if *flags & BLOCKED == 0 {
-                    continue;
-                }
-                // The pair is judged again (by its first child, which may be the sibling): no
-                // longer settled either.
-                *flags &= !(BLOCKED | SETTLED);
-                let m = self.v.mate(v as usize) as usize;
-                if let Some(mate) = self.v.flags.get_mut(m) {
-                    *mate &= !SETTLED;
-                }
-                if v != a && v != b && fans.unblocked.push(self.v.node[v as usize]).is_err() {
-                    fans.overflow = true;
-                }
-            }
-        }
+        let fan_b = &fans.fans[1];
         // The removed triangles' corners lose one triangle each; then b's become a's.
         for f in [fl, fr] {
             if let Some(t) = self.t.get(f) {
@@ -171,8 +142,10 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 self.t.set_corner(f, k, a);
             }
         }
-        // The neighbours of each removed triangle become each other's.
+        // The neighbours of each removed triangle become each other's: a new neighbour may be
+        // what the collapse of the pair that made them waited for.
         let mut new_fan = NIL;
+        fans.unblocked.clear();
         for f in [fl, fr] {
             let Some(t) = self.t.get(f) else {
                 continue;
@@ -186,6 +159,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 if p == NIL {
                     continue;
                 }
+                self.unblock_pair_of(h, p, fans);
                 for k in 0..3 {
                     if self.t.adj(p)[k] == f {
                         self.t.set_adj(p, k, q);
@@ -220,5 +194,44 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             Some(moved_from) if moved_from == a => b,
             _ => a,
         }
+    }
+
+    /// Clears the illegal mark of the pair that made triangle `f`, which a collapse is giving a
+    /// new neighbour, and remembers its first child in `fans.unblocked`.
+    ///
+    /// A collapse is legal when its two triangles have the four neighbours its split record
+    /// names (Hoppe's condition), and the triangles of an active pair are always there (only the
+    /// collapse of their own pair removes them), so an illegal collapse can become legal only
+    /// when one of its triangles gets a new neighbour. A split never gives it the one it waits
+    /// for: the triangles a split makes are new neighbours only of the triangles its own record
+    /// names, which the file's order of splits makes before it, while a blocked collapse waits
+    /// for a triangle made before its own. So only collapses unblock, and only the pairs that
+    /// made the triangles next to the two a collapse removes: at most four.
+    fn unblock_pair_of(&mut self, h: &HierarchyView<'_>, f: u32, fans: &mut PairFans) {
+        let Some([c0, c1]) = h.face_children(self.t.id[f as usize]) else {
+            return;
+        };
+        // While the pair is active its children are corners of the triangles it made.
+        let (mut a, mut b) = (NIL, NIL);
+        for v in self.t.at(f) {
+            match self.v.node.get(v as usize) {
+                Some(&n) if n == c0 => a = v,
+                Some(&n) if n == c1 => b = v,
+                _ => {}
+            }
+        }
+        let (Some(fa), Some(fb)) = (self.v.flags.get(a as usize), self.v.flags.get(b as usize))
+        else {
+            return;
+        };
+        if fa & fb & BLOCKED == 0 {
+            return;
+        }
+        // Judged again (by its first child): no longer settled either.
+        for s in [a, b] {
+            self.v.flags[s as usize] &= !(BLOCKED | SETTLED);
+        }
+        // At most four (two neighbours of each of two triangles), which `unblocked` holds.
+        let _ = fans.unblocked.push(c0);
     }
 }

@@ -25,18 +25,16 @@ pub(crate) fn holds(fan: &[u32], f: u32) -> bool {
 /// vector (making one writes no memory; an arena would zero its 4 KiB each time).
 pub(crate) type Fan = heapless::Vec<u32, MAX_FAN>;
 
-/// Most nodes whose illegal mark one collapse clears that it remembers (more: it remembers that
-/// there were more).
-pub(crate) const MAX_UNBLOCKED: usize = 32;
+/// Most pairs one collapse unblocks: those that made the four triangles next to the two it
+/// removes.
+pub(crate) const MAX_UNBLOCKED: usize = 4;
 
 /// The triangles around the two vertices of a collapse, found while proving it legal and used
-/// again to do it; and the nodes around it whose illegal mark the collapse cleared.
+/// again to do it; and the pairs whose illegal mark the collapse cleared.
 pub(crate) struct PairFans {
     pub fans: [Fan; 2],
-    /// Nodes of the vertices the last collapse unblocked (see `crate::cut::BLOCKED`).
+    /// First children of the pairs the last collapse unblocked (see `crate::cut::BLOCKED`).
     pub unblocked: heapless::Vec<u32, MAX_UNBLOCKED>,
-    /// More vertices were unblocked than `unblocked` holds.
-    pub overflow: bool,
 }
 
 impl Default for PairFans {
@@ -47,7 +45,6 @@ impl Default for PairFans {
             // (3% of a steady frame's instructions at 1 px, 10% at 4 px).
             fans: core::array::from_fn(|_| Fan::new()),
             unblocked: heapless::Vec::new(),
-            overflow: false,
         }
     }
 }
@@ -138,6 +135,41 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             left -= 1;
             g = self.cw(g, v).unwrap_or(NIL);
         }
+    }
+
+    /// The first triangle around slot `v` for which `wanted` holds, walking as
+    /// [`Cut::for_each_around`] does but stopping there.
+    pub(crate) fn find_around(&self, v: u32, wanted: impl Fn(u32) -> bool) -> Option<u32> {
+        if v as usize >= self.v.len() {
+            return None;
+        }
+        let start = self.v.fan(v as usize);
+        let mut left = self.v.degree[v as usize];
+        if start == NIL {
+            return None;
+        }
+        let mut f = start;
+        while left > 0 {
+            if wanted(f) {
+                return Some(f);
+            }
+            left -= 1;
+            match self.ccw(f, v) {
+                Some(g) if g == start => return None,
+                Some(g) if g != NIL => f = g,
+                _ => break,
+            }
+        }
+        // A border: the rest lies clockwise of the start.
+        let mut g = self.cw(start, v).unwrap_or(NIL);
+        while g != NIL && left > 0 {
+            if wanted(g) {
+                return Some(g);
+            }
+            left -= 1;
+            g = self.cw(g, v).unwrap_or(NIL);
+        }
+        None
     }
 
     /// Whether walking `v`'s fan finds every triangle that uses `v`, each once.

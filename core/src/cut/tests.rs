@@ -281,6 +281,45 @@ mod adapt {
         assert_eq!(first, run());
     }
 
+    /// A pair marked illegal (`BLOCKED`) stays illegal until a collapse unblocks it: only the
+    /// collapses that give its triangles new neighbours do (`Cut::unblock_pair_of`), so after
+    /// every frame no marked pair may be legal, or a collapse the view asks for would wait.
+    #[test]
+    fn a_pair_marked_illegal_is_illegal_until_unblocked() {
+        let bytes = sphere_bytes();
+        let h = HierarchyView::parse(&bytes).unwrap();
+        let policy = (Frustum, (BackFace, ScreenError::new(0.5)));
+        let mut marked = 0;
+        for (frames, max_triangles) in [(0, u32::MAX), (4, u32::MAX), (0, 700)] {
+            let mut cut: Box<Mid> = Cut::boxed();
+            cut.reset(&h).unwrap();
+            cut.set_geomorph_frames(frames);
+            let budget = Budget {
+                max_triangles,
+                ..Budget::default()
+            };
+            let mut fans = PairFans::default();
+            for i in 0..200 {
+                let distance = 1.5 + 4.0 * libm::fabsf(libm::sinf(i as f32 * 0.05));
+                cut.adapt(&h, &orbit(i, distance), &policy, &budget);
+                for a in 0..cut.vertex_count() {
+                    let Some(p) = cut.pair_parent(&h, a) else {
+                        continue;
+                    };
+                    let b = cut.v.mate(a) as usize;
+                    if cut.v.flags[a] & cut.v.flags[b] & BLOCKED != 0 {
+                        marked += 1;
+                        assert!(
+                            cut.collapse_legal(&h, p, &mut fans).is_err(),
+                            "frame {i}: pair of node {p} marked illegal, but legal"
+                        );
+                    }
+                }
+            }
+        }
+        assert!(marked > 1000, "pairs are marked illegal ({marked})");
+    }
+
     /// Renumbering changes slots only: the same nodes, triangles and blended positions, and the
     /// frames after it the same as without it (but for which restless vertices are asked), with
     /// and without geomorphs; the vertices are in node order after it and the triangles in the
