@@ -9,8 +9,8 @@
 //! [`FrameStats::settled`]), then
 //!
 //! 1. **coarsen**: sibling pairs whose parent the policy no longer needs are collapsed where
-//!    Hoppe's condition allows; a collapse lists the pair it makes and the pairs around it whose
-//!    illegal mark it cleared, so when no budget, queue or operation cap binds, one call reaches
+//!    Hoppe's condition allows; a collapse lists the pair it makes and the pairs whose illegal
+//!    mark it cleared (those whose triangles it gave a new neighbour), so when no budget, queue or operation cap binds, one call reaches
 //!    the cut the view asks for and a second call with the same view does nothing (a test over
 //!    the peer orbit at 0.25-4 px);
 //! 2. **refine**: vertices over tolerance are split largest error first (a priority queue), each
@@ -872,7 +872,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         // Scratch for the fans of every collapse tried (made once: making one costs a memset).
         let mut fans = PairFans::default();
         // One pass over a list that grows: a collapse lists the pair it makes and the pairs
-        // around it whose illegal mark it cleared, so a pair that waited for it is tried again.
+        // whose illegal mark it cleared, so a pair that waited for it is tried again.
         let mut k = 0;
         while k < self.pairs.len() {
             let pair = self.pairs.as_slice()[k];

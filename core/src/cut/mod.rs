@@ -116,8 +116,9 @@ pub const NIL: u32 = u32::MAX;
 pub(crate) const VISIBLE: u8 = 1;
 /// Vertex flag: visible at the evaluation before.
 pub(crate) const WAS_VISIBLE: u8 = 2;
-/// Vertex flag, set on both children: their collapse was found illegal, and nothing around
-/// them has collapsed since (a collapse clears it on its fan), so it is not retried.
+/// Vertex flag, set on both children: their collapse was found illegal, and no collapse has
+/// given their triangles a new neighbour since (the one thing that can make it legal: see
+/// `Cut::unblock_pair_of`), so it is not retried.
 pub(crate) const BLOCKED: u8 = 4;
 /// Vertex flag: a geomorph runs (its blend entry has frames left).
 pub(crate) const BLENDING: u8 = 8;
