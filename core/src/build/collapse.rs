@@ -13,6 +13,7 @@ use alloc::vec::Vec;
 use super::chunks::Chunks;
 use super::closest::Surface;
 use super::flatten::{flatten, PlanarCollapse};
+use super::lists::{faces_in, ring_in, Lists};
 use super::positions::Positions;
 use super::quadric::{place, Quadric};
 use super::queue::CostQueue;
@@ -75,10 +76,9 @@ pub(crate) struct Engine<'o> {
     pub color: Vec<[f64; 3]>,
     pub faces: Vec<[u32; 3]>,
     pub face_alive: Vec<bool>,
-    /// Live faces around each live vertex, by slot.
-    vfaces: Vec<Vec<u32>>,
-    /// Sorted neighbours of each live vertex, by slot, kept up to date by [`Engine::collapse`].
-    vverts: Vec<Vec<u32>>,
+    /// Live faces around each live vertex and its sorted neighbours, by slot, kept up to date by
+    /// [`Engine::collapse`].
+    lists: Lists,
     pub alive: Vec<bool>,
     pub alive_count: usize,
     /// Edges by cost.
@@ -135,14 +135,6 @@ pub(crate) fn kept(opts: &BuildOptions, v: Vec3d, children: [Vec3d; 2]) -> Optio
     (opts.placement == Placement::Endpoint)
         .then(|| children.iter().position(|&c| c == v))
         .flatten()
-}
-
-/// `items` in `list`'s allocation, grown to their exact length if it is too small.
-fn exactly(mut list: Vec<u32>, items: &[u32]) -> Vec<u32> {
-    list.clear();
-    list.reserve_exact(items.len());
-    list.extend_from_slice(items);
-    list
 }
 
 /// The corners that follow `v` counter-clockwise in triangle `t` (`None` when `v` is not one):
@@ -367,43 +359,46 @@ impl<'o> Engine<'o> {
         let pos = Positions::new(mesh.positions, n.saturating_sub(1));
         let faces = mesh.triangles.to_vec();
         // Each vertex's faces and neighbours in lists of their exact length (grown by pushing,
-        // they took a sixth of the build's instructions and held twice the room).
-        let mut degree = vec![0u32; n];
+        // they took a sixth of the build's instructions and held twice the room): the faces
+        // filed by vertex first (`start[v]..start[v + 1]` of `filed`, in face order), then each
+        // vertex's lists made from its faces, and the filing freed.
+        let mut start = vec![0u32; n + 1];
         for tri in &faces {
             for &v in tri {
-                degree[v as usize] += 1;
+                start[v as usize + 1] += 1;
             }
         }
-        let mut vfaces: Vec<Vec<u32>> = degree
-            .iter()
-            .map(|&d| Vec::with_capacity(d as usize))
-            .collect();
-        drop(degree);
+        for v in 0..n {
+            start[v + 1] += start[v];
+        }
+        let mut filed = vec![0u32; faces.len() * 3];
+        let mut next = start.clone();
         for (f, tri) in faces.iter().enumerate() {
             for &v in tri {
-                vfaces[v as usize].push(f as u32);
+                filed[next[v as usize] as usize] = f as u32;
+                next[v as usize] += 1;
             }
         }
+        drop(next);
+        let mut lists = Lists::with_capacity(n);
+        let mut ring = Vec::new();
+        for v in 0..n {
+            let around = &filed[start[v] as usize..start[v + 1] as usize];
+            ring.clear();
+            for &f in around {
+                ring.extend(faces[f as usize].iter().filter(|&&x| x != v as u32));
+            }
+            ring.sort_unstable();
+            ring.dedup();
+            lists.push(around, &ring);
+        }
+        drop((start, filed, ring));
         // Colours in 0..=1, only when the mesh has them (none: black, and no array).
         let color: Vec<Vec3d> = mesh.colors.map_or_else(Vec::new, |c| {
             c.iter().map(|c| c.map(|v| v as f64 / 255.0)).collect()
         });
         let (quadric, area) = face_sums(&pos, &faces, n, !color.is_empty());
-        let mut ring = Vec::new();
-        let vverts: Vec<Vec<u32>> = (0..n as u32)
-            .zip(&vfaces)
-            .map(|(v, around)| {
-                ring.clear();
-                for &f in around {
-                    ring.extend(faces[f as usize].iter().filter(|&&x| x != v));
-                }
-                ring.sort_unstable();
-                ring.dedup();
-                ring.as_slice().to_vec()
-            })
-            .collect();
         let mut e = Engine {
-            vverts,
             opts,
             pos,
             quadric,
@@ -412,9 +407,9 @@ impl<'o> Engine<'o> {
             color,
             face_alive: vec![true; faces.len()],
             faces,
-            alive: vfaces.iter().map(|f| !f.is_empty()).collect(),
+            alive: lists.has_faces().collect(),
             alive_count: 0,
-            vfaces,
+            lists,
             queue: CostQueue::default(),
             purged_at: 0,
             rejected: Rejected::with_ids(2 * n),
@@ -454,12 +449,12 @@ impl<'o> Engine<'o> {
                 }
             }
         }
-        let edges = e.vverts.iter().map(Vec::len).sum::<usize>() / 2;
+        let edges = e.lists.ring_total() / 2;
         // Room for half as many again as the edges: the bunny's queue peaks at a third more.
         e.queue.reserve(edges + edges / 2);
         for v in 0..n as u32 {
-            for k in 0..e.vverts[v as usize].len() {
-                let x = e.vverts[v as usize][k];
+            for k in 0..e.lists.ring(v as usize).len() {
+                let x = e.lists.ring(v as usize)[k];
                 if v < x {
                     e.push(v, x);
                 }
@@ -504,19 +499,19 @@ impl<'o> Engine<'o> {
     /// Whether live vertex `v` is on a border: in a manifold fan an inner vertex has as many
     /// triangles as neighbours, a border vertex one fewer.
     pub fn on_border(&self, v: u32) -> bool {
-        self.vfaces[self.at(v)].len() < self.neighbours(v).len()
+        self.lists.faces(self.at(v)).len() < self.neighbours(v).len()
     }
 
     /// Sorted distinct neighbours of a live vertex.
     pub fn neighbours(&self, v: u32) -> &[u32] {
-        &self.vverts[self.at(v)]
+        self.lists.ring(self.at(v))
     }
 
     /// The faces with directed edge `a -> b` and `b -> a`, as (third corner of the first or NONE,
     /// number of faces on the edge).
     #[inline]
     fn edge_faces(&self, a: u32, b: u32) -> ([u32; 2], usize) {
-        edge_wings(&self.faces, &self.vfaces[self.at(a)], a, b)
+        edge_wings(&self.faces, self.lists.faces(self.at(a)), a, b)
     }
 
     fn boundary_neighbours(&self, v: u32) -> Vec<u32> {
@@ -660,7 +655,7 @@ impl<'o> Engine<'o> {
         let mut worst_before = f64::INFINITY;
         let mut worst_after = f64::INFINITY;
         for &s in &[a, b] {
-            for &f in &self.vfaces[self.at(s)] {
+            for &f in self.lists.faces(self.at(s)) {
                 let t = self.faces[f as usize];
                 if t.contains(&a) && t.contains(&b) {
                     continue;
@@ -724,9 +719,11 @@ impl<'o> Engine<'o> {
         if self.planar.is_none() {
             return true;
         }
-        let mut ids: Vec<u32> = self.vfaces[self.at(a)]
+        let mut ids: Vec<u32> = self
+            .lists
+            .faces(self.at(a))
             .iter()
-            .chain(&self.vfaces[self.at(b)])
+            .chain(self.lists.faces(self.at(b)))
             .copied()
             .collect();
         ids.sort_unstable();
@@ -754,7 +751,7 @@ impl<'o> Engine<'o> {
         } else {
             ([b, a], [wings[1], wings[0]])
         };
-        let around = children.map(|c| self.vfaces[self.at(c)].as_slice());
+        let around = children.map(|c| self.lists.faces(self.at(c)));
         let (faces, neighbours) = split_faces(&self.faces, around, children, wings);
         let p = self.pos.len() as u32;
         let (ia, ib) = (a as usize, b as usize);
@@ -775,15 +772,12 @@ impl<'o> Engine<'o> {
             self.corners.push(corner);
         }
 
-        // The lists of p are built in scratch buffers and stored at their exact length in the
-        // allocations of a's lists (grown by pushing they held up to twice the room).
+        // The lists of p are built in scratch buffers and stored at their exact length in a's
+        // slot once a's and b's are read.
         let mut pf = core::mem::take(&mut self.scratch_faces);
         pf.clear();
-        let (own_faces, b_faces) = (
-            core::mem::take(&mut self.vfaces[sa]),
-            core::mem::take(&mut self.vfaces[sb]),
-        );
-        for (s, list) in [(a, &own_faces), (b, &b_faces)] {
+        let (la, lb) = (self.lists.take(sa), self.lists.take(sb));
+        for (s, list) in [(a, faces_in(&la)), (b, faces_in(&lb))] {
             for &f in list {
                 let t = &mut self.faces[f as usize];
                 if t.contains(&a) && t.contains(&b) {
@@ -794,9 +788,8 @@ impl<'o> Engine<'o> {
                             .copied()
                             .find(|&x| x != a && x != b)
                             .unwrap_or(NONE);
-                        let list = self.slot.get(third as usize).copied();
-                        if let Some(list) = list.and_then(|l| self.vfaces.get_mut(l as usize)) {
-                            list.retain(|&g| g != f);
+                        if let Some(&l) = self.slot.get(third as usize) {
+                            self.lists.remove_face(l as usize, f);
                         }
                     }
                     continue;
@@ -815,8 +808,6 @@ impl<'o> Engine<'o> {
             self.fans.extend(pf.iter().map(|&f| self.faces[f as usize]));
             self.fan_ends.push(self.fans.len() as u32);
         }
-        self.vfaces[sa] = exactly(own_faces, &pf);
-        self.scratch_faces = pf;
         self.alive[ia] = false;
         self.alive[ib] = false;
         self.alive.push(true);
@@ -835,7 +826,7 @@ impl<'o> Engine<'o> {
         // Both rings are sorted: one merge makes p's, sorted.
         let mut ring = core::mem::take(&mut self.scratch_ring);
         ring.clear();
-        let (ra, rb) = (&self.vverts[sa], &self.vverts[sb]);
+        let (ra, rb) = (ring_in(&la), ring_in(&lb));
         let (mut i, mut j) = (0, 0);
         loop {
             let x = match (ra.get(i), rb.get(j)) {
@@ -866,19 +857,15 @@ impl<'o> Engine<'o> {
                 ring.push(x);
             }
         }
-        self.vverts[sb] = Vec::new();
         for &x in &ring {
-            let slot = self.at(x);
-            let r = &mut self.vverts[slot];
-            r.retain(|&y| y != a && y != b);
-            r.push(p);
+            self.lists.swap_in_ring(self.at(x), (a, b), p);
         }
-        self.vverts[sa] = exactly(core::mem::take(&mut self.vverts[sa]), &ring);
-        self.scratch_ring = ring;
+        self.lists.set(sa, &pf, &ring);
+        drop((la, lb));
+        self.scratch_faces = pf;
         // Fresh costs for the edges of p (no other edge's cost changed); edges around it that were
         // illegal may have become legal.
-        for k in 0..self.vverts[sa].len() {
-            let x = self.vverts[sa][k];
+        for &x in &ring {
             self.push(p, x);
             let mut retry = self.rejected.take(x);
             retry.sort_unstable();
@@ -892,5 +879,6 @@ impl<'o> Engine<'o> {
                 }
             }
         }
+        self.scratch_ring = ring;
     }
 }

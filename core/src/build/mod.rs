@@ -48,6 +48,7 @@ pub(crate) mod closest;
 pub(crate) mod collapse;
 pub(crate) mod flatten;
 mod input;
+mod lists;
 mod passes;
 mod positions;
 mod quadric;
