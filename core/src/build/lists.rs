@@ -17,18 +17,18 @@ pub(crate) struct Lists {
     slots: Vec<Box<[u32]>>,
 }
 
-/// The faces of lists `l`.
+/// The faces of lists `l` (a slot's, or taken by [`Lists::take`]).
 #[inline]
-fn faces_of(l: &[u32]) -> &[u32] {
+pub(crate) fn faces_in(l: &[u32]) -> &[u32] {
     match l {
         [f, _, rest @ ..] => rest.get(..*f as usize).unwrap_or(&[]),
         _ => &[],
     }
 }
 
-/// The ring of lists `l`.
+/// The ring of lists `l` (a slot's, or taken by [`Lists::take`]).
 #[inline]
-fn ring_of(l: &[u32]) -> &[u32] {
+pub(crate) fn ring_in(l: &[u32]) -> &[u32] {
     match l {
         [f, r, rest @ ..] => rest.get(*f as usize..(*f + *r) as usize).unwrap_or(&[]),
         _ => &[],
@@ -60,23 +60,23 @@ impl Lists {
     /// The faces around slot `s`'s vertex.
     #[inline]
     pub fn faces(&self, s: usize) -> &[u32] {
-        self.slots.get(s).map_or(&[], |l| faces_of(l))
+        self.slots.get(s).map_or(&[], |l| faces_in(l))
     }
 
     /// The sorted neighbours of slot `s`'s vertex.
     #[inline]
     pub fn ring(&self, s: usize) -> &[u32] {
-        self.slots.get(s).map_or(&[], |l| ring_of(l))
+        self.slots.get(s).map_or(&[], |l| ring_in(l))
     }
 
     /// Every slot's ring length, summed.
     pub fn ring_total(&self) -> usize {
-        self.slots.iter().map(|l| ring_of(l).len()).sum()
+        self.slots.iter().map(|l| ring_in(l).len()).sum()
     }
 
     /// Whether each slot has faces.
     pub fn has_faces(&self) -> impl Iterator<Item = bool> + '_ {
-        self.slots.iter().map(|l| !faces_of(l).is_empty())
+        self.slots.iter().map(|l| !faces_in(l).is_empty())
     }
 
     /// Takes slot `s`'s lists out (leaving none), for [`faces_in`] and [`ring_in`].
@@ -100,7 +100,7 @@ impl Lists {
             return;
         };
         let (nf, nr) = (l[0] as usize, l[1] as usize);
-        let Some(k) = faces_of(l).iter().position(|&g| g == f) else {
+        let Some(k) = faces_in(l).iter().position(|&g| g == f) else {
             return;
         };
         // The faces after it and the whole ring move down one.
@@ -133,18 +133,6 @@ impl Lists {
         ring[kept] = p;
         l[1] = kept as u32 + 1;
     }
-}
-
-/// The faces of lists taken by [`Lists::take`].
-#[inline]
-pub(crate) fn faces_in(l: &[u32]) -> &[u32] {
-    faces_of(l)
-}
-
-/// The ring of lists taken by [`Lists::take`].
-#[inline]
-pub(crate) fn ring_in(l: &[u32]) -> &[u32] {
-    ring_of(l)
 }
 
 #[cfg(test)]
