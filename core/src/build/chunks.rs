@@ -1,6 +1,6 @@
 //! A list that grows a chunk at a time and never copies what it holds.
 //!
-//! The collapse engine makes one record a collapse while the build's memory is near its peak:
+//! The collapse engines make one record a collapse while the build's memory is near its peak:
 //! reserved for every collapse at the start, the records' room (44 bytes an input vertex) was
 //! part of that peak; grown as a `Vec` doubles, each doubling would hold the old and the new
 //! room at once. Chunks add only what the collapses fill, and are joined into one `Vec` when the
@@ -36,6 +36,11 @@ impl<T> Chunks<T> {
             }
         }
         self.len += 1;
+    }
+
+    /// Items pushed.
+    pub fn len(&self) -> usize {
+        self.len
     }
 
     /// The last item pushed.

@@ -24,6 +24,7 @@
 use alloc::vec;
 use alloc::vec::Vec;
 
+use super::chunks::Chunks;
 use super::closest::Surface;
 use super::collapse::{
     after, color_of, cost_at, cost_key, edge_wings, face_sums, merge_sums, placement, split_faces,
@@ -71,7 +72,8 @@ pub(crate) struct Passes<'o> {
     face_alive: Vec<bool>,
     /// The live faces, compacted after each pass.
     live: Vec<u32>,
-    collapses: Vec<Collapse>,
+    /// One record a collapse, in chunks (joined once the engine's arrays are gone).
+    collapses: Chunks<Collapse>,
     fans: Vec<[u32; 3]>,
     fan_ends: Vec<u32>,
     /// By slot: quadric, area, the live vertex in it, the pass that last touched its region
@@ -132,7 +134,7 @@ impl<'o> Passes<'o> {
             face_alive: vec![true; faces.len()],
             live: (0..faces.len() as u32).collect(),
             faces,
-            collapses: Vec::with_capacity(ids),
+            collapses: Chunks::for_about(ids),
             fans: Vec::new(),
             fan_ends: Vec::new(),
             quadric,
@@ -275,6 +277,15 @@ impl<'o> Passes<'o> {
     /// What the collapses leave for the hierarchy (the faces' corners as vertex ids again), all
     /// else freed.
     pub fn into_collapsed(self) -> Collapsed<'o> {
+        let (mut collapsed, records) = self.into_parts();
+        // The rest of the engine is gone: the records can be joined.
+        collapsed.collapses = records.into_vec();
+        collapsed
+    }
+
+    /// [`Passes::into_collapsed`] but for the collapse records, still in chunks; the rest of
+    /// the engine is freed on return.
+    fn into_parts(self) -> (Collapsed<'o>, Chunks<Collapse>) {
         let mut faces = self.faces;
         for (t, &alive) in faces.iter_mut().zip(&self.face_alive) {
             *t = if alive {
@@ -283,17 +294,18 @@ impl<'o> Passes<'o> {
                 [NONE; 3]
             };
         }
-        Collapsed {
+        let collapsed = Collapsed {
             heap_pushes: self.evaluations,
             opts: self.opts,
             pos: self.pos,
             color: self.color,
             faces,
             face_alive: self.face_alive,
-            collapses: self.collapses,
+            collapses: Vec::new(),
             fans: self.fans,
             fan_ends: self.fan_ends,
-        }
+        };
+        (collapsed, self.collapses)
     }
 
     /// Brings the filing up to date after a pass: only the slots the pass marked lost faces
