@@ -10,8 +10,8 @@
 //!
 //! 1. **coarsen**: sibling pairs whose parent the policy no longer needs are collapsed where
 //!    Hoppe's condition allows; a collapse lists the pair it makes and the pairs whose illegal
-//!    mark it cleared (those whose triangles it gave a new neighbour), so when no budget, queue or operation cap binds, one call reaches
-//!    the cut the view asks for and a second call with the same view does nothing (a test over
+//!    mark it cleared (those whose triangles it gave a new neighbour), so when no budget, queue
+//!    or operation cap binds, one call reaches the cut the view asks for and a second call with the same view does nothing (a test over
 //!    the peer orbit at 0.25-4 px);
 //! 2. **refine**: vertices over tolerance are split largest error first (a priority queue), each
 //!    forcing the splits it depends on, and their children join the queue (when nothing can stop
@@ -975,7 +975,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
     }
 
     /// After a collapse: lists the pairs whose illegal mark it cleared (`fans.unblocked`, see
-    /// `Cut::unblock_relinked`), when their parent is no longer needed: they may be legal now.
+    /// `Cut::unblock_pair_of`), when their parent is no longer needed: they may be legal now.
     fn list_unblocked<P: Policy>(
         &mut self,
         h: &HierarchyView<'_>,

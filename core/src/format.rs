@@ -968,8 +968,15 @@ impl<'a> HierarchyView<'a> {
     #[inline]
     #[must_use]
     pub fn face_children(&self, face: u32) -> Option<[u32; 2]> {
+        self.face_split(face).map(|k| self.pair(k))
+    }
+
+    /// Which split adds triangle `face` (the `k`-th adds triangles `2k` and `2k + 1` past the
+    /// base), or `None` for a base triangle and ids out of range.
+    #[inline]
+    fn face_split(&self, face: u32) -> Option<u32> {
         let k = face.checked_sub(self.base_triangles)? / 2;
-        (k < self.nodes - self.leaves).then(|| self.pair(k))
+        (k < self.nodes - self.leaves).then_some(k)
     }
 
     /// The parent whose split adds triangle `face`, or `None` for a base triangle (and for ids out
@@ -977,8 +984,7 @@ impl<'a> HierarchyView<'a> {
     #[inline]
     #[must_use]
     pub fn face_creator(&self, face: u32) -> Option<u32> {
-        let k = face.checked_sub(self.base_triangles)? / 2;
-        (k < self.nodes - self.leaves).then(|| self.pair_parent(k))
+        self.face_split(face).map(|k| self.pair_parent(k))
     }
 
     /// Node `i`'s parent, or [`NONE`] (also for ids out of range).

@@ -2,11 +2,11 @@
 //!
 //! The collapse engine keeps, by slot, the faces around each live vertex and its sorted ring of
 //! neighbours. Two `Vec`s a vertex cost 48 bytes of headers before any id; here both lists
-//! share one boxed slice, `[faces, ring, faces..., ring..., room...]`, 16 bytes of header and
-//! 8 of lengths. The lists change in only three ways, none of which grows them in place: a
-//! face leaves its third corner's list, a neighbour's ring swaps the collapsing pair for the
-//! new vertex (the ring loses one or two ids and gains one), and the new vertex gets lists of
-//! its own (a new allocation, at its exact length).
+//! share one boxed slice, `[faces, ring, faces..., ring..., room...]` (room left where a list
+//! shrank), 16 bytes of header and 8 of lengths. The lists change in only three ways, none of
+//! which grows a list in place: a face leaves its third corner's list, a neighbour's ring swaps
+//! the collapsing pair for the new vertex (the ring loses one or two ids and gains one), and the
+//! new vertex gets lists of its own (a new allocation, at its exact length).
 
 use alloc::boxed::Box;
 use alloc::vec::Vec;

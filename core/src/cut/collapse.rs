@@ -231,7 +231,10 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         for s in [a, b] {
             self.v.flags[s as usize] &= !(BLOCKED | SETTLED);
         }
-        // At most four (two neighbours of each of two triangles), which `unblocked` holds.
-        let _ = fans.unblocked.push(c0);
+        // At most four a collapse (two neighbours of each of two triangles), which `unblocked`
+        // holds; were one left out, its pair, unmarked and unsettled, would be asked by the
+        // next frame's walk and listed there.
+        let remembered = fans.unblocked.push(c0).is_ok();
+        debug_assert!(remembered, "a collapse unblocks at most four pairs");
     }
 }

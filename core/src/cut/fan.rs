@@ -109,37 +109,18 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
 
     /// Calls `visit` with each triangle around slot `v`, walking at most as many steps as the
     /// vertex has triangles (so a fan a crafted file broke ends the walk, not the program).
+    #[inline]
     pub(crate) fn for_each_around(&self, v: u32, mut visit: impl FnMut(u32)) {
-        if v as usize >= self.v.len() {
-            return;
-        }
-        let start = self.v.fan(v as usize);
-        let mut left = self.v.degree[v as usize];
-        if start == NIL {
-            return;
-        }
-        let mut f = start;
-        while left > 0 {
+        self.find_around(v, |f| {
             visit(f);
-            left -= 1;
-            match self.ccw(f, v) {
-                Some(g) if g == start => return,
-                Some(g) if g != NIL => f = g,
-                _ => break,
-            }
-        }
-        // A border: the rest lies clockwise of the start.
-        let mut g = self.cw(start, v).unwrap_or(NIL);
-        while g != NIL && left > 0 {
-            visit(g);
-            left -= 1;
-            g = self.cw(g, v).unwrap_or(NIL);
-        }
+            false
+        });
     }
 
-    /// The first triangle around slot `v` for which `wanted` holds, walking as
-    /// [`Cut::for_each_around`] does but stopping there.
-    pub(crate) fn find_around(&self, v: u32, wanted: impl Fn(u32) -> bool) -> Option<u32> {
+    /// The first triangle around slot `v` for which `wanted` holds, walking counter-clockwise
+    /// from the vertex's fan triangle, then (at a border) clockwise from it, at most as many
+    /// steps as the vertex has triangles.
+    pub(crate) fn find_around(&self, v: u32, mut wanted: impl FnMut(u32) -> bool) -> Option<u32> {
         if v as usize >= self.v.len() {
             return None;
         }
