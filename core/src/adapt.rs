@@ -538,16 +538,13 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                     Some(d) => d.visible,
                     None => blends && view.sphere_visible(center, radius),
                 };
-                let mut next_flags = if done {
-                    seen(flags, visible, blends)
-                } else {
-                    flags
-                };
+                let seen_flags = seen(flags, visible, blends);
+                let mut next_flags = if done { seen_flags } else { flags };
                 margin[n] = f32::NEG_INFINITY;
                 turned[n] = f32::NEG_INFINITY;
                 if let Some(m) = settling
                     .as_ref()
-                    .filter(|m| markable && m.measures(flags, i))
+                    .filter(|m| markable & m.measures(flags, i))
                 {
                     // How far the camera may move while it wants no split (answered from its
                     // sphere, a leaf never splits); with geomorphs also while it is seen (or

@@ -163,7 +163,7 @@ impl Settling {
         if self.sparse {
             turn.is_multiple_of(SPARSE_TURN)
         } else {
-            flags & RESTLESS == 0 || turn.is_multiple_of(TURN)
+            (flags & RESTLESS == 0) | turn.is_multiple_of(TURN)
         }
     }
 
@@ -173,20 +173,25 @@ impl Settling {
     /// the last steps, settled when that is at least one frame.
     #[inline(always)]
     pub fn mark(&self, (margin, turned): (f32, f32)) -> Mark {
+        // Both counts' expiries are computed and the mark picked from them, without a branch
+        // on which: that follows no pattern a branch predictor learns.
         let reach = CAP as f32 * QUANTA_PER_TURN.recip();
         let frames = |m: f32, cap: f32, step: f32| {
+            let frames = m.min(cap) / step;
             if m >= step {
-                m.min(cap) / step
+                frames
             } else {
                 0.0
             }
         };
         let travels = frames(margin, CAP as f32 * self.quantum, self.step);
-        if frames(turned, reach, self.turn) > travels {
-            let quanta = ((turned * QUANTA_PER_TURN) as u32).min(CAP);
-            Mark::Settled(TURNING | (self.now[1] + quanta))
+        let turns = frames(turned, reach, self.turn);
+        let by_turn = TURNING | (self.now[1] + ((turned * QUANTA_PER_TURN) as u32).min(CAP));
+        let by_travel = self.now[0] + ((margin / self.quantum) as u32).min(CAP);
+        if turns > travels {
+            Mark::Settled(by_turn)
         } else if travels > 0.0 {
-            Mark::Settled(self.now[0] + ((margin / self.quantum) as u32).min(CAP))
+            Mark::Settled(by_travel)
         } else {
             Mark::Restless
         }

@@ -128,14 +128,19 @@ impl<const V: usize, I: SlotIndex> Vertices<V, I> {
     #[inline(always)]
     pub fn mark(&mut self, s: usize, mark: Mark) {
         if let (Some(x), Some(f)) = (self.tag.get_mut(s), self.flags.get_mut(s)) {
-            match mark {
-                Mark::Settled(until) if *f & (BLENDING | COLLAPSING) == 0 => {
-                    *x = I::store(until);
-                    *f = (*f & !RESTLESS) | SETTLED;
-                }
-                Mark::Settled(_) => {}
-                Mark::Restless => *f |= RESTLESS,
-            }
+            // Written whatever the mark (the old values when it changes nothing): which it is
+            // follows no pattern a branch predictor learns.
+            let (settles, until) = match mark {
+                Mark::Settled(until) => (*f & (BLENDING | COLLAPSING) == 0, until),
+                Mark::Restless => (false, 0),
+            };
+            let restless = u8::from(mark == Mark::Restless) * RESTLESS;
+            *x = if settles { I::store(until) } else { *x };
+            *f = if settles {
+                (*f & !RESTLESS) | SETTLED
+            } else {
+                *f | restless
+            };
         }
     }
 
