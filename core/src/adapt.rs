@@ -465,6 +465,8 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         let mut listed = [0usize; BATCH];
         let mut slow = [0usize; BATCH];
         let mut pairs = [0usize; BATCH];
+        // Those that split (by place in the first list).
+        let mut splitting = [0usize; BATCH];
         let mut margin = [f32::NAN; BATCH];
         // The same as turned (see `crate::cut::rigid`), without geomorphs.
         let mut turned = [f32::NAN; BATCH];
@@ -624,7 +626,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             }
             // 3. The parent of a pair matters unless the first child is to be split or both
             // were found illegal to collapse (see `decide`).
-            let mut np = 0;
+            let (mut np, mut nsp) = (0, 0);
             for (k, &i) in listed.iter().enumerate() {
                 let flags = self.v.flags[i];
                 let m = self.v.mate(i);
@@ -636,6 +638,8 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                     & (flags & mate_flags & BLOCKED == 0);
                 pairs[np] = k;
                 np += judges as usize;
+                splitting[nsp] = k;
+                nsp += splits as usize;
                 // A first child whose pair is marked illegal settles on its own answer (a
                 // collapse that clears the mark on either child clears this one too).
                 if let Some(s) = settling
@@ -683,12 +687,26 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             // 4. The decisions, in slot order. Without geomorphs they touch nothing but the
             // split heap and the pair list, so the pairs can follow the vertices.
             if calm {
+                // What `decide` does without geomorphs: every vertex's flags move, and those
+                // that split join the heap, from lists made without branches (whether a vertex
+                // splits, or a pair is judged, follows no pattern a branch predictor learns).
                 for (k, &i) in listed.iter().enumerate() {
-                    self.decide(h, i, demands[k], frame);
+                    let flags = self.v.flags[i];
+                    debug_assert!(flags & COLLAPSING == 0, "no collapse blends while calm");
+                    self.v.flags[i] = seen(flags, demands[k].visible, false);
+                }
+                for &k in &splitting[..nsp] {
+                    self.want_split(self.v.node[listed[k]], demands[k], frame);
                 }
                 // A pair whose parent was just proven wanted is left as it is, as judging it
                 // would (without geomorphs nothing blends back).
-                for &k in pairs.iter().filter(|&&k| !kept[k]) {
+                let mut judged = 0;
+                for j in 0..pairs.len() {
+                    let k = pairs[j];
+                    splitting[judged] = k;
+                    judged += usize::from(!kept[k]);
+                }
+                for &k in &splitting[..judged] {
                     self.decide_pair(
                         h,
                         view,
@@ -790,13 +808,21 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             if self.v.flags[i] & COLLAPSING != 0 {
                 // Wanted again: reverse the collapse's blend; no split this frame.
                 self.start_blend(h, i, false);
-            } else if self
-                .candidates
-                .heap_push((d.error.to_bits(), node))
-                .is_err()
-            {
-                frame.stats.queue_overflow = true;
+            } else {
+                self.want_split(node, d, frame);
             }
+        }
+    }
+
+    /// Puts `node`, whose demand `d` is over the threshold, in the split heap.
+    #[inline(always)]
+    fn want_split(&mut self, node: u32, d: Demand, frame: &mut Frame) {
+        if self
+            .candidates
+            .heap_push((d.error.to_bits(), node))
+            .is_err()
+        {
+            frame.stats.queue_overflow = true;
         }
     }
 
