@@ -1,5 +1,7 @@
 //! Edge collapses: Hoppe's legality test (`ecol_legal`) and the collapse itself (`apply_ecol`).
 
+use core::hint::select_unpredictable;
+
 use super::fan::PairFans;
 use super::slot::SlotIndex;
 use super::{corner, next3, prev3, Cut, Refused, BLOCKED, NIL, SETTLED};
@@ -135,11 +137,10 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         self.v.degree[a as usize] = self.v.degree[a as usize].saturating_add(db);
         self.v.degree[b as usize] = 0;
         for &f in fan_b {
-            if f == fl || f == fr {
-                continue;
-            }
+            // (The removed two keep `b`: written back, not skipped by a branch.)
             if let Some(k) = self.t.corner_of(f, b) {
-                self.t.set_corner(f, k, a);
+                let kept = (f == fl) | (f == fr);
+                self.t.set_corner(f, k, select_unpredictable(kept, b, a));
             }
         }
         // The neighbours of each removed triangle become each other's: a new neighbour may be
@@ -151,8 +152,11 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 continue;
             };
             let adj = self.t.adj(f);
-            // The third corner w and the neighbours across its two edges.
-            let j = (0..3).find(|&j| t[j] != a && t[j] != b).unwrap_or(0);
+            // The third corner w (the first neither end, computed: which one follows no pattern
+            // a branch predictor learns) and the neighbours across its two edges.
+            let other = t.map(|v| (v != a) & (v != b));
+            let j = usize::from(!other[0]) << usize::from(!other[1]);
+            let j = if other[j] { j } else { 0 };
             let w = t[j];
             let (x, y) = (adj[j], adj[prev3(j)]);
             for (p, q) in [(x, y), (y, x)] {
@@ -160,11 +164,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                     continue;
                 }
                 self.unblock_pair_of(h, p, fans);
-                for k in 0..3 {
-                    if self.t.adj(p)[k] == f {
-                        self.t.set_adj(p, k, q);
-                    }
-                }
+                self.t.replace_adj(p, f, q);
             }
             let keep = if x != NIL { x } else { y };
             let fw = self.v.fan(w as usize);
@@ -214,11 +214,9 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         // While the pair is active its children are corners of the triangles it made.
         let (mut a, mut b) = (NIL, NIL);
         for v in self.t.at(f) {
-            match self.v.node.get(v as usize) {
-                Some(&n) if n == c0 => a = v,
-                Some(&n) if n == c1 => b = v,
-                _ => {}
-            }
+            let n = self.v.node.get(v as usize).copied().unwrap_or(NONE);
+            a = select_unpredictable(n == c0, v, a);
+            b = select_unpredictable(n == c1, v, b);
         }
         let (Some(fa), Some(fb)) = (self.v.flags.get(a as usize), self.v.flags.get(b as usize))
         else {

@@ -75,6 +75,7 @@
 //! ```
 
 use core::fmt;
+use core::hint::select_unpredictable;
 
 use crate::format::{HierarchyView, Record, NONE};
 use crate::nodemap::NodeMap;
@@ -620,16 +621,12 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 if g == NIL || g >= self.t.len() as u32 {
                     continue;
                 }
-                for k in 0..3 {
-                    if self.t.adj(g)[k] == last {
-                        self.t.set_adj(g, k, f);
-                    }
-                }
+                self.t.replace_adj(g, last, f);
             }
             for v in t {
-                if self.v.fan(v as usize) == last {
-                    self.v.set_fan(v as usize, f);
-                }
+                let fan = self.v.fan(v as usize);
+                self.v
+                    .set_fan(v as usize, select_unpredictable(fan == last, f, fan));
             }
             self.t.copy(last, f);
         }

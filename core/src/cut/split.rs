@@ -1,6 +1,8 @@
 //! Vertex splits: Hoppe's legality test (`vspl_legal`), the split itself (`apply_vspl`), and
 //! forced splits (`force_vsplit`; the merge-tree paper's forced refinement, §3.6).
 
+use core::hint::select_unpredictable;
+
 use super::fan::{holds, Fan};
 use super::slot::SlotIndex;
 use super::{next3, Cut, Refused, NIL};
@@ -69,11 +71,11 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         }
         let mut ns = [NIL; 4];
         for &f in &fan {
+            // (Picked without a branch: which triangle is which neighbour follows no pattern
+            // a branch predictor learns.)
             let id = self.t.id[f as usize];
             for k in 0..4 {
-                if n[k] == id {
-                    ns[k] = f;
-                }
+                ns[k] = select_unpredictable(n[k] == id, f, ns[k]);
             }
         }
         for k in 0..4 {
@@ -149,7 +151,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             }
         }
         let moves = |f: u32| f != NIL && holds(moved, f);
-        if moves(ns[1]) || moves(ns[2]) {
+        if moves(ns[1]) | moves(ns[2]) {
             return Err(Refused::Inconsistent);
         }
         Ok(SplitPlan {

@@ -15,6 +15,8 @@
 use super::expiry::{lives, Mark, TURNING};
 use super::renumber::scatter;
 use super::slot::{load3, store3, SlotIndex};
+use core::hint::select_unpredictable;
+
 use super::{prev3, BLENDING, COLLAPSING, NIL, RESTLESS, SETTLED};
 use crate::format::Digest;
 
@@ -361,6 +363,17 @@ impl<const F: usize, I: SlotIndex> Triangles<F, I> {
     #[inline(always)]
     pub fn set_adj(&mut self, f: u32, k: usize, g: u32) {
         self.adj[f as usize][k] = I::store(g);
+    }
+
+    /// Makes triangle `f` (in range) name `to` wherever it names neighbour `from`: all three
+    /// written, picked without branches (which edge it is follows no pattern a branch
+    /// predictor learns).
+    #[inline(always)]
+    pub fn replace_adj(&mut self, f: u32, from: u32, to: u32) {
+        let (from, to) = (I::store(from), I::store(to));
+        for g in &mut self.adj[f as usize] {
+            *g = select_unpredictable(*g == from, to, *g);
+        }
     }
 
     /// Appends a triangle; its slot, or `None` when full.
