@@ -701,8 +701,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 // A pair whose parent was just proven wanted is left as it is, as judging it
                 // would (without geomorphs nothing blends back).
                 let mut judged = 0;
-                for j in 0..pairs.len() {
-                    let k = pairs[j];
+                for &k in pairs {
                     splitting[judged] = k;
                     judged += usize::from(!kept[k]);
                 }
