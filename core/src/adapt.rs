@@ -699,7 +699,8 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                     self.want_split(self.v.node[listed[k]], demands[k], frame);
                 }
                 // A pair whose parent was just proven wanted is left as it is, as judging it
-                // would (without geomorphs nothing blends back).
+                // would (without geomorphs nothing blends back). The others are listed in the
+                // splitting list's room, which has served.
                 let mut judged = 0;
                 for &k in pairs {
                     splitting[judged] = k;

@@ -173,8 +173,9 @@ impl Settling {
     /// the last steps, settled when that is at least one frame.
     #[inline(always)]
     pub fn mark(&self, (margin, turned): (f32, f32)) -> Mark {
-        // Both counts' expiries are computed and the mark picked from them, without a branch
-        // on which: that follows no pattern a branch predictor learns.
+        // Both counts' expiries are computed first, so that picking one is a choice between
+        // values, not a branch around work (which it is follows no pattern a branch predictor
+        // learns).
         let reach = CAP as f32 * QUANTA_PER_TURN.recip();
         let frames = |m: f32, cap: f32, step: f32| {
             let frames = m.min(cap) / step;

@@ -12,11 +12,11 @@
 //! triangle record is 16 bytes: three corner slots, the three neighbouring triangles' slots
 //! (across edges `t[k] -> t[k + 1]`) and its id in the hierarchy's numbering.
 
+use core::hint::select_unpredictable;
+
 use super::expiry::{lives, Mark, TURNING};
 use super::renumber::scatter;
 use super::slot::{load3, store3, SlotIndex};
-use core::hint::select_unpredictable;
-
 use super::{BLENDING, COLLAPSING, NIL, RESTLESS, SETTLED};
 use crate::format::Digest;
 
