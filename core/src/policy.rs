@@ -709,8 +709,8 @@ pub struct MergeTree {
 impl Policy for MergeTree {
     #[inline(always)]
     fn demand(&self, b: &Bounds, view: &View) -> Demand {
-        // Both tests are made for every sphere and the answer picked without a branch: which
-        // spheres are in view and near follows no pattern a branch predictor learns.
+        // Both tests are made for every sphere and the answer picked, not returned early:
+        // which spheres are in view and near follows no pattern a branch predictor learns.
         let visible = view.sphere_visible(b.center, b.radius);
         let r = sub(b.center, view.eye);
         let gap = (libm::sqrtf(dot(r, r)) - b.radius).max(0.0);

@@ -4,7 +4,7 @@ use core::hint::select_unpredictable;
 
 use super::fan::PairFans;
 use super::slot::SlotIndex;
-use super::{corner, next3, prev3, Cut, Refused, BLOCKED, NIL, SETTLED};
+use super::{corner, first_of, next3, prev3, Cut, Refused, BLOCKED, NIL, SETTLED};
 use crate::format::{HierarchyView, SplitView, NONE};
 
 /// The slots of a legal collapse: the two children `a` and `b`, and the triangles it removes
@@ -152,11 +152,8 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 continue;
             };
             let adj = self.t.adj(f);
-            // The third corner w (the first neither end, computed: which one follows no pattern
-            // a branch predictor learns) and the neighbours across its two edges.
-            let other = t.map(|v| (v != a) & (v != b));
-            let j = usize::from(!other[0]) << usize::from(!other[1]);
-            let j = if other[j] { j } else { 0 };
+            // The third corner w and the neighbours across its two edges.
+            let j = first_of(|k| (t[k] != a) & (t[k] != b)).unwrap_or(0);
             let w = t[j];
             let (x, y) = (adj[j], adj[prev3(j)]);
             for (p, q) in [(x, y), (y, x)] {

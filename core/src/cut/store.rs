@@ -17,8 +17,15 @@ use core::hint::select_unpredictable;
 use super::expiry::{lives, Mark, TURNING};
 use super::renumber::scatter;
 use super::slot::{load3, store3, SlotIndex};
-use super::{BLENDING, COLLAPSING, NIL, RESTLESS, SETTLED};
+use super::{first_of, BLENDING, COLLAPSING, NIL, RESTLESS, SETTLED};
 use crate::format::Digest;
+
+/// `a[k]` (`k < 3`), picked in registers: the three are loaded before `k` is known, so that
+/// their load does not wait for it.
+#[inline(always)]
+fn pick<T: Copy>([a0, a1, a2]: [T; 3], k: usize) -> T {
+    select_unpredictable(k == 0, a0, select_unpredictable(k == 1, a1, a2))
+}
 
 /// The vertex records.
 #[derive(Clone, Debug)]
@@ -330,16 +337,12 @@ impl<const F: usize, I: SlotIndex> Triangles<F, I> {
 
     /// Which corner of triangle `f` is vertex slot `v` (`None` when `f` is out of range or `v`
     /// is not a corner; `v` a vertex slot or `NIL`; the first when it is several): compared in
-    /// the stored form, so nothing is widened. Which corner it is follows no pattern a branch
-    /// predictor learns (a third each), so the index is computed, not searched: fan walks ask
-    /// this at every step.
+    /// the stored form, so nothing is widened, and computed ([`first_of`]).
     #[inline(always)]
     pub fn corner_of(&self, f: u32, v: u32) -> Option<usize> {
         let t = self.corners[..self.len as usize].get(f as usize)?;
         let v = I::store(v);
-        // 0 when the first is `v`, else 1 when the second is, else 2 (if that one is).
-        let k = usize::from(t[0] != v) << usize::from(t[1] != v);
-        (t[k] == v).then_some(k)
+        first_of(|k| t[k] == v)
     }
 
     /// Corner `k` of triangle `f` alone (`f` in range).
@@ -409,20 +412,18 @@ impl<const F: usize, I: SlotIndex> Triangles<F, I> {
     /// for the corner the comparisons give.
     #[inline]
     pub fn ccw(&self, f: u32, v: u32) -> Option<u32> {
-        let [a0, a1, a2] = *self.adj.get(f as usize)?;
+        let adj = *self.adj.get(f as usize)?;
         let k = self.corner_of(f, v)?;
-        // `adj[prev3(k)]`, picked in registers.
-        let a = select_unpredictable(k == 0, a2, select_unpredictable(k == 1, a0, a1));
-        Some(a.load())
+        // `adj[prev3(k)]`.
+        Some(pick([adj[2], adj[0], adj[1]], k).load())
     }
 
     /// The triangle before `f` going counter-clockwise around `v` (as [`Triangles::ccw`]).
     #[inline]
     pub fn cw(&self, f: u32, v: u32) -> Option<u32> {
-        let [a0, a1, a2] = *self.adj.get(f as usize)?;
+        let adj = *self.adj.get(f as usize)?;
         let k = self.corner_of(f, v)?;
-        let a = select_unpredictable(k == 0, a0, select_unpredictable(k == 1, a1, a2));
-        Some(a.load())
+        Some(pick(adj, k).load())
     }
 
     /// Exchanges records `f` and `g` (both in range), references to them unchanged.
