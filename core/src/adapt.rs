@@ -11,8 +11,8 @@
 //! 1. **coarsen**: sibling pairs whose parent the policy no longer needs are collapsed where
 //!    Hoppe's condition allows; a collapse lists the pair it makes and the pairs whose illegal
 //!    mark it cleared (those whose triangles it gave a new neighbour), so when no budget, queue
-//!    or operation cap binds, one call reaches the cut the view asks for and a second call with the same view does nothing (a test over
-//!    the peer orbit at 0.25-4 px);
+//!    or operation cap binds, one call reaches the cut the view asks for and a second call with
+//!    the same view does nothing (a test over the peer orbit at 0.25-4 px);
 //! 2. **refine**: vertices over tolerance are split largest error first (a priority queue), each
 //!    forcing the splits it depends on, and their children join the queue (when nothing can stop
 //!    refinement part way and the order cannot change the cut, the children go next, depth
