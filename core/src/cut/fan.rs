@@ -25,6 +25,20 @@ pub(crate) fn holds(fan: &[u32], f: u32) -> bool {
 /// vector (making one writes no memory; an arena would zero its 4 KiB each time).
 pub(crate) type Fan = heapless::Vec<u32, MAX_FAN>;
 
+/// One triangle of a [`Ring`]: its slot, and which of its corners the vertex is.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Around {
+    pub slot: u32,
+    pub corner: u8,
+}
+
+/// A vertex's triangles in counter-clockwise order, each with the corner the vertex takes in
+/// it: what a split reads its neighbours, its wings and the triangles that move to its second
+/// child from, in one walk. On a border the order runs from the triangle after the border to
+/// the one before it; otherwise it is cyclic and starts anywhere. (One vector: a struct of two
+/// would be made with a `memset` of the first's 4 KiB, its two lengths being one aggregate.)
+pub(crate) type Ring = heapless::Vec<Around, MAX_FAN>;
+
 /// Most pairs one collapse unblocks: those that made the four triangles next to the two it
 /// removes.
 pub(crate) const MAX_UNBLOCKED: usize = 4;
@@ -105,6 +119,56 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             };
         }
         out.len() == degree
+    }
+
+    /// [`Cut::complete_fan`] in counter-clockwise order with each triangle's corner (see
+    /// [`Ring`]): the same walks, the same checks, the border fan's clockwise half put first.
+    /// Whether the fan closes (then the order is cyclic), or `None` when it is not whole.
+    pub(crate) fn ring(&self, v: u32, out: &mut Ring) -> Option<bool> {
+        out.clear();
+        if v as usize >= self.v.len() {
+            return None;
+        }
+        let start = self.v.fan(v as usize);
+        let degree = self.v.degree[v as usize] as usize;
+        if start == NIL {
+            return (degree == 0).then_some(false);
+        }
+        let mut f = start;
+        loop {
+            let Some((k, g)) = self.t.ccw_at(f, v) else {
+                return None;
+            };
+            let corner = k as u8;
+            if out.push(Around { slot: f, corner }).is_err() {
+                return None;
+            }
+            match g {
+                g if g == start => return (out.len() == degree).then_some(true),
+                NIL => break,
+                g => f = g,
+            }
+        }
+        // A border: the rest lies clockwise of the start, and must not meet the first half.
+        let ccw_part = out.len();
+        let Some((_, mut g)) = self.t.cw_at(start, v) else {
+            return None;
+        };
+        while g != NIL {
+            let Some((k, next)) = self.t.cw_at(g, v) else {
+                return None;
+            };
+            let corner = k as u8;
+            let met = out[..ccw_part].iter().any(|a| a.slot == g);
+            if met || out.push(Around { slot: g, corner }).is_err() {
+                return None;
+            }
+            g = next;
+        }
+        // Counter-clockwise: the clockwise half reversed, then the first.
+        out[ccw_part..].reverse();
+        out.rotate_left(ccw_part);
+        (out.len() == degree).then_some(false)
     }
 
     /// Calls `visit` with each triangle around slot `v`, walking at most as many steps as the

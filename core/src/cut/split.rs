@@ -3,9 +3,9 @@
 
 use core::hint::select_unpredictable;
 
-use super::fan::{holds, Fan};
+use super::fan::Ring;
 use super::slot::SlotIndex;
-use super::{next3, Cut, Refused, NIL};
+use super::{next3, prev3, Cut, Refused, NIL};
 use crate::format::{HierarchyView, Record, NONE};
 
 /// A split done: its children's ids, slots and records.
@@ -20,43 +20,42 @@ pub(crate) struct Split {
 pub(crate) struct SplitPlan {
     /// The parent's slot (it becomes the first child's).
     parent: u32,
-    /// The neighbour triangles' slots (`fn0..fn3`, `NIL` where the file has none).
+    /// The neighbour triangles' slots (`fn0..fn3`, `NIL` where the file has none) and the
+    /// parent's corner in each.
     neighbours: [u32; 4],
+    corners: [u8; 4],
     /// The children's node ids and the ids of the triangles the split adds.
     children: [u32; 2],
     faces: [u32; 2],
     /// The wing vertices' slots (the second `NIL` on a border).
     wings: [u32; 2],
+    /// The triangles that move to the second child: `count` entries of the parent's [`Ring`]
+    /// from entry `from` on, wrapping round its end.
+    from: usize,
+    count: usize,
 }
+
+/// No entry of a [`Ring`].
+const NOWHERE: usize = usize::MAX;
 
 impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, I> {
     /// Splits active `node` if legal now. On success returns the children's slots.
     pub fn split(&mut self, h: &HierarchyView<'_>, node: u32) -> Result<[u32; 2], Refused> {
-        let mut moved = Fan::new();
-        let plan = self.split_legal(h, node, &mut moved)?;
-        Ok(self.apply_split(h, node, &plan, &moved, 0).0)
-    }
-
-    /// Proves the split of `node` legal: it is active, its neighbour triangles are all around
-    /// it and meet along the edges the new triangles take over, and there is room. Collects the
-    /// triangles that move to the second child into `moved`.
-    pub(crate) fn split_legal(
-        &self,
-        h: &HierarchyView<'_>,
-        node: u32,
-        moved: &mut Fan,
-    ) -> Result<SplitPlan, Refused> {
         let ps = self.slot(node).ok_or(Refused::NotActive)?;
-        self.split_legal_at(h, node, ps, moved)
+        let mut ring = Ring::new();
+        let plan = self.split_legal_at(h, node, ps, &mut ring)?;
+        Ok(self.apply_split(h, node, &plan, &ring, 0).0)
     }
 
-    /// [`Cut::split_legal`] of the node at slot `ps`.
+    /// Proves the split of `node`, active at slot `ps`, legal: its neighbour triangles are all
+    /// around it and meet along the edges the new triangles take over, and there is room. Leaves
+    /// the parent's triangles in `ring`; the plan says which of them move to the second child.
     fn split_legal_at(
         &self,
         h: &HierarchyView<'_>,
         node: u32,
         ps: u32,
-        moved: &mut Fan,
+        ring: &mut Ring,
     ) -> Result<SplitPlan, Refused> {
         let s = h.split(node);
         if s.children[0] == NONE {
@@ -65,21 +64,18 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         let n = s.neighbours;
         let second = s.second();
         // The neighbour triangles must all be around the vertex (whose fan must be whole).
-        let mut fan = Fan::new();
-        if !self.complete_fan(ps, &mut fan) {
-            return Err(Refused::Inconsistent);
-        }
-        let mut ns = [NIL; 4];
-        for &f in &fan {
+        let closed = self.ring(ps, ring).ok_or(Refused::Inconsistent)?;
+        let mut at = [NOWHERE; 4];
+        for (i, a) in ring.iter().enumerate() {
             // (Picked without a branch: which triangle is which neighbour follows no pattern
             // a branch predictor learns.)
-            let id = self.t.id[f as usize];
+            let id = self.t.id[a.slot as usize];
             for k in 0..4 {
-                ns[k] = select_unpredictable(n[k] == id, f, ns[k]);
+                at[k] = select_unpredictable(n[k] == id, i, at[k]);
             }
         }
         for k in 0..4 {
-            if n[k] != NONE && ns[k] == NIL {
+            if n[k] != NONE && at[k] == NOWHERE {
                 return Err(Refused::Missing(n[k]));
             }
         }
@@ -87,99 +83,94 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         if self.v.is_full() || self.v.len() >= self.map.capacity() || self.t.len() + added > F {
             return Err(Refused::Capacity);
         }
+        let present = at.map(|i| i != NOWHERE);
+        let ns = at.map(|i| ring.get(i).map_or(NIL, |a| a.slot));
+        let nc = at.map(|i| ring.get(i).map_or(0, |a| a.corner));
+        // Corner `k` of neighbour `j`, the parent's plus `offset`.
+        let beside =
+            |j: usize, offset: usize| self.t.corner_at(ns[j], (nc[j] as usize + offset) % 3);
 
         // Wings, read off the neighbours (the nodes there now may be finer than at formation).
-        let third = |f: u32, v: u32, offset: usize| -> Option<u32> {
-            let k = self.t.corner_of(f, v)?;
-            Some(self.t.corner_at(f, (k + offset) % 3))
-        };
         // n1 holds c0 -> wl, n2 holds wr -> c0: both still have the parent's slot as c0.
-        let wl = if ns[1] != NIL {
-            third(ns[1], ps, 1)
-        } else {
-            third(ns[0], ps, 2)
-        }
-        .ok_or(Refused::Inconsistent)?;
-        let wr = if !second {
-            NIL
-        } else if ns[2] != NIL {
-            third(ns[2], ps, 2).ok_or(Refused::Inconsistent)?
-        } else {
-            third(ns[3], ps, 1).ok_or(Refused::Inconsistent)?
+        let wl = match present {
+            [_, true, _, _] => beside(1, 1),
+            [true, ..] => beside(0, 2),
+            _ => return Err(Refused::Inconsistent),
+        };
+        let wr = match present {
+            _ if !second => NIL,
+            [_, _, true, _] => beside(2, 2),
+            [.., true] => beside(3, 1),
+            _ => return Err(Refused::Inconsistent),
         };
         // Each neighbour pair must meet along the edge the new triangle will take over
-        // (n0: wl -> p, n1: p -> wl, n2: wr -> p, n3: p -> wr), so the new links are mutual.
-        let across = |f: u32, a: u32, b: u32| -> Option<u32> {
-            let k = self.t.corner_of(f, a)?;
-            (self.t.corner_at(f, next3(k)) == b).then(|| self.t.adj_at(f, k))
-        };
-        let pairs_meet = |x: u32, y: u32, w: u32| -> bool {
-            // x holds w -> p, y holds p -> w; across each lies the other (or a border).
-            let xy = x == NIL || across(x, w, ps) == Some(y);
-            let yx = y == NIL || across(y, ps, w) == Some(x);
+        // (n0: wl -> p, n1: p -> wl, n2: wr -> p, n3: p -> wr), so the new links are mutual:
+        // across each lies the other (or a border).
+        let meet = |into: usize, out: usize, w: u32| -> bool {
+            let (x, y) = (ns[into], ns[out]);
+            let (kx, ky) = (nc[into] as usize, nc[out] as usize);
+            let xy = !present[into]
+                || (self.t.corner_at(x, prev3(kx)) == w && self.t.adj_at(x, prev3(kx)) == y);
+            let yx =
+                !present[out] || (self.t.corner_at(y, next3(ky)) == w && self.t.adj_at(y, ky) == x);
             xy && yx
         };
-        if !pairs_meet(ns[0], ns[1], wl) || (second && !pairs_meet(ns[2], ns[3], wr)) {
+        if !meet(0, 1, wl) || (second && !meet(2, 3, wr)) {
             return Err(Refused::Inconsistent);
         }
-        // The triangles that go to c1: counter-clockwise from n3 to n0, or up to a border and
-        // then clockwise from n0 to the other border.
-        moved.clear();
-        let mut reached = false;
-        if ns[3] != NIL {
-            let mut f = ns[3];
-            while f != NIL {
-                moved.push(f).map_err(|_| Refused::Inconsistent)?;
-                if f == ns[0] {
-                    reached = true;
-                    break;
-                }
-                f = self.ccw(f, ps).ok_or(Refused::Inconsistent)?;
-                if f == ns[3] {
-                    return Err(Refused::Inconsistent);
-                }
-            }
-        }
-        if !reached && ns[0] != NIL {
-            let mut f = ns[0];
-            while f != NIL {
-                if holds(moved, f) {
-                    return Err(Refused::Inconsistent);
-                }
-                moved.push(f).map_err(|_| Refused::Inconsistent)?;
-                f = self.cw(f, ps).ok_or(Refused::Inconsistent)?;
-            }
-        }
-        let moves = |f: u32| f != NIL && holds(moved, f);
-        if moves(ns[1]) | moves(ns[2]) {
+        // The triangles that go to c1: counter-clockwise from n3 to n0, through the border if
+        // the fan has one; from the border to n0, or from n3 to the border, when one of them
+        // is missing (on a closed fan, a contradiction).
+        let len = ring.len();
+        let (from, count) = match (present[3], present[0]) {
+            (true, true) if at[3] <= at[0] => (at[3], at[0] - at[3] + 1),
+            (true, true) => (at[3], len - at[3] + at[0] + 1),
+            (true, false) if !closed => (at[3], len - at[3]),
+            (false, true) if !closed => (0, at[0] + 1),
+            (false, false) => (0, 0),
+            _ => return Err(Refused::Inconsistent),
+        };
+        let moves = |j: usize| {
+            let i = at[j];
+            let d = if i >= from { i - from } else { i + len - from };
+            present[j] && d < count
+        };
+        if moves(1) | moves(2) {
             return Err(Refused::Inconsistent);
         }
         Ok(SplitPlan {
             parent: ps,
             neighbours: ns,
+            corners: nc,
             children: s.children,
             faces: s.faces,
             wings: [wl, wr],
+            from,
+            count,
         })
     }
 
-    /// Performs a split [`Cut::split_legal`] approved; with `frames > 0` the children start at
-    /// the parent's current (blended) position, normal and colour and blend to their own over
-    /// that many frames. Returns the children's slots and records.
+    /// Performs a split [`Cut::split_legal_at`] approved, with the parent's triangles it left
+    /// in `ring`; with `frames > 0` the children start at the parent's current (blended)
+    /// position, normal and colour and blend to their own over that many frames. Returns the
+    /// children's slots and records.
     pub(crate) fn apply_split(
         &mut self,
         h: &HierarchyView<'_>,
         node: u32,
         plan: &SplitPlan,
-        moved: &Fan,
+        ring: &Ring,
         frames: u16,
     ) -> ([u32; 2], [Record; 2]) {
         let SplitPlan {
             parent: ps,
             neighbours: ns,
+            corners: nc,
             children: [c0, c1],
             faces,
             wings: [wl, wr],
+            from,
+            count,
         } = *plan;
         let second = wr != NIL;
         let start = (frames > 0 && self.blends.len() + 2 <= Q).then(|| self.vertex(h, ps as usize));
@@ -187,7 +178,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         // because the first replaces the parent's entry.
         self.reassign(ps as usize, c0);
         let Some(c1s) = self.push_vertex(c1) else {
-            // `split_legal` proved room in the vertex arena and the node map, so this cannot
+            // `split_legal_at` proved room in the vertex arena and the node map, so this cannot
             // happen; should it, the parent comes back rather than the cut breaking.
             debug_assert!(false, "room for a split's second child was proven");
             self.rename_vertex(h, ps as usize, node);
@@ -200,13 +191,17 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             self.start_blend_from(ps as usize, &from, frames, false);
             self.start_blend_from(c1s as usize, &from, frames, false);
         }
-        for &f in moved {
-            if let Some(k) = self.t.corner_of(f, ps) {
-                self.t.set_corner(f, k, c1s);
-            }
+        // The moved entries: from `from` to the ring's end, then from its start.
+        let (head, tail) = ring.split_at(from.min(ring.len()));
+        let wrapped = (from + count).saturating_sub(ring.len()).min(head.len());
+        for a in &tail[..count.min(tail.len())] {
+            self.t.set_corner(a.slot, a.corner as usize, c1s);
+        }
+        for a in &head[..wrapped] {
+            self.t.set_corner(a.slot, a.corner as usize, c1s);
         }
         let added = 1 + second as u16;
-        let m = moved.len() as u16;
+        let m = count as u16;
         let d = self.v.degree[ps as usize];
         self.v.degree[ps as usize] = d.saturating_sub(m).saturating_add(added);
         self.v.degree[c1s as usize] = m.saturating_add(added);
@@ -217,29 +212,26 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         }
         let fl = self.t.len() as u32;
         let fr = if second { fl + 1 } else { NIL };
-        // `split_legal` proved room for both.
+        // `split_legal_at` proved room for both.
         let first = self.t.push([ps, c1s, wl], [fr, ns[0], ns[1]], faces[0]);
         debug_assert_eq!(first, Some(fl), "room for a split's triangles was proven");
         if second {
             let pushed = self.t.push([c1s, ps, wr], [fl, ns[2], ns[3]], faces[1]);
             debug_assert_eq!(pushed, Some(fr), "room for a split's triangles was proven");
         }
-        self.point_edge(ns[0], wl, c1s, fl);
-        self.point_edge(ns[1], ps, wl, fl);
-        self.point_edge(ns[2], wr, ps, fr);
-        self.point_edge(ns[3], c1s, wr, fr);
+        // The edges `split_legal_at` proved: n0's wl -> c1 and n2's wr -> c0 end at the
+        // parent's corner, n1's c0 -> wl and n3's c1 -> wr start there.
+        let to = [fl, fl, fr, fr];
+        for j in 0..4 {
+            if ns[j] != NIL {
+                let k = nc[j] as usize;
+                let edge = if j % 2 == 0 { prev3(k) } else { k };
+                self.t.set_adj(ns[j], edge, to[j]);
+            }
+        }
         self.v.set_fan(ps as usize, fl);
         self.v.set_fan(c1s as usize, fl);
         ([ps, c1s], records)
-    }
-
-    /// Points the edge `a -> b` of triangle `f` (if `f` is a triangle with that edge) at `to`.
-    fn point_edge(&mut self, f: u32, a: u32, b: u32, to: u32) {
-        if let Some(k) = self.t.corner_of(f, a) {
-            if self.t.corner_at(f, next3(k)) == b {
-                self.t.set_adj(f, k, to);
-            }
-        }
     }
 
     /// Splits active `node`, first splitting whatever its split needs (Hoppe's forced split; the
@@ -271,7 +263,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         self.stack.clear();
         self.stack.push(node).map_err(|_| Refused::Capacity)?;
         let mut done = 0;
-        let mut moved = Fan::new();
+        let mut ring = Ring::new();
         // The slot of the node on top of the stack, when known.
         let mut known = Some(slot);
         // Each round splits once or pushes a coarser node; bounded for crafted files.
@@ -311,11 +303,11 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 }
                 continue;
             };
-            match self.split_legal_at(h, v, vs, &mut moved) {
+            match self.split_legal_at(h, v, vs, &mut ring) {
                 Ok(plan) => {
                     let added = if plan.wings[1] != NIL { 2 } else { 1 };
                     allow(v, added)?;
-                    let (slots, records) = self.apply_split(h, v, &plan, &moved, frames);
+                    let (slots, records) = self.apply_split(h, v, &plan, &ring, frames);
                     split(Split {
                         children: plan.children,
                         slots,

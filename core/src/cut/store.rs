@@ -412,18 +412,30 @@ impl<const F: usize, I: SlotIndex> Triangles<F, I> {
     /// for the corner the comparisons give.
     #[inline]
     pub fn ccw(&self, f: u32, v: u32) -> Option<u32> {
-        let adj = *self.adj.get(f as usize)?;
-        let k = self.corner_of(f, v)?;
-        // `adj[prev3(k)]`.
-        Some(pick([adj[2], adj[0], adj[1]], k).load())
+        self.ccw_at(f, v).map(|(_, g)| g)
     }
 
     /// The triangle before `f` going counter-clockwise around `v` (as [`Triangles::ccw`]).
     #[inline]
     pub fn cw(&self, f: u32, v: u32) -> Option<u32> {
+        self.cw_at(f, v).map(|(_, g)| g)
+    }
+
+    /// [`Triangles::ccw`], and the corner `v` takes in `f`.
+    #[inline(always)]
+    pub fn ccw_at(&self, f: u32, v: u32) -> Option<(usize, u32)> {
         let adj = *self.adj.get(f as usize)?;
         let k = self.corner_of(f, v)?;
-        Some(pick(adj, k).load())
+        // `adj[prev3(k)]`.
+        Some((k, pick([adj[2], adj[0], adj[1]], k).load()))
+    }
+
+    /// [`Triangles::cw`], and the corner `v` takes in `f`.
+    #[inline(always)]
+    pub fn cw_at(&self, f: u32, v: u32) -> Option<(usize, u32)> {
+        let adj = *self.adj.get(f as usize)?;
+        let k = self.corner_of(f, v)?;
+        Some((k, pick(adj, k).load()))
     }
 
     /// Exchanges records `f` and `g` (both in range), references to them unchanged.
