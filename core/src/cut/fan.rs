@@ -136,9 +136,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         }
         let mut f = start;
         loop {
-            let Some((k, g)) = self.t.ccw_at(f, v) else {
-                return None;
-            };
+            let (k, g) = self.t.ccw_at(f, v)?;
             let corner = k as u8;
             if out.push(Around { slot: f, corner }).is_err() {
                 return None;
@@ -151,13 +149,9 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         }
         // A border: the rest lies clockwise of the start, and must not meet the first half.
         let ccw_part = out.len();
-        let Some((_, mut g)) = self.t.cw_at(start, v) else {
-            return None;
-        };
+        let (_, mut g) = self.t.cw_at(start, v)?;
         while g != NIL {
-            let Some((k, next)) = self.t.cw_at(g, v) else {
-                return None;
-            };
+            let (k, next) = self.t.cw_at(g, v)?;
             let corner = k as u8;
             let met = out[..ccw_part].iter().any(|a| a.slot == g);
             if met || out.push(Around { slot: g, corner }).is_err() {
