@@ -146,6 +146,32 @@ impl<const M: usize, I: SlotIndex> NodeMap<M, I> {
         true
     }
 
+    /// [`NodeMap::insert`] of a key the map does not hold (a node just made active): the
+    /// first empty entry from its home takes it, no key compared on the way. Were the key
+    /// there after all, both entries would name slots holding it, and a lookup finds either.
+    #[inline]
+    pub fn insert_new(&mut self, slot: u32, nodes: &[u32]) -> bool {
+        let Some(&key) = nodes.get(slot as usize) else {
+            return false;
+        };
+        if (self.len() + 1) * 8 > self.span as usize * 7 {
+            return false;
+        }
+        let mut i = self.home(key);
+        for _ in 0..self.span {
+            match self.table.get_mut(i) {
+                Some(e) if e.load() == 0 => {
+                    *e = I::store(slot + 1);
+                    self.len += 1;
+                    return true;
+                }
+                Some(_) => i = self.next(i),
+                None => return false,
+            }
+        }
+        false
+    }
+
     /// Points `key`'s entry at `slot` (which will hold `key` from now on).
     pub fn repoint(&mut self, key: u32, slot: u32, nodes: &[u32]) {
         if let Some(Ok(i)) = self.find(key, nodes) {
@@ -211,7 +237,14 @@ mod tests {
             x ^= x << 5;
             let s = (x % 64) as usize;
             if x & 0x100 != 0 {
-                assert!(m.insert(s as u32, &sh.nodes));
+                // A key not held goes in by `insert_new` half the time (as the cut's new nodes).
+                let new = !sh.used[s] && x & 0x200 != 0;
+                let inserted = if new {
+                    m.insert_new(s as u32, &sh.nodes)
+                } else {
+                    m.insert(s as u32, &sh.nodes)
+                };
+                assert!(inserted);
                 sh.used[s] = true;
             } else {
                 m.remove(sh.nodes[s], &sh.nodes);

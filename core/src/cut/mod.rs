@@ -513,7 +513,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
     /// it.
     fn map_insert(&mut self, s: u32) -> bool {
         self.respan_map(self.v.len());
-        self.map.insert(s, self.v.nodes())
+        self.map.insert_new(s, self.v.nodes())
     }
 
     /// Rebuilds the node map over a span fit for `entries` active vertices, if it needs another.
@@ -560,7 +560,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         self.free_blend(s);
         self.v.node[s] = node;
         // The old entry was removed, so there is room.
-        self.map.insert(s as u32, self.v.nodes());
+        self.map.insert_new(s as u32, self.v.nodes());
         self.v.flags[s] &= VISIBLE | WAS_VISIBLE;
     }
 
