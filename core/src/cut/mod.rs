@@ -509,10 +509,13 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         self.v.set_mate(s, NIL);
     }
 
-    /// Inserts slot `s` into the node map, first re-spanning the map when the count calls for
-    /// it.
+    /// Inserts slot `s` (the last, just pushed) into the node map, which the map's rebuild does
+    /// when the count calls for another span.
     fn map_insert(&mut self, s: u32) -> bool {
-        self.respan_map(self.v.len());
+        if self.map.should_resize(self.v.len()) {
+            self.rebuild_map(self.v.len());
+            return self.slot(self.v.node[s as usize]) == Some(s);
+        }
         self.map.insert_new(s, self.v.nodes())
     }
 
