@@ -17,6 +17,17 @@ Arguments: the profile, the binary (built with line tables, e.g.
 optionally a divisor (frames), how many lines to print (40), and a function inlined into it
 (`force_split_at`) whose own lines to charge instead (the rest shows as `other`). Prints
 instructions per divisor, the share, and the source line.
+
+Options, anywhere among the arguments:
+
+- `--minus BASE` subtracts the counts of profile `BASE` (the same binary, e.g. the same flight
+  cut short) address by address: what the frames between the two cost, without the first frame
+  both share, e.g. `table1_adapt 400 0.4 100 FILE` minus `table1_adapt 400 0.4 0 FILE`, divided
+  by 100;
+- `--event K` reads the profile's K-th event instead of the first (with `--branch-sim=yes` the
+  events are `Ir Bc Bcm Bi Bim`: `--event 2` counts mispredicted conditional branches);
+- `--innermost` charges each instruction to the innermost line instead, as callgrind does, but
+  within the functions asked for and summed per line across them.
 """
 
 import collections
@@ -25,14 +36,17 @@ import subprocess
 import sys
 
 
-def costs(path, name):
-    """Instruction address -> cost, for the instructions of functions whose name holds `name`."""
+def costs(path, name, event=0):
+    """Instruction address -> cost of event `event`, for the instructions of functions whose name
+    holds `name`."""
     names = {}
     out = collections.Counter()
     current = None
     last = 0
     after_call = False
-    position = re.compile(r"^(0x[0-9a-f]+|\+\d+|-\d+|\*)(?:\s+\S+)?\s+(\d+)$")
+    # An instruction's address (absolute, relative to the last, or the same), its line (with
+    # `--dump-line=yes`, the default), then one count per event (trailing zeros left out).
+    position = re.compile(r"^(0x[0-9a-f]+|\+\d+|-\d+|\*)\s+\S+((?:\s+\d+)*)$")
     with open(path) as f:
         for line in f:
             line = line.rstrip("\n")
@@ -65,14 +79,16 @@ def costs(path, name):
             if after_call:
                 after_call = False
                 continue
-            if current and name in current:
-                out[address] += int(m.group(2))
+            counts = m.group(2).split()
+            if current and name in current and event < len(counts):
+                out[address] += int(counts[event])
     return out
 
 
-def outermost(binary, addresses, within=None):
+def outermost(binary, addresses, within=None, innermost=False):
     """Address -> the outermost `file:line` of its inlining chain, or with `within` the line of
-    the outermost frame whose function's name holds it (instructions outside it: `other`)."""
+    the outermost frame whose function's name holds it (instructions outside it: `other`), or
+    with `innermost` the innermost line."""
     query = "\n".join(f"0x{a:x}" for a in addresses)
     text = subprocess.run(
         ["addr2line", "-e", binary, "-i", "-f", "-C", "-a"],
@@ -92,26 +108,42 @@ def outermost(binary, addresses, within=None):
         elif address is not None and function is None:
             function = line
         elif address is not None:
-            if within is None or within in function:
+            if innermost:
+                out.setdefault(address, line.split(" ")[0])
+            elif within is None or within in function:
                 out[address] = line.split(" ")[0]
             function = None
     return out
 
 
 def main():
-    if len(sys.argv) < 4:
+    args, minus, event, innermost = [], None, 0, False
+    argv = iter(sys.argv[1:])
+    for a in argv:
+        if a == "--minus":
+            minus = next(argv, None)
+        elif a == "--event":
+            event = int(next(argv, "0"))
+        elif a == "--innermost":
+            innermost = True
+        else:
+            args.append(a)
+    if len(args) < 3:
         print(__doc__)
         sys.exit(2)
-    path, binary, name = sys.argv[1:4]
-    divisor = float(sys.argv[4]) if len(sys.argv) > 4 else 1.0
-    shown = int(sys.argv[5]) if len(sys.argv) > 5 else 40
-    within = sys.argv[6] if len(sys.argv) > 6 else None
-    cost = costs(path, name)
+    path, binary, name = args[:3]
+    divisor = float(args[3]) if len(args) > 3 else 1.0
+    shown = int(args[4]) if len(args) > 4 else 40
+    within = args[5] if len(args) > 5 else None
+    cost = costs(path, name, event)
+    if minus is not None:
+        cost.subtract(costs(minus, name, event))
     lines = collections.Counter()
-    for address, where in outermost(binary, sorted(cost), within).items():
+    for address, where in outermost(binary, sorted(cost), within, innermost).items():
         lines[where] += cost[address]
     total = sum(cost.values())
-    print(f"{total / divisor:.0f} instructions per divisor in functions matching {name!r}")
+    what = "instructions" if event == 0 else f"counts of event {event}"
+    print(f"{total / divisor:.0f} {what} per divisor in functions matching {name!r}")
     sources = {}
     for where, c in lines.most_common(shown):
         file, _, number = where.rpartition(":")
