@@ -13,14 +13,6 @@ use super::{Cut, NIL};
 /// rather than walked forever.
 pub const MAX_FAN: usize = 1024;
 
-/// Whether `fan` holds triangle `f`. A loop of our own, inlined where it is asked: the slice's
-/// `contains` is a call out of line, which costs more than the few triangles of a fan.
-#[inline(always)]
-#[allow(clippy::manual_contains)]
-pub(crate) fn holds(fan: &[u32], f: u32) -> bool {
-    fan.iter().any(|&g| g == f)
-}
-
 /// The triangle slots of one fan: scratch on the stack, never in the cut, so an uninitialised
 /// vector (making one writes no memory; an arena would zero its 4 KiB each time).
 pub(crate) type Fan = heapless::Vec<u32, MAX_FAN>;
@@ -77,54 +69,45 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
     }
 
     /// Collects `v`'s triangles into `out` and says whether the walk found every triangle that
-    /// uses `v`, each once. Each step of a walk is a function of the triangle it stands on, so a
-    /// walk that comes back to its start (or reaches a border) without exceeding [`MAX_FAN`]
-    /// steps repeats nothing; only the two halves of a border fan can overlap, which is checked,
-    /// and the count must match the vertex's triangle count.
+    /// uses `v`, each once. Out of line: inlined into a caller that makes `out` just for it,
+    /// it lets LLVM see the whole of a fresh vector's life, which it then zeroes (4 KiB).
+    #[inline(never)]
     pub(crate) fn complete_fan(&self, v: u32, out: &mut Fan) -> bool {
-        out.clear();
-        if v as usize >= self.v.len() {
-            return false;
-        }
-        let start = self.v.fan(v as usize);
-        let degree = self.v.degree[v as usize] as usize;
-        if start == NIL {
-            return degree == 0;
-        }
-        let mut f = start;
-        loop {
-            if out.push(f).is_err() {
-                return false;
-            }
-            match self.ccw(f, v) {
-                Some(g) if g == start => return out.len() == degree,
-                Some(NIL) => break,
-                Some(g) => f = g,
-                None => return false,
-            }
-        }
-        // A border: the rest lies clockwise of the start, and must not meet the first half.
-        let ccw_part = out.len();
-        let mut g = match self.cw(start, v) {
-            Some(g) => g,
-            None => return false,
-        };
-        while g != NIL {
-            if holds(&out[..ccw_part], g) || out.push(g).is_err() {
-                return false;
-            }
-            g = match self.cw(g, v) {
-                Some(g) => g,
-                None => return false,
-            };
-        }
-        out.len() == degree
+        self.walk_fan(v, out, |f, _| f, |&f| f).is_some()
     }
 
     /// [`Cut::complete_fan`] in counter-clockwise order with each triangle's corner (see
-    /// [`Ring`]): the same walks, the same checks, the border fan's clockwise half put first.
-    /// Whether the fan closes (then the order is cyclic), or `None` when it is not whole.
+    /// [`Ring`]): the border fan's clockwise half reversed and put first. Whether the fan closes
+    /// (then the order is cyclic), or `None` when it is not whole.
     pub(crate) fn ring(&self, v: u32, out: &mut Ring) -> Option<bool> {
+        let make = |slot, k: usize| Around {
+            slot,
+            corner: k as u8,
+        };
+        let (ccw_part, closed) = self.walk_fan(v, out, make, |a| a.slot)?;
+        if !closed {
+            out[ccw_part..].reverse();
+            out.rotate_left(ccw_part);
+        }
+        Some(closed)
+    }
+
+    /// Walks `v`'s fan into `out`, each triangle as `make(slot, v's corner in it)`:
+    /// counter-clockwise from the vertex's fan triangle, and at a border clockwise from it
+    /// (`slot` reads an entry's slot back). Each step of a walk is a function of the triangle
+    /// it stands on, so a walk that comes back to its start (or reaches a border) without
+    /// exceeding [`MAX_FAN`] steps repeats nothing; only the two halves of a border fan can
+    /// overlap, which is checked, and the count must match the vertex's triangle count. `None`
+    /// when the walk does not find every triangle that uses `v`, each once; else how many
+    /// entries the counter-clockwise walk made, and whether it came back to its start.
+    #[inline(always)]
+    fn walk_fan<T>(
+        &self,
+        v: u32,
+        out: &mut heapless::Vec<T, MAX_FAN>,
+        make: impl Fn(u32, usize) -> T,
+        slot: impl Fn(&T) -> u32,
+    ) -> Option<(usize, bool)> {
         out.clear();
         if v as usize >= self.v.len() {
             return None;
@@ -132,17 +115,16 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         let start = self.v.fan(v as usize);
         let degree = self.v.degree[v as usize] as usize;
         if start == NIL {
-            return (degree == 0).then_some(false);
+            return (degree == 0).then_some((0, false));
         }
         let mut f = start;
         loop {
             let (k, g) = self.t.ccw_at(f, v)?;
-            let corner = k as u8;
-            if out.push(Around { slot: f, corner }).is_err() {
+            if out.push(make(f, k)).is_err() {
                 return None;
             }
             match g {
-                g if g == start => return (out.len() == degree).then_some(true),
+                g if g == start => return (out.len() == degree).then_some((out.len(), true)),
                 NIL => break,
                 g => f = g,
             }
@@ -152,17 +134,13 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         let (_, mut g) = self.t.cw_at(start, v)?;
         while g != NIL {
             let (k, next) = self.t.cw_at(g, v)?;
-            let corner = k as u8;
-            let met = out[..ccw_part].iter().any(|a| a.slot == g);
-            if met || out.push(Around { slot: g, corner }).is_err() {
+            let met = out[..ccw_part].iter().any(|e| slot(e) == g);
+            if met || out.push(make(g, k)).is_err() {
                 return None;
             }
             g = next;
         }
-        // Counter-clockwise: the clockwise half reversed, then the first.
-        out[ccw_part..].reverse();
-        out.rotate_left(ccw_part);
-        (out.len() == degree).then_some(false)
+        (out.len() == degree).then_some((ccw_part, false))
     }
 
     /// Calls `visit` with each triangle around slot `v`, walking at most as many steps as the
