@@ -56,18 +56,6 @@ impl Default for PairFans {
 }
 
 impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, I> {
-    /// The triangle after `f` going counter-clockwise around vertex `v` (`NIL` at a border).
-    #[inline]
-    pub(crate) fn ccw(&self, f: u32, v: u32) -> Option<u32> {
-        self.t.ccw(f, v)
-    }
-
-    /// The triangle before `f` going counter-clockwise around `v` (`NIL` at a border).
-    #[inline]
-    pub(crate) fn cw(&self, f: u32, v: u32) -> Option<u32> {
-        self.t.cw(f, v)
-    }
-
     /// Collects `v`'s triangles into `out` and says whether the walk found every triangle that
     /// uses `v`, each once. Out of line: inlined into a caller that makes `out` just for it,
     /// it lets LLVM see the whole of a fresh vector's life, which it then zeroes (4 KiB).
@@ -171,20 +159,20 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 return Some(f);
             }
             left -= 1;
-            match self.ccw(f, v) {
+            match self.t.ccw(f, v) {
                 Some(g) if g == start => return None,
                 Some(g) if g != NIL => f = g,
                 _ => break,
             }
         }
         // A border: the rest lies clockwise of the start.
-        let mut g = self.cw(start, v).unwrap_or(NIL);
+        let mut g = self.t.cw(start, v).unwrap_or(NIL);
         while g != NIL && left > 0 {
             if wanted(g) {
                 return Some(g);
             }
             left -= 1;
-            g = self.cw(g, v).unwrap_or(NIL);
+            g = self.t.cw(g, v).unwrap_or(NIL);
         }
         None
     }
