@@ -122,6 +122,8 @@ const TURN: u32 = 4;
 /// After a frame that settled under an eighth of what it measured, every vertex measures one
 /// frame in this many.
 const SPARSE_TURN: u32 = 16;
+/// Fewer vertices measured than this in a frame do not make the next one sparse.
+const SPARSE_SAMPLE: u32 = 64;
 
 /// One frame's settling: the count, the margins' terms, and how to turn a margin into an
 /// expiry.
@@ -386,11 +388,15 @@ impl Motion {
             self.seen = SwayScale::ZERO;
             self.checked = true;
         }
-        let renew = if !continues || drifted.is_some() {
+        // A larger scale only makes the marks made under the smaller one expire sooner (their
+        // sway margins were counted at less than the count now spends on a sway): they hold.
+        // Under a smaller one they could outlive their margins.
+        let shrinks = drifted.is_some_and(|r| r < scale);
+        if let Some(r) = drifted {
+            self.scale_less_one = r - 1.0;
+        }
+        let renew = if !continues || shrinks {
             self.now = [0; 2];
-            if let Some(r) = drifted {
-                self.scale_less_one = r - 1.0;
-            }
             let q = model.1 / QUANTA_PER_RADIUS;
             // A degenerate model settles nothing (every margin is under an infinite quantum).
             self.quantum = if q > 0.0 && q.is_finite() {
@@ -408,6 +414,7 @@ impl Motion {
             } else {
                 turns
             };
+            let scale = self.scale_less_one + 1.0;
             let steps = [libm::ceilf(step(scale) / self.quantum), turns];
             let mut by = [0; 2];
             for k in 0..2 {
@@ -444,7 +451,9 @@ impl Motion {
             now: self.now,
             margins: Margins::new(view.eye, now, envelope, (t, slack), model, reach),
             renew,
-            step: if step > self.quantum {
+            // After a jump (or in the first frame) the step says nothing of the next one: each
+            // margin then settles its vertex for what it is worth, as under a still camera.
+            step: if continues && step > self.quantum {
                 step
             } else {
                 self.quantum
@@ -465,9 +474,13 @@ impl Motion {
     /// After a frame that measured the margins of `measured` vertices, settled `settled` of them
     /// and skipped `skipped`: when it settled under one in eight or skipped fewer than it
     /// measured (a camera that moves far each frame: measuring costs more than it saves), the
-    /// next frame measures every vertex only in its sparse turn.
+    /// next frame measures every vertex only in its sparse turn. Under [`SPARSE_SAMPLE`]
+    /// measured says nothing either way (a cut's first frame measures only its base mesh, whose
+    /// vertices all split): the next frame measures every vertex, or the cut would spend its
+    /// first frames asking every vertex while measuring a sixteenth of them a frame.
     pub fn tally(&mut self, measured: u32, settled: u32, skipped: u32) {
-        self.sparse = settled.saturating_mul(8) < measured || skipped < measured;
+        self.sparse = measured >= SPARSE_SAMPLE
+            && (settled.saturating_mul(8) < measured || skipped < measured);
     }
 
     /// Forgets the marks and the motion seen (a new hierarchy): the scale is checked again
@@ -652,29 +665,16 @@ mod tests {
         View::look_at(eye, [0.0; 3], [0.0, 1.0, 0.0], 1.0, 1.0, 480.0)
     }
 
-    #[test]
-    fn the_sway_scale_follows_the_camera_and_marks_still_expire_in_time() {
-        let mut m = Motion::ZERO;
-        let frame = |m: &mut Motion, f: u32| {
-            m.begin(&circling(f), Some(ENVELOPE), (1.0, 1.0), false, MODEL)
-                .expect("an envelope settles")
-        };
-        // Until the first check the scale is 1; at it the marks are forgotten and the scale
-        // becomes the measured ratio, about 2.
-        let mut f = 0;
-        while frame(&mut m, f).renew != Renew::Forget || f == 0 {
-            assert_eq!(m.scale_less_one + 1.0, 1.0);
-            f += 1;
-        }
-        assert_eq!(f, u32::from(SwayScale::FIRST));
-        let scale = m.scale_less_one + 1.0;
-        assert!((1.8..2.2).contains(&scale), "{scale}");
-        // A vertex whose answer holds while the planes sway less than `room` is marked with
-        // `room` counted at the scale; it stays settled no longer than the planes take to sway
-        // that far, but about twice as long as under a scale of 1.
-        let room = 2000.0;
-        f += 1;
-        let marked = frame(&mut m, f);
+    /// A vertex marked in `marked` whose answer holds while the planes sway less than `room`
+    /// (`room` counted at that frame's scale): flies on from frame `f` until the count passes
+    /// the mark, asserting that the planes have not swayed past `room` meanwhile and that no
+    /// frame forgets; the frames it stayed settled.
+    fn settled_frames(
+        frame: &mut impl FnMut(u32) -> Settling,
+        marked: &Settling,
+        mut f: u32,
+        room: f32,
+    ) -> u32 {
         let at = planes(&circling(f));
         let Mark::Settled(until) = marked.mark((
             Either {
@@ -689,18 +689,79 @@ mod tests {
         let mut settled = 0;
         loop {
             f += 1;
-            let s = frame(&mut m, f);
-            assert_ne!(s.renew, Renew::Forget);
+            let s = frame(f);
+            assert_ne!(s.renew, Renew::Forget, "frame {f}");
             if s.now[0] > until {
-                break;
+                return settled;
             }
             assert!(sway(&at, &planes(&circling(f)), MODEL) <= room, "frame {f}");
             settled += 1;
         }
+    }
+
+    #[test]
+    fn the_sway_scale_follows_the_camera_and_marks_still_expire_in_time() {
+        let mut m = Motion::ZERO;
+        let mut frame = |f: u32| {
+            m.begin(&circling(f), Some(ENVELOPE), (1.0, 1.0), false, MODEL)
+                .expect("an envelope settles")
+        };
+        // Until the first check the scale is 1; at it the scale becomes the measured ratio,
+        // about 2, and the marks made under 1 are kept (they only expire sooner).
+        assert_eq!(frame(0).renew, Renew::Forget);
+        let room = 2000.0;
+        let last = u32::from(SwayScale::FIRST) - 1;
+        for f in 1..last {
+            let s = frame(f);
+            assert_ne!(s.renew, Renew::Forget);
+            assert_eq!(s.scale, 1.0);
+        }
+        // Marked under a scale of 1 the frame before the check: expires in time across it.
+        let marked = frame(last);
+        let early = settled_frames(&mut frame, &marked, last, room);
+        let f = last + early + 1;
+        let marked = frame(f);
+        assert!((1.8..2.2).contains(&marked.scale), "{}", marked.scale);
+        // Marked under the measured scale, a vertex stays settled no longer than the planes take
+        // to sway `room`, but about twice as long as under a scale of 1.
+        let settled = settled_frames(&mut frame, &marked, f, room);
         let per_frame = sway(&planes(&circling(0)), &planes(&circling(1)), MODEL);
         assert!(
             settled as f32 > 1.8 * room / (2.0 * per_frame),
             "{settled} frames"
         );
+        assert!(
+            settled as f32 > 1.8 * early as f32,
+            "{settled} against {early}"
+        );
+    }
+
+    #[test]
+    fn a_smaller_sway_scale_forgets_the_marks() {
+        // A camera turning where it stands: its planes sway, its eye does not move; at the first
+        // check the scale falls to its floor, and the marks made under 1 would outlive their
+        // margins.
+        let mut m = Motion::ZERO;
+        let turning = |f: u32| {
+            let a = f as f32 * 0.01;
+            let at = [libm::sinf(a), 0.0, libm::cosf(a)];
+            View::look_at(
+                [0.0, 0.0, 3.0 * 4096.0],
+                at,
+                [0.0, 1.0, 0.0],
+                1.0,
+                1.0,
+                480.0,
+            )
+        };
+        for f in 0..=u32::from(SwayScale::FIRST) {
+            let s = m
+                .begin(&turning(f), Some(ENVELOPE), (1.0, 1.0), false, MODEL)
+                .expect("an envelope settles");
+            let checked = f == u32::from(SwayScale::FIRST);
+            assert_eq!(s.renew == Renew::Forget, f == 0 || checked, "frame {f}");
+            let expected = if checked { 1.0 / SwayScale::LIMIT } else { 1.0 };
+            assert_eq!(s.scale, expected, "frame {f}");
+        }
     }
 }
