@@ -9,7 +9,7 @@
 //! backward-shift deletion: no tombstones, so lookups stay short however long the cut runs, and
 //! nothing depends on iteration order (the map is never iterated).
 //!
-//! Only the first `span` entries of the table are in use, two to sixteen times the entries, so
+//! Only the first `span` entries of the table are in use, two to 32 times the entries, so
 //! that a small cut's map stays small and in cache however large its capacity; the cut rebuilds
 //! the map (from its node array: no scratch memory) when the span must grow or may shrink.
 //!
@@ -56,17 +56,18 @@ impl<const M: usize, I: SlotIndex> NodeMap<M, I> {
         }
     }
 
-    /// The span this many entries should use: four times as many (a quarter full, so that
-    /// many entries come and go before the next rebuild), at least [`MIN_SPAN`], at most `M`.
+    /// The span this many entries should use: eight times as many (an eighth full, so that
+    /// many entries come and go before the next rebuild, and a cut growing from its base mesh
+    /// rebuilds its map a third as often as at four times), at least [`MIN_SPAN`], at most `M`.
     pub fn span_for(entries: usize) -> usize {
-        entries.saturating_mul(4).max(MIN_SPAN).min(M)
+        entries.saturating_mul(8).max(MIN_SPAN).min(M)
     }
 
     /// Whether `entries` entries call for another span: more than half of it, or (when it is
-    /// above the minimum) less than a sixteenth.
+    /// above the minimum) less than a 32nd.
     pub fn should_resize(&self, entries: usize) -> bool {
         let span = self.span as usize;
-        (entries * 2 > span && span < M) || (entries * 16 < span && span > MIN_SPAN.min(M))
+        (entries * 2 > span && span < M) || (entries * 32 < span && span > MIN_SPAN.min(M))
     }
 
     /// Empties the map and makes it use `span` entries (clamped to `1..=M`).
@@ -282,7 +283,8 @@ mod tests {
         assert!((0..200).all(|s| m.get(s * 7, &nodes) == Some(s)));
         // A rebuild leaves room both ways.
         assert!(!m.should_resize(201) && !m.should_resize(150) && !m.should_resize(60));
-        assert!(m.should_resize(10) && m.should_resize(401));
+        assert!(!m.should_resize(800) && !m.should_resize(51));
+        assert!(m.should_resize(49) && m.should_resize(801));
         assert_eq!(NodeMap::<4096, u16>::span_for(1 << 20), 4096);
     }
 }
