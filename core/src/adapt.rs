@@ -336,11 +336,18 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         self.v.flags[b] |= BLOCKED;
     }
 
-    /// Collapses `parent` now if legal, with `fans` as scratch; `true` when done.
-    fn collapse_now(&mut self, h: &HierarchyView<'_>, parent: u32, fans: &mut PairFans) -> bool {
-        match self.collapse_legal(h, parent, fans) {
+    /// Collapses `parent` now if legal, with `fans` as scratch, leaving the second child's slot
+    /// empty when `frees` (see [`Cut::free_vertex`]); `true` when done.
+    fn collapse_now(
+        &mut self,
+        h: &HierarchyView<'_>,
+        parent: u32,
+        fans: &mut PairFans,
+        frees: bool,
+    ) -> bool {
+        match self.collapse_legal(h, parent, fans, frees) {
             Ok(plan) => {
-                self.apply_collapse(h, parent, plan, fans);
+                self.apply_collapse(h, parent, plan, fans, frees);
                 true
             }
             Err(_) => false,
@@ -363,6 +370,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         let settling = self.evaluate(h, view, policy, budget.max_visits, &mut frame);
         self.coarsen(h, view, policy, budget, &mut frame);
         self.refine(h, view, policy, budget, settling.as_ref(), &mut frame);
+        self.fill_holes();
         self.enforce_max(h, view, policy, budget, &mut frame.stats);
         // A cut that shrank gets a smaller node map (faster lookups).
         self.respan_map(self.v.len());
@@ -939,7 +947,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             let seen = e >= 0.0 && (fa | fb) & WAS_VISIBLE != 0;
             // `a` is the first child: its pair's split is found without counting parents.
             let split = h.pair_split(self.v.node[a]);
-            let legal = self.collapse_legal_at(&split, a as u32, b as u32, &mut fans);
+            let legal = self.collapse_legal_at(&split, a as u32, b as u32, &mut fans, true);
             if legal.is_err() && !blending {
                 self.block(a, b);
                 continue;
@@ -954,7 +962,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             }
             match legal {
                 Ok(plan) => {
-                    let s = self.apply_collapse(h, p, plan, &mut fans);
+                    let s = self.apply_collapse(h, p, plan, &mut fans, true);
                     frame.stats.ecols += 1;
                     frame.ops += 1;
                     self.list_new_pair(h, view, policy, s as usize, frame);
@@ -1089,7 +1097,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             } else {
                 0
             };
-            let before = self.v.len();
+            let before = self.active();
             let mut tris = self.t.len() as u32;
             let mut spent = frame.ops;
             // The splits done (forced ones first): their children are evaluated next (past 64
@@ -1120,7 +1128,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                     done_splits.push(split).ok();
                 },
             );
-            let done = (self.v.len() - before) as u32;
+            let done = (self.active() - before) as u32;
             frame.stats.vsplits += done;
             frame.stats.forced += done.saturating_sub(result.is_ok() as u32);
             frame.ops += done;
@@ -1225,7 +1233,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 break;
             }
             *traded += 1;
-            if self.collapse_now(h, pair.parent, &mut fans) {
+            if self.collapse_now(h, pair.parent, &mut fans, true) {
                 frame.stats.ecols += 1;
                 frame.ops += 1;
                 freed = true;
@@ -1262,7 +1270,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 if self.t.len() as u32 <= budget.max_triangles {
                     return;
                 }
-                if self.collapse_now(h, self.pairs.as_slice()[k].parent, &mut fans) {
+                if self.collapse_now(h, self.pairs.as_slice()[k].parent, &mut fans, false) {
                     stats.ecols += 1;
                     stats.budget_ecols += 1;
                     progress = true;

@@ -22,16 +22,18 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
     /// parent's slot.
     pub fn collapse(&mut self, h: &HierarchyView<'_>, node: u32) -> Result<u32, Refused> {
         let mut fans = PairFans::default();
-        let plan = self.collapse_legal(h, node, &mut fans)?;
-        Ok(self.apply_collapse(h, node, plan, &mut fans))
+        let plan = self.collapse_legal(h, node, &mut fans, false)?;
+        Ok(self.apply_collapse(h, node, plan, &mut fans, false))
     }
 
-    /// Proves the collapse of `node`'s children legal.
+    /// Proves the collapse of `node`'s children legal (see [`Cut::collapse_legal_at`] for
+    /// `frees`).
     pub(crate) fn collapse_legal(
         &self,
         h: &HierarchyView<'_>,
         node: u32,
         fans: &mut PairFans,
+        frees: bool,
     ) -> Result<CollapsePlan, Refused> {
         let s = h.split(node);
         let [c0, c1] = s.children;
@@ -40,16 +42,19 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         }
         let a = self.slot(c0).ok_or(Refused::NotActive)?;
         let b = self.slot(c1).ok_or(Refused::NotActive)?;
-        self.collapse_legal_at(&s, a, b, fans)
+        self.collapse_legal_at(&s, a, b, fans, frees)
     }
 
-    /// [`Cut::collapse_legal`] with the children's slots `a` and `b` known.
+    /// [`Cut::collapse_legal`] with the children's slots `a` and `b` known; `frees` when the
+    /// collapse will leave `b`'s slot empty ([`Cut::free_vertex`]) instead of moving the last
+    /// vertex into it (whose fan must then be whole).
     pub(crate) fn collapse_legal_at(
         &self,
         s: &SplitView,
         a: u32,
         b: u32,
         fans: &mut PairFans,
+        frees: bool,
     ) -> Result<CollapsePlan, Refused> {
         // Only `b`'s triangles are renamed, so `a`'s fan is walked only as far as `fl` (most
         // collapses tried are refused by `fl`'s neighbours).
@@ -94,9 +99,9 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         } else if fr != NIL {
             return Err(Refused::Inconsistent);
         }
-        // Renaming b and moving the last vertex into b's slot must reach every triangle.
+        // Renaming b, and moving the last vertex into b's slot, must reach every triangle.
         let last = self.v.len() as u32 - 1;
-        if !self.complete_fan(b, &mut fans.fans[1]) || !self.fan_complete(last) {
+        if !self.complete_fan(b, &mut fans.fans[1]) || !(frees || self.fan_complete(last)) {
             return Err(Refused::Inconsistent);
         }
         Ok(CollapsePlan {
@@ -108,13 +113,15 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
     }
 
     /// Performs a collapse [`Cut::collapse_legal`] approved, with the fans it found (used as
-    /// scratch afterwards); returns the parent's slot.
+    /// scratch afterwards), leaving `b`'s slot empty when `frees` (as approved); returns the
+    /// parent's slot.
     pub(crate) fn apply_collapse(
         &mut self,
         h: &HierarchyView<'_>,
         node: u32,
         plan: CollapsePlan,
         fans: &mut PairFans,
+        frees: bool,
     ) -> u32 {
         let CollapsePlan {
             a,
@@ -187,6 +194,10 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         // mate link.
         self.map.remove(self.v.node[b as usize], self.v.nodes());
         self.rename_vertex(h, a as usize, node);
+        if frees {
+            self.free_vertex(b);
+            return a;
+        }
         match self.remove_vertex(b, &mut fans.fans[0]) {
             Some(moved_from) if moved_from == a => b,
             _ => a,

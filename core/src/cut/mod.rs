@@ -34,11 +34,11 @@
 //! | triangle slot | `6i + 4 + i` (18 with `u16`) | corners, neighbours, id; one node-map entry |
 //! | queue entry | `4 + 8 + 12 + 28 = 52` | forcing stack, split heap, collapse pairs, blend arena |
 //!
-//! plus 324 bytes of lengths, settings, the walk's position and the terms the settled
-//! vertices were marked under (`expiry`).
+//! plus 332 bytes of lengths, settings, the walk's position, the chain of vertex slots a
+//! frame's collapses freed and the terms the settled vertices were marked under (`expiry`).
 //! With the recommended `F = 2 V` and `Q = V / 8` that is 21 + 36 + 6.5 = 63.5 bytes per vertex
 //! slot, **31.75 bytes per triangle of capacity** with `u16` (48.75 with `u32`), 32.05 for a
-//! 1,000-triangle cut. A cut for a 10,000-triangle budget, `Cut<5000, 10000, 625>`, is 317,824
+//! 1,000-triangle cut. A cut for a 10,000-triangle budget, `Cut<5000, 10000, 625>`, is 317,832
 //! bytes. The queues only bound how much one frame can do: when one overflows, the rest
 //! waits for the next frame and [`crate::adapt::FrameStats`] says so.
 //!
@@ -106,8 +106,8 @@ use store::{Triangles, Vertices};
 
 // The documented figure, checked when the crate is compiled for any target (CI builds it for
 // x86_64 and a 32-bit Cortex-M): a cut of 10,240 triangle slots with the recommended
-// capacities is 325,444 bytes, at most 32 bytes per triangle of capacity.
-const _: () = assert!(Cut::<5120, 10240, 640>::BYTES == 325_444);
+// capacities is 325,452 bytes, at most 32 bytes per triangle of capacity.
+const _: () = assert!(Cut::<5120, 10240, 640>::BYTES == 325_452);
 const _: () = assert!(Cut::<5120, 10240, 640>::BYTES <= 32 * 10240);
 
 /// A slot that holds nothing (no neighbour across a border edge, no incident triangle).
@@ -239,6 +239,10 @@ pub struct Cut<const V: usize, const F: usize, const Q: usize, I: SlotIndex = u1
     pub(crate) motion: Motion,
     /// Where the next frame's walk starts when [`crate::adapt::Budget::max_visits`] binds.
     pub(crate) walk: u32,
+    /// Vertex slots a collapse freed and no split has taken yet, chained through their fan
+    /// entries (`NIL` ends the chain), and how many (see [`Cut::free_vertex`]).
+    pub(crate) free: u32,
+    pub(crate) holes: u32,
 }
 
 impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> fmt::Debug for Cut<V, F, Q, I> {
@@ -342,6 +346,8 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             threshold: 0.0,
             motion: Motion::ZERO,
             walk: 0,
+            free: NIL,
+            holes: 0,
         }
     }
 
@@ -438,6 +444,8 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         self.threshold = 1.0;
         self.motion.clear();
         self.walk = 0;
+        self.free = NIL;
+        self.holes = 0;
     }
 
     /// Active vertices.
@@ -512,8 +520,8 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
     /// Inserts slot `s` (the last, just pushed) into the node map, which the map's rebuild does
     /// when the count calls for another span.
     fn map_insert(&mut self, s: u32) -> bool {
-        if self.map.should_resize(self.v.len()) {
-            self.rebuild_map(self.v.len());
+        if self.map.should_resize(self.active()) {
+            self.rebuild_map(self.active());
             return self.slot(self.v.node[s as usize]) == Some(s);
         }
         self.map.insert_new(s, self.v.nodes())
@@ -533,17 +541,37 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
     pub(crate) fn rebuild_map(&mut self, entries: usize) {
         self.map.reset(NodeMap::<F, I>::span_for(entries));
         for s in 0..self.v.len() as u32 {
-            self.map.insert(s, self.v.nodes());
+            if self.v.node[s as usize] != NONE {
+                self.map.insert(s, self.v.nodes());
+            }
         }
     }
 
-    /// Appends a vertex for `node` (visible, no blend, not linked); its slot, or `None` when
-    /// the arena or the node map is full.
+    /// Active vertices: the slots in use less the holes collapses left.
+    #[inline(always)]
+    pub(crate) fn active(&self) -> usize {
+        self.v.len() - self.holes as usize
+    }
+
+    /// Adds a vertex for `node` (visible, no blend, not linked) in the last slot a collapse
+    /// freed, else at the end; its slot, or `None` when the arena or the node map is full.
     #[inline(always)]
     fn push_vertex(&mut self, node: u32) -> Option<u32> {
-        let s = self.v.push(node, VISIBLE)?;
+        let hole = self.free;
+        let s = if hole != NIL {
+            self.free = self.v.fan(hole as usize);
+            self.holes -= 1;
+            self.v.fill(hole as usize, node, VISIBLE);
+            hole
+        } else {
+            self.v.push(node, VISIBLE)?
+        };
         if !self.map_insert(s) {
-            self.v.pop();
+            if hole != NIL {
+                self.free_vertex(s);
+            } else {
+                self.v.pop();
+            }
             return None;
         }
         Some(s)
@@ -585,36 +613,94 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         self.v.set_mate(b, first);
     }
 
+    /// Leaves vertex slot `v` (its node already out of the map, its triangles gone or renamed)
+    /// empty, to be taken by the next vertex added ([`Cut::push_vertex`]) or filled by the
+    /// last at the end of the frame ([`Cut::fill_holes`]). Moving the last vertex into the slot
+    /// at once, as [`Cut::remove_vertex`] does, walks the last vertex's fan, which nothing else
+    /// in a collapse touches: a frame's collapses leave their slots to its splits instead.
+    pub(crate) fn free_vertex(&mut self, v: u32) {
+        let i = v as usize;
+        self.unlink_mate(i);
+        self.free_blend(i);
+        self.v.node[i] = NONE;
+        self.v.flags[i] = 0;
+        self.v.set_fan(i, self.free);
+        self.free = v;
+        self.holes += 1;
+    }
+
+    /// Fills the slots collapses left empty with the last vertices (dropping the empty ones at
+    /// the end), so that the slots in use are the active vertices again.
+    pub(crate) fn fill_holes(&mut self) {
+        if self.holes == 0 {
+            return;
+        }
+        let mut fan = Fan::new();
+        while self.holes > 0 {
+            let last = self.v.len() - 1;
+            if self.v.node[last] == NONE {
+                // Still in the chain, past the end: passed over below.
+                self.v.pop();
+                self.holes -= 1;
+                continue;
+            }
+            let mut hole = self.free;
+            while hole as usize >= self.v.len() {
+                hole = self.v.fan(hole as usize);
+            }
+            self.free = self.v.fan(hole as usize);
+            self.holes -= 1;
+            self.move_last_into(hole, &mut fan);
+        }
+        self.free = NIL;
+    }
+
     /// Swap-removes vertex slot `v` (its node already out of the map, its triangles gone or
     /// renamed), with `fan` as scratch. Returns the slot the last vertex moved from, if it moved.
     fn remove_vertex(&mut self, v: u32, fan: &mut Fan) -> Option<u32> {
         self.unlink_mate(v as usize);
         self.free_blend(v as usize);
         let last = self.v.len() as u32 - 1;
-        let moved = (v != last).then(|| {
-            // Proven whole before the collapse that removes `v`.
-            let whole = self.complete_fan(last, fan);
-            debug_assert!(whole, "the last vertex's fan was proven whole");
+        if v == last {
+            self.v.pop();
+            return None;
+        }
+        self.move_last_into(v, fan);
+        Some(last)
+    }
+
+    /// Moves the last vertex into slot `v` (empty, or its vertex removed) and drops the last
+    /// slot, with `fan` as scratch: its triangles' corners, its map entry, its mate's link and
+    /// its blend follow it.
+    fn move_last_into(&mut self, v: u32, fan: &mut Fan) {
+        let last = self.v.len() as u32 - 1;
+        if self.complete_fan(last, fan) {
             for &f in fan.iter() {
                 if let Some(k) = self.t.corner_of(f, last) {
                     self.t.set_corner(f, k, v);
                 }
             }
-            let key = self.v.node[last as usize];
-            self.map.repoint(key, v, self.v.nodes());
-            self.v.copy(last as usize, v as usize);
-            let m = self.v.mate(v as usize);
-            if m != NIL {
-                self.v.set_mate(m as usize, v);
+        } else {
+            // Only in a cut already broken (a collapse proves the last vertex's fan whole
+            // before it moves the vertex at once): every triangle is searched instead.
+            for f in 0..self.t.len() as u32 {
+                while let Some(k) = self.t.corner_of(f, last) {
+                    self.t.set_corner(f, k, v);
+                }
             }
-            let b = self.v.blend(v as usize);
-            if let Some(entry) = self.blends.as_mut_slice().get_mut(b as usize) {
-                entry.slot = v;
-            }
-            last
-        });
+        }
+        let key = self.v.node[last as usize];
+        self.map.repoint(key, v, self.v.nodes());
+        self.v.copy(last as usize, v as usize);
+        let m = self.v.mate(v as usize);
+        if m != NIL {
+            self.v.set_mate(m as usize, v);
+        }
+        let b = self.v.blend(v as usize);
+        if let Some(entry) = self.blends.as_mut_slice().get_mut(b as usize) {
+            entry.slot = v;
+        }
         self.v.pop();
-        moved
     }
 
     /// Swap-removes triangle slot `f`, re-pointing whatever pointed at the moved one.

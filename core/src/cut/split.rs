@@ -80,7 +80,10 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             }
         }
         let added = 1 + second as usize;
-        if self.v.is_full() || self.v.len() >= self.map.capacity() || self.t.len() + added > F {
+        if (self.v.is_full() && self.free == NIL)
+            || self.active() >= self.map.capacity()
+            || self.t.len() + added > F
+        {
             return Err(Refused::Capacity);
         }
         let present = at.map(|i| i != NOWHERE);

@@ -216,14 +216,19 @@ impl<const V: usize, I: SlotIndex> Vertices<V, I> {
         if s >= V {
             return None;
         }
+        self.fill(s, node, flags);
+        self.len += 1;
+        Some(s as u32)
+    }
+
+    /// Makes record `s` (in range) a new vertex for `node`, as [`Vertices::push`] makes one.
+    pub fn fill(&mut self, s: usize, node: u32, flags: u8) {
         self.node[s] = node;
         self.fan[s] = I::store(NIL);
         self.degree[s] = 0;
         self.mate[s] = I::store(NIL);
         self.tag[s] = I::store(NIL);
         self.flags[s] = flags;
-        self.len += 1;
-        Some(s as u32)
     }
 
     /// Copies record `from` over record `to`.
