@@ -43,8 +43,11 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
     /// sibling links, the blend entries and the triangle ids right for `h`.
     pub fn check(&self, h: &HierarchyView<'_>) -> Result<(), Defect> {
         let bad = |what, slot| Err(Defect { what, slot });
-        if self.holes != 0 || self.free != NIL {
-            return bad("vertex slots a collapse freed are left empty", self.free);
+        if self.holes != 0 || self.free != 0 {
+            return bad(
+                "vertex slots a collapse freed are left empty",
+                self.free - 1,
+            );
         }
         let nv = self.v.len() as u32;
         let nf = self.t.len() as u32;

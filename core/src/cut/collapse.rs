@@ -101,7 +101,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         }
         // Renaming b, and moving the last vertex into b's slot, must reach every triangle.
         let last = self.v.len() as u32 - 1;
-        if !self.complete_fan(b, &mut fans.fans[1]) || !(frees || self.fan_complete(last)) {
+        if !self.complete_fan(b, &mut fans.fan) || !(frees || self.fan_complete(last)) {
             return Err(Refused::Inconsistent);
         }
         Ok(CollapsePlan {
@@ -129,7 +129,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             left: fl,
             right: fr,
         } = plan;
-        let fan_b = &fans.fans[1];
+        let fan_b = &fans.fan;
         // The removed triangles' corners lose one triangle each; then b's become a's.
         for f in [fl, fr] {
             if let Some(t) = self.t.get(f) {
@@ -198,7 +198,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             self.free_vertex(b);
             return a;
         }
-        match self.remove_vertex(b, &mut fans.fans[0]) {
+        match self.remove_vertex(b) {
             Some(moved_from) if moved_from == a => b,
             _ => a,
         }

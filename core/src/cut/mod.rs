@@ -96,8 +96,8 @@ mod store;
 pub(crate) use blend::Blend;
 pub use blend::{VertexOut, LANES};
 pub use check::Defect;
+pub(crate) use fan::PairFans;
 pub use fan::MAX_FAN;
-pub(crate) use fan::{Fan, PairFans};
 pub use slot::SlotIndex;
 
 use expiry::Motion;
@@ -239,8 +239,10 @@ pub struct Cut<const V: usize, const F: usize, const Q: usize, I: SlotIndex = u1
     pub(crate) motion: Motion,
     /// Where the next frame's walk starts when [`crate::adapt::Budget::max_visits`] binds.
     pub(crate) walk: u32,
-    /// Vertex slots a collapse freed and no split has taken yet, chained through their fan
-    /// entries (`NIL` ends the chain), and how many (see [`Cut::free_vertex`]).
+    /// Vertex slots a collapse freed and no split has taken yet (see [`Cut::free_vertex`]):
+    /// the first one's slot plus one (0: none, so that a new cut is all zeros and a `static`
+    /// one lands in `.bss`), each chained to the next through its fan entry (`NIL` ends the
+    /// chain); and how many.
     pub(crate) free: u32,
     pub(crate) holes: u32,
 }
@@ -346,7 +348,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             threshold: 0.0,
             motion: Motion::ZERO,
             walk: 0,
-            free: NIL,
+            free: 0,
             holes: 0,
         }
     }
@@ -444,7 +446,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         self.threshold = 1.0;
         self.motion.clear();
         self.walk = 0;
-        self.free = NIL;
+        self.free = 0;
         self.holes = 0;
     }
 
@@ -557,9 +559,9 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
     /// freed, else at the end; its slot, or `None` when the arena or the node map is full.
     #[inline(always)]
     fn push_vertex(&mut self, node: u32) -> Option<u32> {
-        let hole = self.free;
+        let hole = self.free.wrapping_sub(1);
         let s = if hole != NIL {
-            self.free = self.v.fan(hole as usize);
+            self.free = self.v.fan(hole as usize).wrapping_add(1);
             self.holes -= 1;
             self.v.fill(hole as usize, node, VISIBLE);
             hole
@@ -624,18 +626,14 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         self.free_blend(i);
         self.v.node[i] = NONE;
         self.v.flags[i] = 0;
-        self.v.set_fan(i, self.free);
-        self.free = v;
+        self.v.set_fan(i, self.free.wrapping_sub(1));
+        self.free = v + 1;
         self.holes += 1;
     }
 
     /// Fills the slots collapses left empty with the last vertices (dropping the empty ones at
     /// the end), so that the slots in use are the active vertices again.
     pub(crate) fn fill_holes(&mut self) {
-        if self.holes == 0 {
-            return;
-        }
-        let mut fan = Fan::new();
         while self.holes > 0 {
             let last = self.v.len() - 1;
             if self.v.node[last] == NONE {
@@ -644,20 +642,20 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 self.holes -= 1;
                 continue;
             }
-            let mut hole = self.free;
+            let mut hole = self.free.wrapping_sub(1);
             while hole as usize >= self.v.len() {
                 hole = self.v.fan(hole as usize);
             }
-            self.free = self.v.fan(hole as usize);
+            self.free = self.v.fan(hole as usize).wrapping_add(1);
             self.holes -= 1;
-            self.move_last_into(hole, &mut fan);
+            self.move_last_into(hole);
         }
-        self.free = NIL;
+        self.free = 0;
     }
 
     /// Swap-removes vertex slot `v` (its node already out of the map, its triangles gone or
-    /// renamed), with `fan` as scratch. Returns the slot the last vertex moved from, if it moved.
-    fn remove_vertex(&mut self, v: u32, fan: &mut Fan) -> Option<u32> {
+    /// renamed). Returns the slot the last vertex moved from, if it moved.
+    fn remove_vertex(&mut self, v: u32) -> Option<u32> {
         self.unlink_mate(v as usize);
         self.free_blend(v as usize);
         let last = self.v.len() as u32 - 1;
@@ -665,24 +663,16 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             self.v.pop();
             return None;
         }
-        self.move_last_into(v, fan);
+        self.move_last_into(v);
         Some(last)
     }
 
     /// Moves the last vertex into slot `v` (empty, or its vertex removed) and drops the last
-    /// slot, with `fan` as scratch: its triangles' corners, its map entry, its mate's link and
-    /// its blend follow it.
-    fn move_last_into(&mut self, v: u32, fan: &mut Fan) {
+    /// slot: its triangles' corners, its map entry, its mate's link and its blend follow it.
+    fn move_last_into(&mut self, v: u32) {
         let last = self.v.len() as u32 - 1;
-        if self.complete_fan(last, fan) {
-            for &f in fan.iter() {
-                if let Some(k) = self.t.corner_of(f, last) {
-                    self.t.set_corner(f, k, v);
-                }
-            }
-        } else {
-            // Only in a cut already broken (a collapse proves the last vertex's fan whole
-            // before it moves the vertex at once): every triangle is searched instead.
+        if !self.rename_fan(last, v) {
+            // Only in a cut already broken: every triangle is searched for the rest.
             for f in 0..self.t.len() as u32 {
                 while let Some(k) = self.t.corner_of(f, last) {
                     self.t.set_corner(f, k, v);
@@ -701,6 +691,52 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             entry.slot = v;
         }
         self.v.pop();
+    }
+
+    /// Makes slot `to` (which no triangle names) the corner of every triangle around slot
+    /// `from` in its place, walking `from`'s fan as it goes (nothing is kept: a kept fan would
+    /// cost 4 KiB of stack); whether the walk renamed as many triangles as `from` has.
+    fn rename_fan(&mut self, from: u32, to: u32) -> bool {
+        if from as usize >= self.v.len() {
+            return false;
+        }
+        let (start, degree) = (
+            self.v.fan(from as usize),
+            self.v.degree[from as usize] as usize,
+        );
+        if start == NIL {
+            return degree == 0;
+        }
+        let mut renamed = 0;
+        let mut f = start;
+        // Counter-clockwise from the fan triangle, round to it or to a border.
+        loop {
+            let Some((k, g)) = self.t.ccw_at(f, from) else {
+                return false;
+            };
+            self.t.set_corner(f, k, to);
+            renamed += 1;
+            if g == start {
+                return renamed == degree;
+            }
+            if g == NIL || renamed > degree {
+                break;
+            }
+            f = g;
+        }
+        // A border: the rest lies clockwise of the fan triangle, which names `to` now.
+        let Some((_, mut g)) = self.t.cw_at(start, to) else {
+            return false;
+        };
+        while g != NIL && renamed <= degree {
+            let Some((k, next)) = self.t.cw_at(g, from) else {
+                return false;
+            };
+            self.t.set_corner(g, k, to);
+            renamed += 1;
+            g = next;
+        }
+        renamed == degree
     }
 
     /// Swap-removes triangle slot `f`, re-pointing whatever pointed at the moved one.

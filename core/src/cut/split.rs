@@ -80,7 +80,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             }
         }
         let added = 1 + second as usize;
-        if (self.v.is_full() && self.free == NIL)
+        if (self.v.is_full() && self.free == 0)
             || self.active() >= self.map.capacity()
             || self.t.len() + added > F
         {
