@@ -12,11 +12,12 @@
 //!    Hoppe's condition allows; a collapse lists the pair it makes and the pairs whose illegal
 //!    mark it cleared (those whose triangles it gave a new neighbour), so when no budget, queue
 //!    or operation cap binds, one call reaches the cut the view asks for and a second call with
-//!    the same view does nothing (a test over the peer orbit at 0.25-4 px);
+//!    the same view does nothing (a test over the peer orbit at 0.25-4 px); a collapse leaves its
+//!    second child's vertex slot empty;
 //! 2. **refine**: vertices over tolerance are split largest error first (a priority queue), each
 //!    forcing the splits it depends on, and their children join the queue (when nothing can stop
 //!    refinement part way and the order cannot change the cut, the children go next, depth
-//!    first);
+//!    first); new vertices take the slots collapses left, and the last vertices fill the rest;
 //! 3. **budget**: splits stop at [`Budget::max_triangles`]; when the budget binds, pairs whose
 //!    parent's error is below the next split's are collapsed to make room, so the cut is the best
 //!    the budget allows. [`Budget::target_triangles`] regulates the error threshold from frame to
