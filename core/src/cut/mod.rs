@@ -562,7 +562,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         let hole = self.free.wrapping_sub(1);
         let s = if hole != NIL {
             self.free = self.v.fan(hole as usize).wrapping_add(1);
-            self.holes -= 1;
+            self.holes = self.holes.saturating_sub(1);
             self.v.fill(hole as usize, node, VISIBLE);
             hole
         } else {
@@ -643,14 +643,20 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 continue;
             }
             let mut hole = self.free.wrapping_sub(1);
-            while hole as usize >= self.v.len() {
+            while hole as usize >= self.v.len() && hole != NIL {
                 hole = self.v.fan(hole as usize);
+            }
+            if hole == NIL {
+                // The chain holds fewer than the count (never, as kept): nothing more to fill.
+                debug_assert!(false, "{} empty slots not in the chain", self.holes);
+                break;
             }
             self.free = self.v.fan(hole as usize).wrapping_add(1);
             self.holes -= 1;
             self.move_last_into(hole);
         }
         self.free = 0;
+        self.holes = 0;
     }
 
     /// Swap-removes vertex slot `v` (its node already out of the map, its triangles gone or
