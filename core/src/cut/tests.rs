@@ -86,6 +86,14 @@ fn full_refinement_gives_the_input_and_full_coarsening_the_base() {
     }
 }
 
+/// Marsaglia's 32-bit xorshift: `x`'s next state, returned.
+fn xorshift(x: &mut u32) -> u32 {
+    *x ^= *x << 13;
+    *x ^= *x >> 17;
+    *x ^= *x << 5;
+    *x
+}
+
 #[test]
 fn random_splits_and_collapses_keep_a_valid_manifold() {
     for (name, bytes, input) in meshes() {
@@ -97,9 +105,7 @@ fn random_splits_and_collapses_keep_a_valid_manifold() {
         let mut splits = 0;
         let mut collapses = 0;
         for _ in 0..3000 {
-            x ^= x << 13;
-            x ^= x >> 17;
-            x ^= x << 5;
+            xorshift(&mut x);
             let v = cut.nodes()[(x >> 8) as usize % cut.vertex_count()];
             if x & 1 == 0 || x & 6 == 0 {
                 if let Ok(k) = cut.force_split(&h, v, 0, &mut |_, _| Ok(())) {
@@ -133,12 +139,7 @@ fn slots_freed_by_collapses_are_taken_by_splits_or_filled() {
         while cut.refine_everything(&h) > 0 {}
         let mut fans = PairFans::default();
         let mut x = 0x9E37_79B9u32;
-        let mut next = || {
-            x ^= x << 13;
-            x ^= x >> 17;
-            x ^= x << 5;
-            x
-        };
+        let mut next = || xorshift(&mut x);
         let (mut freed, mut taken, mut filled) = (0, 0, 0);
         for _ in 0..100 {
             for _ in 0..12 {
