@@ -46,7 +46,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         if self.holes != 0 || self.free != 0 {
             return bad(
                 "vertex slots a collapse freed are left empty",
-                self.free - 1,
+                self.free.wrapping_sub(1),
             );
         }
         let nv = self.v.len() as u32;

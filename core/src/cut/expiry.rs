@@ -395,6 +395,8 @@ impl Motion {
         if let Some(r) = drifted {
             self.scale_less_one = r - 1.0;
         }
+        // The scale this frame counts its step and marks its vertices under.
+        let scale = self.scale_less_one + 1.0;
         let renew = if !continues || shrinks {
             self.now = [0; 2];
             let q = model.1 / QUANTA_PER_RADIUS;
@@ -414,7 +416,6 @@ impl Motion {
             } else {
                 turns
             };
-            let scale = self.scale_less_one + 1.0;
             let steps = [libm::ceilf(step(scale) / self.quantum), turns];
             let mut by = [0; 2];
             for k in 0..2 {
@@ -430,7 +431,6 @@ impl Motion {
                 Renew::Rebase(by)
             }
         };
-        let scale = self.scale_less_one + 1.0;
         let step = step(scale);
         *self = Motion {
             valid: true,
