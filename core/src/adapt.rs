@@ -71,7 +71,7 @@
 //! ```
 
 use crate::cut::expiry::{lives, Renew, Settling, Tally};
-use crate::cut::margin::lesser;
+use crate::cut::margin::{lesser, Either};
 use crate::cut::split::Split;
 use crate::cut::NIL;
 use crate::cut::{
@@ -569,16 +569,24 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                     // A leaf never splits, whatever it is asked (a parent's bounding radius
                     // is not 0 but where its whole region is a point: looked up then).
                     let leaf = digest.radius == 0 && !h.is_parent(self.v.node[i]);
-                    let (own, moved) = if leaf {
-                        (f32::INFINITY, f32::INFINITY)
+                    let (own, e) = if leaf {
+                        let never = Either {
+                            eye: f32::INFINITY,
+                            sway: f32::NEG_INFINITY,
+                        };
+                        (f32::INFINITY, never)
                     } else if wants_none {
                         let e = m.margins.unwanted(s, radius, d2, seen);
-                        (e.within(m.scale), e.displaced())
+                        (e.within(m.scale), e)
                     } else {
-                        (f32::NAN, f32::NAN)
+                        let unproven = Either {
+                            eye: f32::NAN,
+                            sway: f32::NAN,
+                        };
+                        (f32::NAN, unproven)
                     };
                     if !blends {
-                        turned[n] = m.turned(moved, center);
+                        turned[n] = m.turned(e, center, radius);
                     }
                     margin[n] = match (blends, seen) {
                         (false, _) => own,

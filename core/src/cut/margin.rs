@@ -13,6 +13,7 @@
 //! Every margin leaves a relative slack far above float rounding, and a margin that cannot be
 //! proven (a NaN anywhere) is never positive.
 
+use super::rigid::across;
 use crate::policy::{dot, sub, Bounds, Envelope, View};
 
 /// Relative slack on every margin, far above float rounding.
@@ -131,6 +132,9 @@ pub(crate) struct Margins {
     slop: f32,
     /// `slop` plus rounding on each plane's distances, by lane.
     plane_slop: [f32; 8],
+    /// One over each plane's normal's part across the axis the camera turns about, by lane (1
+    /// for every lane without an axis; see `super::rigid`).
+    per_across: [f32; 8],
 }
 
 impl Margins {
@@ -164,7 +168,20 @@ impl Margins {
             scale: libm::sqrtf(envelope.upper * slack * (1.0 + SLACK) / t),
             slop,
             plane_slop,
+            per_across: [1.0; 8],
         }
+    }
+
+    /// These terms for a camera turning about the unit `axis` (a world direction; the zero
+    /// vector for none), for [`Margins::turned_sway`].
+    pub fn about(mut self, axis: [f32; 3]) -> Margins {
+        if axis != [0.0; 3] {
+            let [x, y, z, _] = &self.lanes;
+            for i in 0..5 {
+                self.per_across[i] = 1.0 / across([x[i], y[i], z[i]], axis);
+            }
+        }
+        self
     }
 
     /// How far the eye may move while a vertex of spheroid radius `s` and bounding radius
@@ -187,6 +204,31 @@ impl Margins {
     /// change; `(None, NaN)` when neither is proven.
     #[inline(always)]
     pub fn visibility(&self, center: [f32; 3], radius: f32) -> (Option<bool>, f32) {
+        self.weighed_visibility(center, radius, [1.0; 8])
+    }
+
+    /// How far the camera may turn, in turns (see `super::rigid`), while a sphere at `center`
+    /// of `radius`, `reach` from the axis the camera turns about (from the model's centre
+    /// without one), stays in or out of the frustum: each plane's margin over
+    /// `max(|n⊥| reach, floor)`; NaN when neither is proven.
+    #[inline(always)]
+    pub fn turned_sway(&self, center: [f32; 3], radius: f32, reach: f32, floor: f32) -> f32 {
+        // 1 / max(a reach, floor), without a division per lane (a plane along the axis, or a
+        // centre on it, gets the floor's: an infinite product).
+        let (per_reach, per_floor) = (1.0 / reach, 1.0 / floor);
+        let per = self.per_across.map(|a| (a * per_reach).min(per_floor));
+        self.weighed_visibility(center, radius, per).1
+    }
+
+    /// [`Margins::visibility`] with each plane's margin multiplied by its lane of `per`
+    /// (positive).
+    #[inline(always)]
+    fn weighed_visibility(
+        &self,
+        center: [f32; 3],
+        radius: f32,
+        per: [f32; 8],
+    ) -> (Option<bool>, f32) {
         let [x, y, z, d] = &self.lanes;
         let mut nan = false;
         let mut inside = [0.0f32; 8];
@@ -194,8 +236,8 @@ impl Margins {
         for i in 0..8 {
             let dist = x[i] * center[0] + y[i] * center[1] + z[i] * center[2] + d[i] + radius;
             nan |= dist.is_nan();
-            inside[i] = dist - self.plane_slop[i];
-            outside[i] = -dist - self.plane_slop[i];
+            inside[i] = (dist - self.plane_slop[i]) * per[i];
+            outside[i] = (-dist - self.plane_slop[i]) * per[i];
         }
         // Halved lane by lane with plain comparisons (a NaN is caught by `nan`), so the lanes
         // reduce as vectors.
@@ -266,11 +308,12 @@ impl Margins {
     }
 
     /// [`Margins::wanted`], and how far the camera may turn while the parent stays wanted, in
-    /// turns (see `super::rigid`), for a centre `lever` from the model's centre (at least the
-    /// lever floor `floor`, by which the model's centre shifts at most per turn) and an eye
-    /// `eye` from it: its sphere seen and its error over `t * slack` while the centre moves at
-    /// most the turns times `lever`, and its normal cone not turned away while the axis turns
-    /// as far too. With `u` the centre's offset from the model's and `w` the model's from the
+    /// turns (see `super::rigid`), for a centre `reach` from the axis the camera turns about
+    /// (from the model's centre without one), the lever floor `floor` (by which the model's
+    /// centre shifts at most per turn) and an eye `eye` from the model's centre: its sphere
+    /// seen ([`Margins::turned_sway`]) and its error over `t * slack` while the centre moves at
+    /// most the turns times `lever = max(reach, floor)`, and its normal cone not turned away
+    /// while the axis turns as far too. With `u` the centre's offset from the model's and `w` the model's from the
     /// eye, `rn = (u + w) . axis` and `u . axis` keeps under a rotation, so `s = rn - radius`
     /// changes by at most `|w| turn + shift` and `d` by at most `|u| turn + shift`. The
     /// spheroid's along-axis term, which needs the axis to stay where it is, is left out.
@@ -280,9 +323,10 @@ impl Margins {
         b: &Bounds,
         (t, slack): (f32, f32),
         (step, levels): (f32, u32),
-        (lever, eye, floor): (f32, f32, f32),
+        (reach, eye, floor): (f32, f32, f32),
     ) -> (Both, f32) {
         let e = &self.envelope;
+        let lever = reach.max(floor);
         let sway = match (e.frustum, self.visibility(b.center, b.radius)) {
             (false, _) => f32::INFINITY,
             (true, (Some(true), m)) => m,
@@ -322,7 +366,15 @@ impl Margins {
                 spheroid
             }
         };
-        let turned = lesser(facing_turned, lesser(error(across), sway) / lever);
+        // The sway's margin plane by plane is at least the whole sphere's over the lever: only
+        // worked out when that would decide.
+        let others = lesser(facing_turned, error(across) / lever);
+        let sway_turned = sway / lever;
+        let turned = if sway_turned < others {
+            lesser(others, self.turned_sway(b.center, b.radius, reach, floor))
+        } else {
+            lesser(others, sway_turned)
+        };
         (
             Both {
                 eye: lesser(facing, error(spheroid)),

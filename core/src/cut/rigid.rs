@@ -15,6 +15,18 @@
 //! The frame is any orthonormal one fixed to the camera (built from the view's forward
 //! direction and its side planes): should the planes themselves change in it (a new aspect or
 //! frustum scale), the change is counted in the step too, so the bound holds for any view.
+//!
+//! A camera that keeps turning about one axis (an orbit, a turntable) turns the model about
+//! that axis through its centre, and a point then moves by `turn r⊥`, `r⊥` its distance from
+//! the axis, not from the centre; its distance from a plane moves by at most that times the
+//! part of the plane's normal across the axis (`|n⊥|`: small for the top and bottom planes of
+//! a camera circling about its vertical). The steps of such a camera are the same rotation
+//! each frame, so with an axis `a` the step counts, beside the turn, how far the step strays
+//! from a rotation about `a` by the same angle (`‖N − R_a‖`, see [`step`]); over any run of
+//! frames the model's rotation is one about `a` by at most the turns' sum, followed by a
+//! rotation within the strays' sum of the identity. So a point moves at most the count times
+//! `max(r⊥, lever)`, and a plane's distance at most the count times `max(|n⊥| r⊥, lever)`,
+//! `n⊥` taken from the frame the mark was made in.
 
 use super::margin::Planes;
 use crate::policy::{cross, dot, sub, View};
@@ -84,18 +96,20 @@ impl Axes {
 
 /// The step from `a` to `b` in turns: every node centre within `radius` of the model's centre,
 /// at `r` from it, moves in the camera's frame, relative to the planes, by at most the step
-/// times `max(r, lever)`; 0 when the two are the same.
-pub(crate) fn step(a: &Axes, b: &Axes, radius: f32, lever: f32) -> f32 {
+/// times `max(r, lever)`; 0 when the two are the same. With a unit `axis` (a world direction;
+/// the zero vector for none), `r` is the distance from the axis through the centre, and a
+/// plane's distance moves by at most the step times `max(|n⊥| r, lever)` (see the module).
+pub(crate) fn step(a: &Axes, b: &Axes, radius: f32, lever: f32, axis: [f32; 3]) -> f32 {
     if a == b {
         return 0.0;
     }
-    // The rows' difference: for two rotations its Frobenius norm is sqrt(2) times its norm.
-    let mut squares = 0.0f32;
-    for (p, q) in a.rows.iter().zip(&b.rows) {
-        let d = sub(*p, *q);
-        squares += dot(d, d);
-    }
-    let turn = libm::sqrtf(squares * 0.5) + 4.0 * ROUNDING;
+    let turned = turn(a, b);
+    let strays = if axis == [0.0; 3] {
+        0.0
+    } else {
+        stray(&rotation(a, b), turned, axis)
+    };
+    let turn = turned + 4.0 * ROUNDING;
     let moved = sub(b.center, a.center);
     let (from, to) = (norm(a.center), norm(b.center));
     let shift = norm(moved) + ROUNDING * (from + to);
@@ -107,10 +121,82 @@ pub(crate) fn step(a: &Axes, b: &Axes, radius: f32, lever: f32) -> f32 {
         let dn = [p[0] - q[0], p[1] - q[1], p[2] - q[2]];
         planes = planes.max(norm(dn) * reach + libm::fabsf(p[3] - q[3]));
     }
-    turn + (shift + planes) / lever
+    turn + (shift + planes + strays * radius) / lever
 }
 
-fn norm(v: [f32; 3]) -> f32 {
+/// `‖I − N‖` for the step's rotation `N`: `2 sin(angle / 2)`, without rounding's allowance.
+fn turn(a: &Axes, b: &Axes) -> f32 {
+    // The rows' difference: for two rotations its Frobenius norm is sqrt(2) times its norm.
+    let mut squares = 0.0f32;
+    for (p, q) in a.rows.iter().zip(&b.rows) {
+        let d = sub(*p, *q);
+        squares += dot(d, d);
+    }
+    libm::sqrtf(squares * 0.5)
+}
+
+/// The model's rotation from `a` to `b`, in the world: `N = Bᵀ A` (row `i` of `A` is the
+/// camera's axis `i` as a world direction). A point at `q` from the model's centre is seen
+/// from the two at `A q` and `B q`, and `B q − A q = B (I − N) q`: it moves as far as the
+/// rotation `N` moves `q`.
+fn rotation(a: &Axes, b: &Axes) -> [[f32; 3]; 3] {
+    core::array::from_fn(|i| {
+        core::array::from_fn(|j| {
+            b.rows[0][i] * a.rows[0][j] + b.rows[1][i] * a.rows[1][j] + b.rows[2][i] * a.rows[2][j]
+        })
+    })
+}
+
+/// `sin(angle) axis` of a rotation `n`, from its skew part.
+fn skew(n: &[[f32; 3]; 3]) -> [f32; 3] {
+    [
+        0.5 * (n[2][1] - n[1][2]),
+        0.5 * (n[0][2] - n[2][0]),
+        0.5 * (n[1][0] - n[0][1]),
+    ]
+}
+
+/// How far the rotation `n` (with `‖I − n‖ = turned`) strays from the rotation about the unit
+/// `axis` by the same angle, turned the same way round it: the Frobenius norm of their
+/// difference (at least its norm), with rounding's allowance.
+fn stray(n: &[[f32; 3]; 3], turned: f32, axis: [f32; 3]) -> f32 {
+    // turned = 2 sin(angle / 2): cos = 1 - turned^2 / 2, |sin| = turned sqrt(1 - turned^2 / 4).
+    let cos = 1.0 - 0.5 * turned * turned;
+    let sin = turned * libm::sqrtf((1.0 - 0.25 * turned * turned).max(0.0));
+    let sin = if dot(skew(n), axis) < 0.0 { -sin } else { sin };
+    let [x, y, z] = axis;
+    // Rodrigues: cos I + sin [axis]x + (1 - cos) axis axisᵀ.
+    let k = [[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]];
+    let mut squares = 0.0f32;
+    for i in 0..3 {
+        for j in 0..3 {
+            let r =
+                if i == j { cos } else { 0.0 } + sin * k[i][j] + (1.0 - cos) * axis[i] * axis[j];
+            squares += (n[i][j] - r) * (n[i][j] - r);
+        }
+    }
+    libm::sqrtf(squares) + 8.0 * ROUNDING
+}
+
+/// The unit axis the step from `a` to `b` turned about (a world direction, either way along
+/// it), when it turned by more than a ten-thousandth of a radian; the axes of smaller turns
+/// are mostly rounding.
+pub(crate) fn spin(a: &Axes, b: &Axes) -> Option<[f32; 3]> {
+    if a == b {
+        return None;
+    }
+    let w = skew(&rotation(a, b));
+    let sin = norm(w);
+    (sin > 1e-4).then(|| w.map(|c| c / sin))
+}
+
+/// The part across the unit `axis` of the unit normal `n`: `|n − (n . axis) axis|`.
+pub(crate) fn across(n: [f32; 3], axis: [f32; 3]) -> f32 {
+    let along = dot(n, axis);
+    libm::sqrtf((dot(n, n) - along * along).max(0.0))
+}
+
+pub(crate) fn norm(v: [f32; 3]) -> f32 {
     libm::sqrtf(dot(v, v))
 }
 
@@ -142,15 +228,24 @@ mod tests {
     #[test]
     fn a_still_camera_does_not_step() {
         let v = view(0.3, [0.0; 3]);
-        assert_eq!(step(&axes(&v), &axes(&v), 1.0, 0.5), 0.0);
+        assert_eq!(step(&axes(&v), &axes(&v), 1.0, 0.5, [0.0; 3]), 0.0);
     }
 
     #[test]
     fn circling_the_centre_turns_by_the_angle_and_shifts_nothing() {
         let (a, b) = (view(0.3, [0.0; 3]), view(0.31, [0.0; 3]));
-        let s = step(&axes(&a), &axes(&b), 1.0, 0.5);
+        let s = step(&axes(&a), &axes(&b), 1.0, 0.5, [0.0; 3]);
         // 2 sin(0.005) turned, and rounding.
         assert!(s > 0.01 && s < 0.0101, "{s}");
+        // It turned about the vertical, and about it strays by no more than rounding.
+        let spin = spin(&axes(&a), &axes(&b)).expect("it turned");
+        assert!(norm(cross(spin, [0.0, 1.0, 0.0])) < 1e-4, "{spin:?}");
+        let about = step(&axes(&a), &axes(&b), 1.0, 0.5, [0.0, 1.0, 0.0]);
+        assert!(about >= s && about < s + 1e-4, "{about} against {s}");
+        // About another axis it strays by about the turn times the sine between them.
+        let tilted = [0.0, libm::cosf(0.1), libm::sinf(0.1)];
+        let off = step(&axes(&a), &axes(&b), 1.0, 0.5, tilted);
+        assert!(off > s + 0.01 * 0.1 && off < s + 0.01 * 0.5 / 0.5, "{off}");
     }
 
     #[test]
@@ -182,7 +277,7 @@ mod tests {
             (view(0.3, [0.0; 3]), view(2.0, [0.5, 0.0, 0.0])),
         ];
         for (a, b) in pairs {
-            let s = step(&axes(&a), &axes(&b), 1.0, 0.5);
+            let s = step(&axes(&a), &axes(&b), 1.0, 0.5, [0.0; 3]);
             for &p in &points {
                 let bound = s * libm::sqrtf(dot(p, p)).max(0.5);
                 let ((pa, da), (pb, db)) = (seen(&a, p), seen(&b, p));
@@ -193,5 +288,91 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// Seven views turning about the vertical through the centre, wobbling a little about
+    /// other axes (as rounding would, and more), and changing their frustum once.
+    fn wobbling_orbit() -> [View; 7] {
+        core::array::from_fn(|k| {
+            let t = 0.3 + 0.02 * k as f32;
+            let eye = [
+                10.0 * libm::sinf(t),
+                3.0 + 0.05 * (k % 3) as f32,
+                10.0 * libm::cosf(t),
+            ];
+            let target = [0.0, 0.001 * (k % 2) as f32, 0.0];
+            let scale = if k == 5 { 0.9 } else { 1.0 };
+            View::with_frustum_scale(eye, target, [0.0, 1.0, 0.0], 1.0, 1.5, 480.0, scale)
+        })
+    }
+
+    #[test]
+    fn about_an_axis_every_point_and_plane_moves_less_than_the_counted_steps_say() {
+        // From the first view to each later one, every point moves by at most the steps' sum
+        // times its distance from the axis (at least the floor), and its distance from each
+        // plane by at most that sum times the plane's normal's part across the axis (in the
+        // first view) times that distance (at least the floor): the bound a mark relies on.
+        let points: [[f32; 3]; 300] = core::array::from_fn(|i| {
+            let t = i as f32 * 0.37;
+            let r = (i % 7) as f32 / 6.0;
+            [
+                r * libm::cosf(t) * libm::sinf(1.3 * t),
+                r * libm::cosf(2.1 * t),
+                r * libm::sinf(t) * libm::sinf(1.3 * t),
+            ]
+        });
+        let up = [0.0, 1.0, 0.0];
+        let views = wobbling_orbit();
+        let first = &views[0];
+        let ps = planes(first);
+        let across_up: [f32; 5] =
+            core::array::from_fn(|i| across([ps[i][0], ps[i][1], ps[i][2]], up));
+        // The top and bottom planes are mostly across the vertical: their distances move
+        // slowly as the camera circles.
+        assert!(across_up[2] < 0.8 && across_up[3] < 0.3, "{across_up:?}");
+        let mut counted = 0.0;
+        for pair in views.windows(2) {
+            counted += step(&axes(&pair[0]), &axes(&pair[1]), 1.0, 0.5, up);
+            let b = pair[1];
+            for &p in &points {
+                let reach = norm([p[0], 0.0, p[2]]);
+                let ((pa, da), (pb, db)) = (seen(first, p), seen(&b, p));
+                let moved = norm(sub(pa, pb));
+                assert!(
+                    moved <= counted * reach.max(0.5),
+                    "{moved} > {counted} x {reach}"
+                );
+                for i in 0..5 {
+                    let bound = counted * (across_up[i] * reach).max(0.5);
+                    assert!(
+                        libm::fabsf(da[i] - db[i]) <= bound,
+                        "plane {i}: {} > {bound}",
+                        libm::fabsf(da[i] - db[i])
+                    );
+                }
+            }
+        }
+        // And the wobble costs little: the count about the axis is near the plain one.
+        let plain: f32 = views
+            .windows(2)
+            .map(|pair| step(&axes(&pair[0]), &axes(&pair[1]), 1.0, 0.5, [0.0; 3]))
+            .sum();
+        assert!(counted < 1.5 * plain, "{counted} against {plain}");
+    }
+
+    #[test]
+    fn a_turn_about_another_axis_strays_by_about_itself() {
+        // Circling the centre over it (about the side axis): about the vertical the step
+        // strays by about twice what it turns, so the count more than doubles.
+        let over = |t: f32| {
+            let eye = [0.0, 10.0 * libm::sinf(t), 10.0 * libm::cosf(t)];
+            View::look_at(eye, [0.0; 3], [0.0, 1.0, 0.0], 1.0, 1.5, 480.0)
+        };
+        let (a, b) = (over(0.1), over(0.12));
+        let plain = step(&axes(&a), &axes(&b), 1.0, 0.5, [0.0; 3]);
+        let about = step(&axes(&a), &axes(&b), 1.0, 0.5, [0.0, 1.0, 0.0]);
+        assert!(about > 2.0 * plain, "{about} against {plain}");
+        let spin = spin(&axes(&a), &axes(&b)).expect("it turned");
+        assert!(libm::fabsf(spin[0]) > 0.999, "{spin:?}");
     }
 }
