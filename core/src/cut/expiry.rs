@@ -154,7 +154,7 @@ pub(crate) struct Settling {
     /// The camera's last step as turned (at least a quantum; infinite when it cannot be
     /// counted this frame).
     pub turn: f32,
-    /// The model's centre and the lever floor (see [`Settling::lever`]).
+    /// The model's centre and the lever floor (see [`Settling::turned`]).
     centre: ([f32; 3], f32),
     /// The axis the turning count's marks are made about (zero for none).
     axis: [f32; 3],
@@ -181,9 +181,9 @@ impl Settling {
     }
 
     /// The mark of a vertex whose answers' margin is `margin` as the eye travels (model
-    /// units) and `turned` as the camera turns ([`Settling::lever`] units; `-inf` for either
-    /// when not measured, NaN when unproven): on the count on which it lasts more frames at
-    /// the last steps, settled when that is at least one frame.
+    /// units) and `turned` as the camera turns (in turns, see [`Settling::turned`]; `-inf` for
+    /// either when not measured, NaN when unproven): on the count on which it lasts more frames
+    /// at the last steps, settled when that is at least one frame.
     #[inline(always)]
     pub fn mark(&self, (margin, turned): (f32, f32)) -> Mark {
         // Both counts' expiries are computed first, so that picking one is a choice between

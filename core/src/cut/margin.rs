@@ -313,10 +313,11 @@ impl Margins {
     /// centre shifts at most per turn) and an eye `eye` from the model's centre: its sphere
     /// seen ([`Margins::turned_sway`]) and its error over `t * slack` while the centre moves at
     /// most the turns times `lever = max(reach, floor)`, and its normal cone not turned away
-    /// while the axis turns as far too. With `u` the centre's offset from the model's and `w` the model's from the
-    /// eye, `rn = (u + w) . axis` and `u . axis` keeps under a rotation, so `s = rn - radius`
-    /// changes by at most `|w| turn + shift` and `d` by at most `|u| turn + shift`. The
-    /// spheroid's along-axis term, which needs the axis to stay where it is, is left out.
+    /// while the axis turns as far too. With `u` the centre's offset from the model's and `w`
+    /// the model's from the eye, `rn = (u + w) . axis` and `u . axis` keeps under a rotation,
+    /// so `s = rn - radius` changes by at most `|w| turn + shift` and `d` by at most `lever
+    /// turn + shift` (`super::rigid` counts what else the steps stray by). The spheroid's
+    /// along-axis term, which needs the axis to stay where it is, is left out.
     #[inline(always)]
     pub fn wanted_turned(
         &self,
