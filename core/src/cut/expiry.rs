@@ -280,7 +280,37 @@ pub(crate) struct Motion {
     axis: [f32; 3],
     /// The axis the camera's last steps turned about, and for how many steps it has held.
     candidate: [f32; 3],
-    held: u8,
+    held: Held,
+}
+
+/// Steps a candidate axis has held (the low six bits) and axes dropped so far (the high two,
+/// at most three): one byte, so that the cut keeps its size.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+struct Held(u8);
+
+impl Held {
+    const STEPS: u8 = 63;
+
+    /// Whether the candidate has held long enough to become the axis: [`HELD`] steps, twice
+    /// as many after each drop.
+    fn enough(self) -> bool {
+        self.0 & Held::STEPS >= HELD << (self.0 >> 6)
+    }
+
+    /// One more step about the candidate.
+    fn step(self) -> Held {
+        Held(self.0 + u8::from(self.0 & Held::STEPS < Held::STEPS))
+    }
+
+    /// A new candidate: no steps yet.
+    fn restart(self) -> Held {
+        Held(self.0 & !Held::STEPS)
+    }
+
+    /// The axis was dropped: no steps, one more drop.
+    fn dropped(self) -> Held {
+        Held(((self.0 >> 6) + 1).min(3) << 6)
+    }
 }
 
 /// How the count weighs the planes' sway against the eye's movement.
@@ -361,7 +391,7 @@ impl Motion {
         checked: false,
         axis: [0.0; 3],
         candidate: [0.0; 3],
-        held: 0,
+        held: Held(0),
     };
 
     /// Starts a frame seen from `view` with threshold `t` and the cut's bound slack `slack`,
@@ -509,7 +539,8 @@ impl Motion {
     /// [`HELD`] steps gets it as the marks' axis (marks made without one hold under any
     /// axis's steps, which are never shorter); one that turns about another drops it (with
     /// the count's marks on it, which its strays would soon expire anyway) until a new one
-    /// holds.
+    /// holds, for twice as many steps after each drop (at most eight times as many): a camera
+    /// that keeps changing its axis soon counts about the centre alone, as without axes.
     fn turning(&mut self, b: &Axes, radius: f32, floor: f32) -> f32 {
         let step = rigid::step(&self.axes, b, radius, floor, self.axis);
         let Some(spin) = rigid::spin(&self.axes, b) else {
@@ -519,18 +550,18 @@ impl Motion {
             // Strays that more than double the step: the camera turns about another axis.
             if step > 2.0 * rigid::step(&self.axes, b, radius, floor, [0.0; 3]) {
                 self.axis = [0.0; 3];
-                self.held = 0;
+                self.held = self.held.dropped();
                 return f32::INFINITY;
             }
             return step;
         }
         let same = self.candidate != [0.0; 3] && norm(cross(spin, self.candidate)) < SAME_AXIS;
         if same {
-            self.held = self.held.saturating_add(1);
+            self.held = self.held.step();
         } else {
-            (self.candidate, self.held) = (spin, 0);
+            (self.candidate, self.held) = (spin, self.held.restart());
         }
-        if self.held >= HELD {
+        if self.held.enough() {
             self.axis = self.candidate;
         }
         step
@@ -875,5 +906,42 @@ mod tests {
         assert_eq!(dropped.turn, f32::INFINITY);
         assert_eq!(m.axis, [0.0; 3]);
         assert_eq!(dropped.levers(above).0, 3000.0);
+        // Circling again, the axis comes back after holding twice as many steps as the first
+        // time (the step back onto the circle, about neither axis, holds nothing).
+        let steps = |m: &mut Motion, from: u32| {
+            let mut f = from;
+            while m.axis == [0.0; 3] {
+                f += 1;
+                at(m, &circling(f));
+                assert!(f < from + 100, "no axis");
+            }
+            f - from
+        };
+        let again = steps(&mut m, 0);
+        assert_eq!(f, u32::from(HELD) + 1);
+        assert_eq!(again, 2 * u32::from(HELD) + 2);
+    }
+
+    #[test]
+    fn each_drop_doubles_the_steps_an_axis_must_hold_up_to_eight_times() {
+        let mut held = Held::default();
+        for drops in 0..6u32 {
+            let needed = u32::from(HELD) << drops.min(3);
+            let mut steps = 0;
+            while !held.enough() {
+                held = held.step();
+                steps += 1;
+            }
+            assert_eq!(steps, needed, "after {drops} drops");
+            held = held.restart();
+            assert!(!held.enough());
+            held = held.dropped();
+        }
+        // The steps saturate instead of spilling into the drops.
+        let mut held = Held::default();
+        for _ in 0..200 {
+            held = held.step();
+        }
+        assert_eq!(held, Held(Held::STEPS));
     }
 }
