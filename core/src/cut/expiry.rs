@@ -30,11 +30,12 @@
 //! the count's bit in its expiry: for a camera circling the model, the turning count lets a
 //! vertex near the centre stay settled several times as long (the peer orbit asks 38% fewer
 //! vertices a frame than on the eye's path alone). A camera that has turned about one axis for
-//! a few frames (an orbit, a turntable) gets that axis: a point then counts its distance from
-//! the axis, not from the centre, and a plane's margin its normal's part across the axis
-//! (`super::rigid`), so a vertex above the centre, or near the top or bottom plane of a camera
-//! circling about its vertical, stays settled longer (Table 1's 0.4 flight asks a fifth fewer
-//! vertices a frame); a step about another axis drops it, with the marks made about it.
+//! a few frames (an orbit, a turntable) gets that axis, through the point it circles: a point
+//! then counts its distance from the axis, not from the centre, and a plane's margin its
+//! normal's part across the axis (`super::rigid`), so a vertex above the centre, or near the
+//! top or bottom plane of a camera circling about its vertical, stays settled longer (Table 1's
+//! 0.4 flight asks 29% fewer vertices a frame); a step about another axis drops it, with the
+//! marks made about it.
 //!
 //! Skipping changes no decision: every skipped answer is proven the same as asking would give
 //! (with a relative slack far above float rounding), so frames are the same with or without
@@ -80,6 +81,10 @@ pub(crate) fn lives(tag: u32, now: [u32; 2]) -> bool {
     let turning = (tag >> 15).wrapping_neg();
     tag >= now[0] ^ ((now[0] ^ TURNING.saturating_add(now[1])) & turning)
 }
+fn add(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+
 /// Steps a camera turns about one axis before the turning count's marks are made about it.
 const HELD: u8 = 4;
 /// Two steps' axes are one when the sine between them is under this.
@@ -281,6 +286,10 @@ pub(crate) struct Motion {
     /// The axis the camera's last steps turned about, and for how many steps it has held.
     candidate: [f32; 3],
     held: Held,
+    /// Where the axis passes, as an offset from the model's centre (zero without an axis): the
+    /// point the turning count turns about, so that a camera circling a point off the centre
+    /// does not shift it every step.
+    offset: [f32; 3],
 }
 
 /// Steps a candidate axis has held (the low six bits) and axes dropped so far (the high two,
@@ -392,6 +401,7 @@ impl Motion {
         axis: [0.0; 3],
         candidate: [0.0; 3],
         held: Held(0),
+        offset: [0.0; 3],
     };
 
     /// Starts a frame seen from `view` with threshold `t` and the cut's bound slack `slack`,
@@ -423,11 +433,23 @@ impl Motion {
         let step = |scale: f32| moved.max(scale * swayed);
         // And as turned, when both frames have axes.
         let lever = model.1 * LEVER;
-        let axes = Axes::of(view, &now, model.0);
+        let pivot = add(model.0, self.offset);
+        let axes = Axes::of(view, &now, pivot);
         let turned = match (&axes, self.has_axes) {
-            (Some(b), true) => self.turning(b, model.1, lever),
+            (Some(b), true) => self.turning(b, model.1 + norm(self.offset), lever),
             _ => f32::INFINITY,
         };
+        // An axis taken or dropped moves the pivot: this frame's axes are taken about the new
+        // one, so that the next step compares like with like.
+        let moved_pivot = add(model.0, self.offset) != pivot;
+        let pivot = add(model.0, self.offset);
+        let axes = if moved_pivot {
+            Axes::of(view, &now, pivot)
+        } else {
+            axes
+        };
+        // Every node centre is within this of the pivot.
+        let around = model.1 + norm(self.offset);
         let turns = libm::ceilf(turned * QUANTA_PER_TURN);
         let same =
             self.valid && envelope == self.envelope && t == self.threshold && blends == self.blends;
@@ -506,7 +528,7 @@ impl Motion {
         };
         // The eye travels at most this far while a mark lasts; as turned, a point moves at
         // most as far again (at most CAP quanta of turns, times a lever within the model).
-        let reach = CAP as f32 * (self.quantum + model.1 / QUANTA_PER_TURN);
+        let reach = CAP as f32 * (self.quantum + around / QUANTA_PER_TURN);
         Some(Settling {
             now: self.now,
             margins: Margins::new(view.eye, now, envelope, (t, slack), model, reach)
@@ -522,12 +544,9 @@ impl Motion {
             quantum: self.quantum,
             scale,
             turn: turned.max(QUANTA_PER_TURN.recip()),
-            centre: (model.0, lever),
+            centre: (pivot, lever),
             axis: self.axis,
-            eye: {
-                let w = sub(model.0, view.eye);
-                libm::sqrtf(dot(w, w))
-            },
+            eye: norm(sub(pivot, view.eye)),
             tick: u32::from(self.tick),
             sparse: self.sparse,
         })
@@ -551,6 +570,7 @@ impl Motion {
             if step > 2.0 * rigid::step(&self.axes, b, radius, floor, [0.0; 3]) {
                 self.axis = [0.0; 3];
                 self.held = self.held.dropped();
+                self.offset = [0.0; 3];
                 return f32::INFINITY;
             }
             return step;
@@ -563,6 +583,11 @@ impl Motion {
         }
         if self.held.enough() {
             self.axis = self.candidate;
+            // Turning about a point within an eighth of the model's radius of its centre: else
+            // about the centre (a camera circling far off it is better counted there).
+            self.offset = rigid::pivot(&self.axes, b, self.axis)
+                .filter(|d| norm(*d) <= radius * 0.125)
+                .unwrap_or([0.0; 3]);
         }
         step
     }

@@ -26,7 +26,9 @@
 //! frames the model's rotation is one about `a` by at most the turns' sum, followed by a
 //! rotation within the strays' sum of the identity. So a point moves at most the count times
 //! `max(r⊥, lever)`, and a plane's distance at most the count times `max(|n⊥| r⊥, lever)`,
-//! `n⊥` taken from the frame the mark was made in.
+//! `n⊥` taken from the frame the mark was made in. The axis passes through the point the
+//! camera circles ([`pivot`]), which need not be the model's centre: taken about it, the
+//! axes' centre does not shift from step to step.
 
 use super::margin::Planes;
 use crate::policy::{cross, dot, sub, View};
@@ -188,6 +190,39 @@ pub(crate) fn spin(a: &Axes, b: &Axes) -> Option<[f32; 3]> {
     let w = skew(&rotation(a, b));
     let sin = norm(w);
     (sin > 1e-4).then(|| w.map(|c| c / sin))
+}
+
+/// The point the step from `a` to `b` turned about, as an offset from the point both axes were
+/// taken about ([`Axes::of`]'s `center`), across the unit `axis`: a camera circling a point
+/// off that centre turns about the circle's axis, where a point stands still in the camera's
+/// frame. `None` when the step turned too little to tell.
+pub(crate) fn pivot(a: &Axes, b: &Axes, axis: [f32; 3]) -> Option<[f32; 3]> {
+    // A point `c + d` is seen at `A (c - e_a) + A d` and `B (c - e_b) + B d`; with `A = B N`
+    // it stands still where `(N - I) d = Bᵀ (c_b - c_a)`, solved across the axis.
+    let n = rotation(a, b);
+    let moved = sub(b.center, a.center);
+    let g: [f32; 3] = core::array::from_fn(|i| {
+        b.rows[0][i] * moved[0] + b.rows[1][i] * moved[1] + b.rows[2][i] * moved[2]
+    });
+    let other = if libm::fabsf(axis[0]) < 0.9 {
+        [1.0, 0.0, 0.0]
+    } else {
+        [0.0, 0.0, 1.0]
+    };
+    let e1 = cross(axis, other);
+    let e1 = e1.map(|c| c / norm(e1));
+    let e2 = cross(axis, e1);
+    let less_i = |v: [f32; 3]| -> [f32; 3] { core::array::from_fn(|i| dot(n[i], v) - v[i]) };
+    let (m1, m2) = (less_i(e1), less_i(e2));
+    let [a11, a21, a12, a22] = [dot(e1, m1), dot(e2, m1), dot(e1, m2), dot(e2, m2)];
+    let det = a11 * a22 - a12 * a21;
+    // det = turn^2 for a rotation about the axis: a tenth of a degree at least.
+    if det.partial_cmp(&3e-6) != Some(core::cmp::Ordering::Greater) {
+        return None;
+    }
+    let (g1, g2) = (dot(g, e1), dot(g, e2));
+    let (d1, d2) = ((a22 * g1 - a12 * g2) / det, (a11 * g2 - a21 * g1) / det);
+    Some(core::array::from_fn(|i| d1 * e1[i] + d2 * e2[i]))
 }
 
 /// The part across the unit `axis` of the unit normal `n`: `|n − (n . axis) axis|`.
@@ -373,5 +408,31 @@ mod tests {
         assert!(about > 2.0 * plain, "{about} against {plain}");
         let spin = spin(&axes(&a), &axes(&b)).expect("it turned");
         assert!(libm::fabsf(spin[0]) > 0.999, "{spin:?}");
+    }
+
+    #[test]
+    fn a_camera_circling_a_point_off_the_centre_turns_about_it() {
+        let (o, up) = ([0.3, 0.0, 0.2], [0.0, 1.0, 0.0]);
+        let view = |t: f32| {
+            let eye = [
+                o[0] + 10.0 * libm::sinf(t),
+                3.0,
+                o[2] + 10.0 * libm::cosf(t),
+            ];
+            View::look_at(eye, o, up, 1.0, 1.5, 480.0)
+        };
+        let (a, b) = (view(0.3), view(0.31));
+        let d = pivot(&axes(&a), &axes(&b), up).expect("it turned");
+        assert!(norm(sub(d, o)) < 1e-3, "{d:?}");
+        // About the pivot the step is the turn alone; about the centre the centre shifts too.
+        let about = |v: &View| Axes::of(v, &planes(v), d).expect("axes");
+        let plain = step(&axes(&a), &axes(&b), 1.0, 0.5, up);
+        let pivoted = step(&about(&a), &about(&b), 1.0, 0.5, up);
+        assert!(
+            pivoted < 0.0101 && plain > pivoted + 0.005,
+            "{plain} against {pivoted}"
+        );
+        // A still camera says nothing of where it turns.
+        assert_eq!(pivot(&axes(&a), &axes(&a), up), None);
     }
 }
