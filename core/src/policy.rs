@@ -197,6 +197,11 @@ pub(crate) fn sub(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
+#[inline]
+pub(crate) fn add(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+
 /// What every view-dependent test of a vertex starts from: the squared distance from the eye
 /// and the eye vector's component along the cone axis.
 #[derive(Clone, Copy)]

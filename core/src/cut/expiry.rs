@@ -54,7 +54,7 @@
 use super::margin::{planes, sway, Either, Margins, Planes};
 use super::rigid::{self, norm, Axes};
 use super::RESTLESS;
-use crate::policy::{cross, dot, sub, Envelope, View};
+use crate::policy::{add, cross, dot, sub, Envelope, View};
 
 /// Quanta of motion per unit of the model's bounding radius.
 const QUANTA_PER_RADIUS: f32 = 4096.0;
@@ -81,10 +81,6 @@ pub(crate) fn lives(tag: u32, now: [u32; 2]) -> bool {
     let turning = (tag >> 15).wrapping_neg();
     tag >= now[0] ^ ((now[0] ^ TURNING.saturating_add(now[1])) & turning)
 }
-fn add(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-
 /// Steps a camera turns about one axis before the turning count's marks are made about it.
 const HELD: u8 = 4;
 /// Two steps' axes are one when the sine between them is under this.
@@ -433,20 +429,19 @@ impl Motion {
         let step = |scale: f32| moved.max(scale * swayed);
         // And as turned, when both frames have axes.
         let lever = model.1 * LEVER;
-        let pivot = add(model.0, self.offset);
-        let axes = Axes::of(view, &now, pivot);
+        let offset = self.offset;
+        let axes = Axes::of(view, &now, add(model.0, offset));
         let turned = match (&axes, self.has_axes) {
-            (Some(b), true) => self.turning(b, model.1 + norm(self.offset), lever),
+            (Some(b), true) => self.turning(b, model.1 + norm(offset), lever),
             _ => f32::INFINITY,
         };
-        // An axis taken or dropped moves the pivot: this frame's axes are taken about the new
-        // one, so that the next step compares like with like.
-        let moved_pivot = add(model.0, self.offset) != pivot;
+        // An axis taken or dropped moves the pivot: this frame's axes are taken again about
+        // the new one, so that the next step compares like with like.
         let pivot = add(model.0, self.offset);
-        let axes = if moved_pivot {
-            Axes::of(view, &now, pivot)
-        } else {
+        let axes = if self.offset == offset {
             axes
+        } else {
+            Axes::of(view, &now, pivot)
         };
         // Every node centre is within this of the pivot.
         let around = model.1 + norm(self.offset);
@@ -604,12 +599,15 @@ impl Motion {
             && (settled.saturating_mul(8) < measured || skipped < measured);
     }
 
-    /// Forgets the marks and the motion seen (a new hierarchy): the scale is checked again
-    /// [`SwayScale::FIRST`] frames on.
+    /// Forgets the marks, the motion seen and the axis (a new hierarchy): the scale is checked
+    /// again [`SwayScale::FIRST`] frames on.
     pub fn clear(&mut self) {
         self.valid = false;
         self.seen = SwayScale::ZERO;
         self.checked = false;
+        // Another model: the pivot's offset was from the last one's centre.
+        (self.axis, self.candidate, self.held, self.offset) =
+            ([0.0; 3], [0.0; 3], Held::default(), [0.0; 3]);
     }
 
     /// Turns skipping on or off (it starts on).
@@ -946,6 +944,12 @@ mod tests {
         let again = steps(&mut m, 0);
         assert_eq!(f, u32::from(HELD) + 1);
         assert_eq!(again, 2 * u32::from(HELD) + 2);
+        // Another hierarchy (another model) forgets the axis and where it passed.
+        m.clear();
+        assert_eq!(
+            (m.axis, m.offset, m.held),
+            ([0.0; 3], [0.0; 3], Held::default())
+        );
     }
 
     #[test]

@@ -96,11 +96,12 @@ impl Axes {
     }
 }
 
-/// The step from `a` to `b` in turns: every node centre within `radius` of the model's centre,
-/// at `r` from it, moves in the camera's frame, relative to the planes, by at most the step
-/// times `max(r, lever)`; 0 when the two are the same. With a unit `axis` (a world direction;
-/// the zero vector for none), `r` is the distance from the axis through the centre, and a
-/// plane's distance moves by at most the step times `max(|n⊥| r, lever)` (see the module).
+/// The step from `a` to `b` in turns: every node centre within `radius` of the point both
+/// axes were taken about ([`Axes::of`]'s `center`), at `r` from it, moves in the camera's
+/// frame, relative to the planes, by at most the step times `max(r, lever)`; 0 when the two
+/// are the same. With a unit `axis` (a world direction; the zero vector for none), `r` is the
+/// distance from the axis through that point, and a plane's distance moves by at most the
+/// step times `max(|n⊥| r, lever)` (see the module).
 pub(crate) fn step(a: &Axes, b: &Axes, radius: f32, lever: f32, axis: [f32; 3]) -> f32 {
     if a == b {
         return 0.0;
