@@ -21,9 +21,10 @@
 //!    time per triangle as a ratio.
 //!
 //! 6. **Hoppe's SrMesh** (`srmesh_orbit` from `../shared/peers/hoppe/run.sh`, when built), the
-//!    same orbit and policy: ours before and after SrMesh's runs over a finer tolerance grid,
-//!    and the speed-up at equal triangle counts (SrMesh's time interpolated log-log at ours),
-//!    steady frames and the first frame.
+//!    same orbit and policy: ours and SrMesh's runs over a finer tolerance grid in turn, in
+//!    rounds (`VDLOD_ROUNDS`, 3), and the speed-up at equal triangle counts (SrMesh's time
+//!    interpolated log-log at ours), steady frames and the first frame (in a new cut and after
+//!    a reset), as the median over rounds and its range.
 //!
 //! 7. **Settled vertices** skipped or asked (`Cut::set_settling`), without and with geomorphs.
 //!
@@ -84,6 +85,9 @@ fn mean(v: &[f64]) -> f64 {
 struct Adapt {
     first_us: f64,
     first_tris: u32,
+    /// The first frame again after the revolutions, from a reset of the same cut.
+    reset_us: f64,
+    reset_tris: u32,
     us: Vec<f64>,
     tris: Vec<f64>,
     ops: Vec<f64>,
@@ -140,6 +144,12 @@ fn adapt_orbit_set(
                 .push(s.settled as f64 / s.vertices.max(1) as f64);
         }
     }
+    cut.reset(h).expect("base mesh fits");
+    let view = orbit.camera(0).view();
+    let start = Instant::now();
+    let s = cut.adapt(h, &view, policy, &Budget::default());
+    out.reset_us = start.elapsed().as_secs_f64() * 1e6;
+    out.reset_tris = s.triangles;
     out
 }
 
@@ -340,50 +350,130 @@ fn log_log(points: &[(f64, f64)], x: f64) -> Option<f64> {
     })
 }
 
-/// Our cut beside Hoppe's SrMesh in the same run: per tolerance ours, then SrMesh's whole grid,
-/// then ours again; SrMesh's time at our triangle count interpolated log-log between its two
-/// nearest tolerances (steady frames and the first frame, refined from the base mesh).
+/// How many rounds the SrMesh section runs (`VDLOD_ROUNDS`, default 3, at least 1).
+fn rounds() -> usize {
+    std::env::var("VDLOD_ROUNDS")
+        .ok()
+        .and_then(|v| v.parse::<usize>().ok())
+        .unwrap_or(3)
+        .max(1)
+}
+
+/// The median of `v` and its range, as `1.23x (1.10-1.40x)`; `-` when empty.
+fn spread(mut v: Vec<f64>) -> String {
+    if v.is_empty() {
+        return "-".to_string();
+    }
+    v.sort_by(f64::total_cmp);
+    format!(
+        "{:.2}x ({:.2}-{:.2}x)",
+        median(v.clone()),
+        v[0],
+        v[v.len() - 1]
+    )
+}
+
+/// Our cut beside Hoppe's SrMesh in the same run, in rounds: ours at every tolerance, then
+/// SrMesh's whole grid, then ours again, and so on ([`rounds`] of SrMesh, one more of ours).
+/// Each round's speed-up compares SrMesh's time at our triangle count (interpolated log-log
+/// between its two nearest tolerances) with ours in the runs either side of it; the table gives
+/// the median over rounds and their range. First frames, from the base mesh: ours in a cut just
+/// made (its memory never touched) and after a reset of a cut that has run (as after a jump of
+/// the camera; SrMesh's own first frame follows loading, which writes all of its records), each
+/// round's against SrMesh's.
 fn srmesh(h: &HierarchyView<'_>, mesh: &IndexedMesh) {
     println!("\n## 6. Beside Hoppe's SrMesh, bunny, peer orbit (640x480, 60 deg, 200 frames)\n");
-    let before = every_tolerance(h, mesh);
-    let peer = run_srmesh();
-    if peer.is_empty() {
-        return;
+    let mut ours = vec![every_tolerance(h, mesh)];
+    let mut peers = Vec::new();
+    for _ in 0..rounds() {
+        let peer = run_srmesh();
+        if peer.is_empty() {
+            return;
+        }
+        peers.push(peer);
+        ours.push(every_tolerance(h, mesh));
     }
-    let after = every_tolerance(h, mesh);
-    let mut steady: Vec<(f64, f64)> = peer.iter().map(|p| (p.tris, p.us)).collect();
-    steady.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let mut first: Vec<(f64, f64)> = peer.iter().map(|p| (p.first_tris, p.first_us)).collect();
-    first.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let sorted = |mut v: Vec<(f64, f64)>| {
+        v.sort_by(|a, b| a.0.total_cmp(&b.0));
+        v
+    };
+    let steady: Vec<_> = peers
+        .iter()
+        .map(|p| sorted(p.iter().map(|p| (p.tris, p.us)).collect()))
+        .collect();
+    let first: Vec<_> = peers
+        .iter()
+        .map(|p| sorted(p.iter().map(|p| (p.first_tris, p.first_us)).collect()))
+        .collect();
     println!(
-        "SrMesh over its own tolerances: {}\n",
-        peer.iter()
-            .map(|p| format!(
-                "{} px {:.0} us, {:.0} tris, {:.1} ops",
-                p.tol, p.us, p.tris, p.ops
-            ))
+        "{} rounds. SrMesh over its own tolerances (median over rounds): {}\n",
+        peers.len(),
+        peers[0]
+            .iter()
+            .enumerate()
+            .map(|(k, p)| {
+                let us = median(
+                    peers
+                        .iter()
+                        .filter_map(|q| q.get(k))
+                        .map(|q| q.us)
+                        .collect(),
+                );
+                format!(
+                    "{} px {us:.0} us, {:.0} tris, {:.1} ops",
+                    p.tol, p.tris, p.ops
+                )
+            })
             .collect::<Vec<_>>()
             .join("; ")
     );
-    println!("| tol px | our median us | our mean us | our tris | ops/frame | SrMesh median us at our tris | speed-up (medians) | speed-up (our mean) | our first frame | SrMesh first frame at our tris | speed-up |");
-    println!("|---|---|---|---|---|---|---|---|---|---|---|");
+    println!("| tol px | our median us | our mean us | our tris | ops/frame | SrMesh median us at our tris | speed-up (medians) | speed-up (our mean) | our first frame, new cut | speed-up | our first frame after a reset | speed-up |");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|");
     for (k, &t) in TOLERANCES.iter().enumerate() {
-        let (a, b) = (&before[k], &after[k]);
-        let (us, tris, ops) = both(a, b);
-        let mean_us = mean(&[a.us.clone(), b.us.clone()].concat());
-        let first_us = a.first_us.min(b.first_us);
-        let cell = |v: Option<f64>, ours: f64| {
-            v.map_or(("-".to_string(), "-".to_string()), |v| {
-                (format!("{v:.0}"), format!("{:.2}x", v / ours))
-            })
+        let all: Vec<&Adapt> = ours.iter().map(|o| &o[k]).collect();
+        let cat = |f: fn(&Adapt) -> &Vec<f64>| -> Vec<f64> {
+            all.iter().flat_map(|a| f(a).iter().copied()).collect()
         };
-        // SrMesh walks its whole active list every frame: its median is its mean.
-        let (sr, up) = cell(log_log(&steady, tris), us);
-        let (_, up_mean) = cell(log_log(&steady, tris), mean_us);
-        let (sr_first, up_first) = cell(log_log(&first, a.first_tris as f64), first_us);
+        let (us, mean_us) = (median(cat(|a| &a.us)), mean(&cat(|a| &a.us)));
+        let (tris, ops) = (mean(&cat(|a| &a.tris)), mean(&cat(|a| &a.ops)));
+        let mut up = Vec::new();
+        let mut up_mean = Vec::new();
+        let mut up_first = Vec::new();
+        let mut up_reset = Vec::new();
+        let mut sr_us = Vec::new();
+        for (r, (steady, first)) in steady.iter().zip(&first).enumerate() {
+            // The runs either side of SrMesh's round `r`.
+            let (a, b) = (&ours[r][k], &ours[r + 1][k]);
+            let round: Vec<f64> = a.us.iter().chain(&b.us).copied().collect();
+            let tris = mean(&[a.tris.clone(), b.tris.clone()].concat());
+            if let Some(sr) = log_log(steady, tris) {
+                sr_us.push(sr);
+                up.push(sr / median(round.clone()));
+                up_mean.push(sr / mean(&round));
+            }
+            // SrMesh walks its whole active list every frame: its median is its mean.
+            if let Some(sr) = log_log(first, a.first_tris as f64) {
+                up_first.push(sr / a.first_us);
+            }
+            if let Some(sr) = log_log(first, a.reset_tris as f64) {
+                up_reset.push(sr / a.reset_us);
+            }
+        }
+        let sr = if sr_us.is_empty() {
+            "-".to_string()
+        } else {
+            format!("{:.0}", median(sr_us))
+        };
+        let first_us = median(all.iter().map(|a| a.first_us).collect());
+        let reset_us = median(all.iter().map(|a| a.reset_us).collect());
         println!(
-            "| {t} | {us:.1} | {mean_us:.1} | {tris:.0} | {ops:.1} | {sr} | {up} | {up_mean} | {first_us:.0} us, {} tris | {sr_first} | {up_first} |",
-            a.first_tris
+            "| {t} | {us:.1} | {mean_us:.1} | {tris:.0} | {ops:.1} | {sr} | {} | {} | {first_us:.0} us, {} tris | {} | {reset_us:.0} us, {} tris | {} |",
+            spread(up),
+            spread(up_mean),
+            all[0].first_tris,
+            spread(up_first),
+            all[0].reset_tris,
+            spread(up_reset),
         );
     }
 }
