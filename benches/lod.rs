@@ -153,6 +153,19 @@ fn adapt_orbit_set(
     out
 }
 
+/// [`every_tolerance`], the file loaded anew for each tolerance (`HierarchyView::parse`, which
+/// reads every byte to validate it), as SrMesh's driver loads its own before each: the first
+/// frame then meets the file as an application's first frame after loading it would.
+fn every_tolerance_loaded(bytes: &[u8], mesh: &IndexedMesh) -> Vec<Adapt> {
+    TOLERANCES
+        .iter()
+        .map(|&t| {
+            let h = HierarchyView::parse(bytes).expect("valid");
+            adapt_orbit(&h, mesh, t, 2)
+        })
+        .collect()
+}
+
 /// Two revolutions of the peer orbit at each of [`TOLERANCES`].
 fn every_tolerance(h: &HierarchyView<'_>, mesh: &IndexedMesh) -> Vec<Adapt> {
     TOLERANCES
@@ -378,12 +391,12 @@ fn spread(mut v: Vec<f64>) -> String {
 /// Each round's speed-up compares SrMesh's time at our triangle count (interpolated log-log
 /// between its two nearest tolerances) with ours in the runs either side of it; the table gives
 /// the median over rounds and their range. First frames, from the base mesh: ours in a cut just
-/// made (its memory never touched) and after a reset of a cut that has run (as after a jump of
-/// the camera; SrMesh's own first frame follows loading, which writes all of its records), each
-/// round's against SrMesh's.
-fn srmesh(h: &HierarchyView<'_>, mesh: &IndexedMesh) {
+/// made after loading the file (SrMesh's driver loads its file before each tolerance's first
+/// frame too, writing all of its records), and after a reset of a cut that has run (as after a
+/// jump of the camera), each round's against SrMesh's.
+fn srmesh(bytes: &[u8], mesh: &IndexedMesh) {
     println!("\n## 6. Beside Hoppe's SrMesh, bunny, peer orbit (640x480, 60 deg, 200 frames)\n");
-    let mut ours = vec![every_tolerance(h, mesh)];
+    let mut ours = vec![every_tolerance_loaded(bytes, mesh)];
     let mut peers = Vec::new();
     for _ in 0..rounds() {
         let peer = run_srmesh();
@@ -391,7 +404,7 @@ fn srmesh(h: &HierarchyView<'_>, mesh: &IndexedMesh) {
             return;
         }
         peers.push(peer);
-        ours.push(every_tolerance(h, mesh));
+        ours.push(every_tolerance_loaded(bytes, mesh));
     }
     let sorted = |mut v: Vec<(f64, f64)>| {
         v.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -427,7 +440,7 @@ fn srmesh(h: &HierarchyView<'_>, mesh: &IndexedMesh) {
             .collect::<Vec<_>>()
             .join("; ")
     );
-    println!("| tol px | our median us | our mean us | our tris | ops/frame | SrMesh median us at our tris | speed-up (medians) | speed-up (our mean) | our first frame, new cut | speed-up | our first frame after a reset | speed-up |");
+    println!("| tol px | our median us | our mean us | our tris | ops/frame | SrMesh median us at our tris | speed-up (medians) | speed-up (our mean) | our first frame, file just loaded | speed-up | our first frame after a reset | speed-up |");
     println!("|---|---|---|---|---|---|---|---|---|---|---|---|");
     for (k, &t) in TOLERANCES.iter().enumerate() {
         let all: Vec<&Adapt> = ours.iter().map(|o| &o[k]).collect();
@@ -839,7 +852,7 @@ fn main() {
             policies(&h, &mesh);
         }
         if wanted("srmesh") {
-            srmesh(&h, &mesh);
+            srmesh(&bytes, &mesh);
         }
         if wanted("settling") {
             settling(&h, &mesh);
