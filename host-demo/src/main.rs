@@ -288,6 +288,10 @@ struct ReproduceArgs {
     /// Parent directory of the experiment's folder.
     #[arg(long, short, default_value = "out")]
     out: PathBuf,
+    /// Rounds of `table1`'s flights, flown in turn: each line then gives the medians over
+    /// rounds and the range of the speed-up and of adaptation's share.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=100))]
+    rounds: u32,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -1161,6 +1165,9 @@ fn remesh_command(args: RemeshArgs) -> Result<(), String> {
 }
 
 fn reproduce(args: ReproduceArgs) -> Result<(), String> {
+    if args.rounds != 1 && !matches!(args.name, Experiment::Table1) {
+        return Err("--rounds applies to table1 only".into());
+    }
     let (name, lines) = match args.name {
         Experiment::Fish => ("fish", wavelet::fish(&args.out.join("fish"))?),
         Experiment::Fig11 => ("fig11", wavelet::fig11(&args.out.join("fig11"))?),
@@ -1172,7 +1179,10 @@ fn reproduce(args: ReproduceArgs) -> Result<(), String> {
             table1::table1(
                 &args.out.join("table1"),
                 load_obj_bytes(BUNNY_NAME, BUNNY_OBJ).map_err(|e| e.to_string())?,
-                table1::Setup::REPRODUCE,
+                table1::Setup {
+                    rounds: args.rounds,
+                    ..table1::Setup::REPRODUCE
+                },
             )?,
         ),
         Experiment::Terrain => ("terrain", importance::terrain(&args.out.join("terrain"))?),

@@ -29,7 +29,9 @@
 //! median over the adapted frame's (adapt + render). A flight may put the cut's slots back in
 //! order every so many frames (`Cut::renumber`), as an application drawing the cut would: that
 //! is timed apart, and its mean per frame is added to the adapt column (`renumber_ms` says how
-//! much of it it is), since a median would leave those frames out.
+//! much of it it is), since a median would leave those frames out. With several rounds
+//! (`reproduce table1 --rounds N`) every flight is flown N times in turn and each line gives the
+//! medians over rounds and the range of the speed-up and of adaptation's share.
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -70,6 +72,10 @@ pub struct Setup {
     /// One flight per entry: frames in one revolution of the orbit (how fast the frustum
     /// moves), and frames between renumberings of the cut's slots (`Cut::renumber`; 0: never).
     pub flights: &'static [(u32, u32)],
+    /// Rounds: every flight is flown this many times in turn (at least once), and each summary
+    /// line gives the median over rounds, with the range of the speed-up and of adaptation's
+    /// share when there are several.
+    pub rounds: u32,
 }
 
 impl Setup {
@@ -81,6 +87,7 @@ impl Setup {
     pub const REPRODUCE: Setup = Setup {
         loop_steps: 1,
         flights: &[(100, 0), (400, 0), (400, 32), (800, 0)],
+        rounds: 1,
     };
 }
 
@@ -211,7 +218,7 @@ struct Flight<'a> {
 fn fly(
     model: &Model,
     h: &HierarchyView<'_>,
-    flight: &Flight<'_>,
+    (flight, round): (&Flight<'_>, u32),
     picture: u32,
     shot: &mut Frame,
     csv: &mut String,
@@ -281,7 +288,7 @@ fn fly(
         }
         let _ = writeln!(
             csv,
-            "{},{renumber_every},{size},{i},{},{},{},{},{},{t_adapt:.3},{t_renumber:.3},{t_render:.3},{t_full:.3}",
+            "{round},{},{renumber_every},{size},{i},{},{},{},{},{},{t_adapt:.3},{t_renumber:.3},{t_render:.3},{t_full:.3}",
             orbit.frames, stats.triangles, stats.vsplits, stats.ecols, stats.visited, stats.settled
         );
     }
@@ -340,58 +347,91 @@ pub fn table1(out_dir: &Path, input: IndexedMesh, setup: Setup) -> Result<Vec<St
         100.0 * share_in_view(&model.mesh.positions, &cameras, 0.2 * c, near),
     )];
     let mut csv = String::from(
-        "frames,renumber_every,size,frame,triangles,vsplits,ecols,visited,settled,adapt_ms,renumber_ms,render_ms,full_ms\n",
+        "round,frames,renumber_every,size,frame,triangles,vsplits,ecols,visited,settled,adapt_ms,renumber_ms,render_ms,full_ms\n",
     );
     let mut shot = Frame::new(WIDTH, HEIGHT).map_err(|e| e.to_string())?;
     let mut panels = Vec::new();
-    for (run, &(frames, renumber_every)) in setup.flights.iter().enumerate() {
-        let orbit = merge_tree_orbit(&bounds, frames.max(2), WIDTH, HEIGHT);
-        let picture = if run == 0 {
-            (orbit.frames / 8).max(1)
-        } else {
-            u32::MAX
-        };
-        for (size, paper) in SIZES {
-            let flight = Flight {
-                orbit: &orbit,
-                near,
-                c,
-                size,
-                renumber_every,
+    let orbits: Vec<Orbit> = setup
+        .flights
+        .iter()
+        .map(|&(frames, _)| merge_tree_orbit(&bounds, frames.max(2), WIDTH, HEIGHT))
+        .collect();
+    // Each flight's rows per frustum size, a row a round; the rounds go through every flight in
+    // turn, so that a slow phase of the machine meets them alike.
+    let mut rows = vec![vec![Vec::new(); SIZES.len()]; orbits.len()];
+    for round in 0..setup.rounds.max(1) {
+        for (run, (orbit, &(_, renumber_every))) in orbits.iter().zip(setup.flights).enumerate() {
+            let pictures = round == 0 && run == 0;
+            let picture = if pictures {
+                (orbit.frames / 8).max(1)
+            } else {
+                u32::MAX
             };
-            let row = fly(&model, &h, &flight, picture, &mut shot, &mut csv)?;
-            if run == 0 {
-                shot.save_png(&out_dir.join(format!("frustum_{size}.png")))
-                    .map_err(|e| e.to_string())?;
-                panels.push(panel(&shot, format!("frustum {size}")));
+            for (k, &(size, _)) in SIZES.iter().enumerate() {
+                let flight = Flight {
+                    orbit,
+                    near,
+                    c,
+                    size,
+                    renumber_every,
+                };
+                let row = fly(&model, &h, (&flight, round), picture, &mut shot, &mut csv)?;
+                if pictures {
+                    shot.save_png(&out_dir.join(format!("frustum_{size}.png")))
+                        .map_err(|e| e.to_string())?;
+                    panels.push(panel(&shot, format!("frustum {size}")));
+                }
+                rows[run][k].push(row);
             }
+            if pictures {
+                shot.draw(
+                    &model.mesh.as_raster_mesh(),
+                    &camera_params(&orbit.camera(picture), Shading::Gouraud, false),
+                )
+                .map_err(|e| e.to_string())?;
+                shot.save_png(&out_dir.join("full.png"))
+                    .map_err(|e| e.to_string())?;
+                panels.push(panel(&shot, "full detail".into()));
+                let png = sheet(&panels, panels.len(), CROP)?;
+                std::fs::write(out_dir.join("table1.png"), png).map_err(io)?;
+            }
+        }
+    }
+    for ((orbit, &(_, renumber_every)), rows) in orbits.iter().zip(setup.flights).zip(&rows) {
+        for (&(size, paper), rounds) in SIZES.iter().zip(rows) {
+            let of = |f: fn(&Row) -> f64| median(rounds.iter().map(f).collect());
+            let (speedup, share) = (of(Row::speedup), of(Row::adapt_share));
+            let ranges = if rounds.len() > 1 {
+                let range = |f: fn(&Row) -> f64, scale: f64, digits: usize| {
+                    let v = rounds.iter().map(|r| scale * f(r));
+                    let (lo, hi) = v.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+                        (lo.min(x), hi.max(x))
+                    });
+                    format!("{lo:.digits$}-{hi:.digits$}")
+                };
+                format!(
+                    " rounds={} speedup_range={} adapt_share_range={}",
+                    rounds.len(),
+                    range(Row::speedup, 1.0, 2),
+                    range(Row::adapt_share, 100.0, 0),
+                )
+            } else {
+                String::new()
+            };
+            let triangles = of(|r| r.triangles);
             lines.push(format!(
-                "experiment=table1 frames={} degrees_per_frame={:.2} renumber_every={renumber_every} frustum={size} kept_pct={:.1} triangles={:.0} ops={:.0} adapt_ms={:.2} renumber_ms={:.3} render_ms={:.2} full_ms={:.2} speedup={:.2} adapt_share_pct={:.0} first_adapt_ms={:.1} paper_speedup={paper}",
+                "experiment=table1 frames={} degrees_per_frame={:.2} renumber_every={renumber_every} frustum={size} kept_pct={:.1} triangles={triangles:.0} ops={:.0} adapt_ms={:.2} renumber_ms={:.3} render_ms={:.2} full_ms={:.2} speedup={speedup:.2} adapt_share_pct={:.0} first_adapt_ms={:.1} paper_speedup={paper}{ranges}",
                 orbit.frames,
                 360.0 / orbit.frames as f64,
-                100.0 * row.triangles / model.mesh.triangles.len().max(1) as f64,
-                row.triangles,
-                row.ops,
-                row.adapt_ms,
-                row.renumber_ms,
-                row.render_ms,
-                row.full_ms,
-                row.speedup(),
-                100.0 * row.adapt_share(),
-                row.first_adapt_ms,
+                100.0 * triangles / model.mesh.triangles.len().max(1) as f64,
+                of(|r| r.ops),
+                of(|r| r.adapt_ms),
+                of(|r| r.renumber_ms),
+                of(|r| r.render_ms),
+                of(|r| r.full_ms),
+                100.0 * share,
+                of(|r| r.first_adapt_ms),
             ));
-        }
-        if run == 0 {
-            shot.draw(
-                &model.mesh.as_raster_mesh(),
-                &camera_params(&orbit.camera(picture), Shading::Gouraud, false),
-            )
-            .map_err(|e| e.to_string())?;
-            shot.save_png(&out_dir.join("full.png"))
-                .map_err(|e| e.to_string())?;
-            panels.push(panel(&shot, "full detail".into()));
-            let png = sheet(&panels, panels.len(), CROP)?;
-            std::fs::write(out_dir.join("table1.png"), png).map_err(io)?;
         }
     }
     std::fs::write(out_dir.join("table1.csv"), csv).map_err(io)?;
@@ -462,6 +502,7 @@ mod tests {
         let setup = Setup {
             loop_steps: 1,
             flights: &[(16, 4)],
+            rounds: 2,
         };
         let lines = table1(&out, cow(), setup).unwrap();
         assert_eq!(lines.len(), 4);
@@ -487,7 +528,18 @@ mod tests {
             assert!(out.join(name).exists(), "{name}");
         }
         let csv = std::fs::read_to_string(out.join("table1.csv")).unwrap();
-        assert_eq!(csv.lines().count(), 1 + 3 * 16);
+        // Two rounds of three sizes, 16 frames each.
+        assert_eq!(csv.lines().count(), 1 + 2 * 3 * 16);
+        for l in &lines[1..] {
+            assert_eq!(summary_value::<u32>(l, "rounds"), Some(2), "{l}");
+            // The median of two rounds lies within their range.
+            let speedup: f64 = summary_value(l, "speedup").unwrap();
+            let range = l.split("speedup_range=").nth(1).unwrap();
+            let (lo, hi) = range.split_once('-').unwrap();
+            let hi = hi.split_whitespace().next().unwrap();
+            let (lo, hi): (f64, f64) = (lo.parse().unwrap(), hi.parse().unwrap());
+            assert!(lo <= speedup + 0.01 && speedup <= hi + 0.01, "{l}");
+        }
         std::fs::remove_dir_all(&out).ok();
     }
 }

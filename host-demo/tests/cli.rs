@@ -716,6 +716,10 @@ fn reproduce_fig11_writes_pictures_csv_and_summary_lines() {
     ] {
         assert!(text.contains(name), "{name} missing from: {text}");
     }
+    let out = demo(&["reproduce", "fig11", "--rounds", "2"], &dir);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("--rounds applies to table1 only"), "{err}");
     let out = succeed(&["reproduce", "fig11", "-o", "out"], &dir);
     let stdout = String::from_utf8_lossy(&out.stdout);
     let lines: Vec<&str> = stdout
