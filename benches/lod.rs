@@ -378,9 +378,10 @@ fn spread(mut v: Vec<f64>) -> String {
         return "-".to_string();
     }
     v.sort_by(f64::total_cmp);
+    // Sorted, so the median is the middle (as `median` picks it) and the ends the range.
     format!(
         "{:.2}x ({:.2}-{:.2}x)",
-        median(v.clone()),
+        v[v.len() / 2],
         v[0],
         v[v.len() - 1]
     )
@@ -454,21 +455,21 @@ fn srmesh(bytes: &[u8], mesh: &IndexedMesh) {
         let mut up_first = Vec::new();
         let mut up_reset = Vec::new();
         let mut sr_us = Vec::new();
-        for (r, (steady, first)) in steady.iter().zip(&first).enumerate() {
+        for (r, (round_steady, round_first)) in steady.iter().zip(&first).enumerate() {
             // The runs either side of SrMesh's round `r`.
             let (a, b) = (&ours[r][k], &ours[r + 1][k]);
             let round: Vec<f64> = a.us.iter().chain(&b.us).copied().collect();
             let tris = mean(&[a.tris.clone(), b.tris.clone()].concat());
-            if let Some(sr) = log_log(steady, tris) {
+            if let Some(sr) = log_log(round_steady, tris) {
                 sr_us.push(sr);
                 up.push(sr / median(round.clone()));
                 up_mean.push(sr / mean(&round));
             }
             // SrMesh walks its whole active list every frame: its median is its mean.
-            if let Some(sr) = log_log(first, a.first_tris as f64) {
+            if let Some(sr) = log_log(round_first, a.first_tris as f64) {
                 up_first.push(sr / a.first_us);
             }
-            if let Some(sr) = log_log(first, a.reset_tris as f64) {
+            if let Some(sr) = log_log(round_first, a.reset_tris as f64) {
                 up_reset.push(sr / a.reset_us);
             }
         }
