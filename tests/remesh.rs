@@ -1,6 +1,6 @@
 //! The remesher on the fixtures: every vertex on the input, the input's topology, no fold in
-//! the map, and the distances the README reports (as regression bounds); hostile inputs give
-//! typed errors.
+//! the map, and the distances `docs/remesher.md` reports (as regression bounds); hostile inputs
+//! give typed errors.
 
 mod common;
 

@@ -765,8 +765,8 @@ impl Policy for MergeTree {
 /// bounding box ([`Importance::for_model`]), so `area / distance` is scale-free and a threshold
 /// means the same on a bunny a few units across and on a terrain of thousands: roughly the
 /// triangle's area as a fraction of the model's squared size, for a camera about one diagonal
-/// away. [`Importance::DEFAULT_THRESHOLD`] is measured to give a sensible mesh on both (the
-/// README's terrain section). The paper's 0.3 was in the units of its own 100-sample terrain,
+/// away. [`Importance::DEFAULT_THRESHOLD`] is measured to give a sensible mesh on both (see
+/// `docs/terrain.md`). The paper's 0.3 was in the units of its own 100-sample terrain,
 /// whose diagonal is about 141 samples: 0.3 there is about 0.002 here.
 ///
 /// [`Importance::demand`] wants nothing of a vertex by itself: both engines ask the triangles.

@@ -39,8 +39,8 @@ fn main() {
         number("VDLOD_FW_WIDTH", 320),
         number("VDLOD_FW_HEIGHT", 240),
     );
-    // The capacities of the README's table: half a vertex slot per triangle plus eight, and a
-    // queue of an eighth of the vertex slots.
+    // The capacities of the table in `docs/device.md`: half a vertex slot per triangle plus
+    // eight, and a queue of an eighth of the vertex slots.
     let vertices = budget / 2 + 8;
     fs::write(
         out.join("config.rs"),

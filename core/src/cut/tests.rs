@@ -889,7 +889,7 @@ mod adapt {
 }
 
 #[test]
-fn the_budget_table_of_the_readme() {
+fn the_budget_table_of_docs_runtime() {
     // A cut for a budget of B triangles: F = B triangle slots, V = F / 2, Q = V / 8.
     assert_eq!(Cut::<500, 1000, 62>::BYTES, 32_092);
     assert_eq!(Cut::<1000, 2000, 125>::BYTES, 63_868);
@@ -898,7 +898,7 @@ fn the_budget_table_of_the_readme() {
 }
 
 #[test]
-fn the_readme_figures_of_the_benchmark_cuts() {
+fn the_figures_of_the_benchmark_cuts_in_docs_runtime() {
     assert_eq!(Cut::<16384, 32768, 2048>::BYTES, 1_040_752);
     assert_eq!(Cut::<262144, 524288, 32768, u32>::BYTES, 25_559_408);
 }
