@@ -6,6 +6,9 @@
 //! cargo run --release -p vdlod-demo --example cut_draw -- [SIZE [AT [FILE.vdh]]]
 //! ```
 //!
+//! Each is drawn at 64x48 from the same camera too: a hundredth of the pixels, the same vertex
+//! stage and triangle setup, so the difference between the two sizes is what the pixels cost.
+//!
 //! Frustum size `SIZE` (0.4), frame `AT` (200). With `FILE.vdh` the hierarchy of the
 //! Loop-subdivided bunny is read from there, or written there when the file does not exist.
 //! For instruction counts: `valgrind --tool=callgrind --toggle-collect='cut_draw::draw'` (the cut's
@@ -20,7 +23,7 @@ use vdlod_core::policy::MergeTree;
 use vdlod_demo::camera::{merge_tree_orbit, Camera};
 use vdlod_demo::frame::Frame;
 use vdlod_demo::mesh::{load_obj_bytes, BUNNY_NAME, BUNNY_OBJ};
-use vdlod_demo::render::style;
+use vdlod_demo::render::{camera_params, style};
 use vdlod_demo::table1::{calibrate, Model};
 use vdlod_raster::Shading;
 
@@ -98,18 +101,27 @@ fn main() -> Result<(), String> {
         let view = orbit.camera(i).view_scaled(c * size);
         cut.adapt(&h, &view, &policy, &Budget::default());
     }
+    // Each draw twice: at 640x480, and at 64x48 from the same camera (the same field of view,
+    // a hundredth of the pixels), where what is left is the vertex stage and each triangle's
+    // setup; the difference is what the pixels cost.
     let camera = orbit.camera(at);
+    let small_camera = merge_tree_orbit(&bounds, 400, 64, 48).camera(at);
     let mut frame = Frame::new(640, 480).map_err(|e| e.to_string())?;
+    let mut small = Frame::new(64, 48).map_err(|e| e.to_string())?;
     let as_is = median_ms(|| draw(&mut frame, &cut, &h, &camera));
+    let as_is_small = median_ms(|| draw(&mut small, &cut, &h, &small_camera));
     let start = Instant::now();
     cut.renumber();
     let renumber_ms = start.elapsed().as_secs_f64() * 1e3;
     let renumbered = median_ms(|| draw(&mut frame, &cut, &h, &camera));
+    let renumbered_small = median_ms(|| draw(&mut small, &cut, &h, &small_camera));
     let mesh = model.mesh.as_raster_mesh();
-    let params = vdlod_demo::render::camera_params(&camera, Shading::Gouraud, false);
+    let params = camera_params(&camera, Shading::Gouraud, false);
     let full = median_ms(|| draw_full(&mut frame, &mesh, &params));
+    let small_params = camera_params(&small_camera, Shading::Gouraud, false);
+    let full_small = median_ms(|| draw_full(&mut small, &mesh, &small_params));
     println!(
-        "frustum={size} frame={at} triangles={} vertices={} cut_ms={as_is:.3} renumbered_ms={renumbered:.3} full_ms={full:.3} renumber_ms={renumber_ms:.2}",
+        "frustum={size} frame={at} triangles={} vertices={} cut_ms={as_is:.3} renumbered_ms={renumbered:.3} full_ms={full:.3} renumber_ms={renumber_ms:.2} at_64x48: cut_ms={as_is_small:.3} renumbered_ms={renumbered_small:.3} full_ms={full_small:.3}",
         cut.triangles().len(),
         cut.vertex_count()
     );
