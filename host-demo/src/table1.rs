@@ -46,6 +46,7 @@ use vdlod_core::policy::{MergeTree, View};
 use vdlod_raster::{CheckedMesh, Shading};
 
 use crate::camera::merge_tree_orbit;
+use crate::chart::{self, BLUE, GREY, ORANGE};
 use crate::frame::Frame;
 use crate::hierarchy::build_with_progress;
 use crate::importance::{sheet, Panel};
@@ -76,6 +77,8 @@ pub struct Setup {
     /// line gives the median over rounds, with the range of the speed-up and of adaptation's
     /// share when there are several.
     pub rounds: u32,
+    /// The flight whose frames `table1_ms.png` charts (an index into `flights`).
+    pub charted: usize,
 }
 
 impl Setup {
@@ -88,6 +91,7 @@ impl Setup {
         loop_steps: 1,
         flights: &[(100, 0), (400, 0), (400, 32), (800, 0)],
         rounds: 1,
+        charted: 1,
     };
 }
 
@@ -183,6 +187,9 @@ pub struct Row {
     pub full_ms: f64,
     /// The first frame's adapt milliseconds (from the base mesh).
     pub first_adapt_ms: f64,
+    /// Every frame after the first: its adapt (with its renumbering), render and full-detail
+    /// milliseconds.
+    pub frames: Vec<[f64; 3]>,
 }
 
 impl Row {
@@ -276,6 +283,7 @@ fn fly(
         tris.push(f64::from(stats.triangles));
         ops.push(f64::from(stats.vsplits + stats.ecols));
     }
+    let mut frames = Vec::new();
     for (i, (stats, t_adapt, t_render, t_renumber)) in (0..).zip(rows) {
         let camera = orbit.camera(i);
         let start = Instant::now();
@@ -285,6 +293,7 @@ fn fly(
         let t_full = start.elapsed().as_secs_f64() * 1e3;
         if i > 0 {
             full.push(t_full);
+            frames.push([t_adapt + t_renumber, t_render, t_full]);
         }
         let _ = writeln!(
             csv,
@@ -302,6 +311,7 @@ fn fly(
         render_ms: median(render),
         full_ms: median(full),
         first_adapt_ms,
+        frames,
     })
 }
 
@@ -322,9 +332,38 @@ fn panel(frame: &Frame, caption: String) -> Panel {
     Panel { caption, pixels }
 }
 
+/// Frustum sizes 0.4 and 0.2 of one flight (its first round), frame by frame: adaptation,
+/// adaptation plus drawing, and drawing every triangle, in milliseconds, as a PNG.
+fn chart_frames(rows: &[Vec<Row>], degrees: f64) -> Result<Vec<u8>, String> {
+    let ink = (60, 60, 60);
+    let heads = SIZES.map(|(size, _)| format!("frustum {size}, {degrees:.2} deg/frame, ms: "));
+    let panel = |k: usize| {
+        let frames = rows
+            .get(k)
+            .and_then(|r| r.first())
+            .map_or(&[][..], |r| &r.frames);
+        let series = |f: fn(&[f64; 3]) -> f64| frames.iter().map(f).collect::<Vec<f64>>();
+        chart::Panel {
+            title: vec![
+                (heads[k].as_str(), ink),
+                ("adapt", ORANGE),
+                (", adapt + render", BLUE),
+                (", full detail", GREY),
+            ],
+            series: vec![
+                (series(|f| f[2]), GREY),
+                (series(|f| f[0] + f[1]), BLUE),
+                (series(|f| f[0]), ORANGE),
+            ],
+        }
+    };
+    chart::panels(&[panel(0), panel(1)])
+}
+
 /// Runs the experiment on `input` into `out_dir` (`table1.csv`; for the first speed,
 /// `frustum_S.png` per size and `full.png`, all of the same frame, and `table1.png`, their
-/// middles side by side as in the paper's Fig. 2) and returns its summary lines.
+/// middles side by side as in the paper's Fig. 2; `table1_ms.png`, the charted flight's frames'
+/// times at sizes 0.4 and 0.2) and returns its summary lines.
 pub fn table1(out_dir: &Path, input: IndexedMesh, setup: Setup) -> Result<Vec<String>, String> {
     let io = |e: std::io::Error| format!("{}: {e}", out_dir.display());
     std::fs::create_dir_all(out_dir).map_err(io)?;
@@ -435,6 +474,10 @@ pub fn table1(out_dir: &Path, input: IndexedMesh, setup: Setup) -> Result<Vec<St
         }
     }
     std::fs::write(out_dir.join("table1.csv"), csv).map_err(io)?;
+    if let (Some(rows), Some(orbit)) = (rows.get(setup.charted), orbits.get(setup.charted)) {
+        let png = chart_frames(rows, 360.0 / orbit.frames as f64)?;
+        std::fs::write(out_dir.join("table1_ms.png"), png).map_err(io)?;
+    }
     Ok(lines)
 }
 
@@ -503,6 +546,7 @@ mod tests {
             loop_steps: 1,
             flights: &[(16, 4)],
             rounds: 2,
+            charted: 0,
         };
         let lines = table1(&out, cow(), setup).unwrap();
         assert_eq!(lines.len(), 4);
@@ -527,6 +571,9 @@ mod tests {
         ] {
             assert!(out.join(name).exists(), "{name}");
         }
+        // The chart of the flight's frames: a picture of the chart's size.
+        let (w, h, _) = crate::frame::load_png(&out.join("table1_ms.png")).unwrap();
+        assert_eq!((w, h), (820, 470));
         let csv = std::fs::read_to_string(out.join("table1.csv")).unwrap();
         // Two rounds of three sizes, 16 frames each.
         assert_eq!(csv.lines().count(), 1 + 2 * 3 * 16);
