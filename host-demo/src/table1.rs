@@ -187,9 +187,22 @@ pub struct Row {
     pub full_ms: f64,
     /// The first frame's adapt milliseconds (from the base mesh).
     pub first_adapt_ms: f64,
-    /// Every frame after the first: its adapt (with its renumbering), render and full-detail
-    /// milliseconds.
-    pub frames: Vec<[f64; 3]>,
+    /// Every frame after the first.
+    pub frames: Vec<FrameTimes>,
+}
+
+/// One frame's milliseconds: adapting, renumbering the slots before it (0 in most frames),
+/// drawing the cut, drawing every triangle.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct FrameTimes {
+    /// Adapting.
+    pub adapt: f64,
+    /// Renumbering the cut's slots before adapting.
+    pub renumber: f64,
+    /// Drawing the cut.
+    pub render: f64,
+    /// Drawing every triangle.
+    pub full: f64,
 }
 
 impl Row {
@@ -244,10 +257,6 @@ fn fly(
     let mut reference = Frame::new(WIDTH, HEIGHT).map_err(|e| e.to_string())?;
     // An application that draws every triangle checks its index buffer once, not every frame.
     let full_mesh = CheckedMesh::new(model.mesh.as_raster_mesh()).map_err(|e| e.to_string())?;
-    let (mut adapt, mut render, mut full) = (Vec::new(), Vec::new(), Vec::new());
-    let mut renumber = Vec::new();
-    let (mut tris, mut ops) = (Vec::new(), Vec::new());
-    let mut first_adapt_ms = 0.0;
     let look = style(Shading::Gouraud, false);
     let mut rows = Vec::new();
     for i in 0..orbit.frames {
@@ -273,17 +282,11 @@ fn fly(
             shot.draw_cut(&cut, h, &camera, &style(Shading::Gouraud, true))
                 .map_err(|e| e.to_string())?;
         }
-        if i == 0 {
-            first_adapt_ms = t_adapt;
-            continue;
-        }
-        adapt.push(t_adapt);
-        renumber.push(t_renumber);
-        render.push(t_render);
-        tris.push(f64::from(stats.triangles));
-        ops.push(f64::from(stats.vsplits + stats.ecols));
     }
+    let first_adapt_ms = rows.first().map_or(0.0, |r| r.1);
+    // Every frame after the first: its times and its triangles and operations.
     let mut frames = Vec::new();
+    let (mut tris, mut ops) = (Vec::new(), Vec::new());
     for (i, (stats, t_adapt, t_render, t_renumber)) in (0..).zip(rows) {
         let camera = orbit.camera(i);
         let start = Instant::now();
@@ -292,8 +295,14 @@ fn fly(
             .map_err(|e| e.to_string())?;
         let t_full = start.elapsed().as_secs_f64() * 1e3;
         if i > 0 {
-            full.push(t_full);
-            frames.push([t_adapt + t_renumber, t_render, t_full]);
+            frames.push(FrameTimes {
+                adapt: t_adapt,
+                renumber: t_renumber,
+                render: t_render,
+                full: t_full,
+            });
+            tris.push(f64::from(stats.triangles));
+            ops.push(f64::from(stats.vsplits + stats.ecols));
         }
         let _ = writeln!(
             csv,
@@ -301,15 +310,16 @@ fn fly(
             orbit.frames, stats.triangles, stats.vsplits, stats.ecols, stats.visited, stats.settled
         );
     }
-    let renumber_ms = mean(renumber.into_iter());
+    let of = |f: fn(&FrameTimes) -> f64| frames.iter().map(f).collect::<Vec<f64>>();
+    let renumber_ms = mean(of(|f| f.renumber).into_iter());
     Ok(Row {
         size,
         triangles: mean(tris.into_iter()),
         ops: mean(ops.into_iter()),
-        adapt_ms: median(adapt) + renumber_ms,
+        adapt_ms: median(of(|f| f.adapt)) + renumber_ms,
         renumber_ms,
-        render_ms: median(render),
-        full_ms: median(full),
+        render_ms: median(of(|f| f.render)),
+        full_ms: median(of(|f| f.full)),
         first_adapt_ms,
         frames,
     })
@@ -342,7 +352,7 @@ fn chart_frames(rows: &[Vec<Row>], degrees: f64) -> Result<Vec<u8>, String> {
             .get(k)
             .and_then(|r| r.first())
             .map_or(&[][..], |r| &r.frames);
-        let series = |f: fn(&[f64; 3]) -> f64| frames.iter().map(f).collect::<Vec<f64>>();
+        let series = |f: fn(&FrameTimes) -> f64| frames.iter().map(f).collect::<Vec<f64>>();
         chart::Panel {
             title: vec![
                 (heads[k].as_str(), ink),
@@ -351,9 +361,9 @@ fn chart_frames(rows: &[Vec<Row>], degrees: f64) -> Result<Vec<u8>, String> {
                 (", full detail", GREY),
             ],
             series: vec![
-                (series(|f| f[2]), GREY),
-                (series(|f| f[0] + f[1]), BLUE),
-                (series(|f| f[0]), ORANGE),
+                (series(|f| f.full), GREY),
+                (series(|f| f.adapt + f.renumber + f.render), BLUE),
+                (series(|f| f.adapt + f.renumber), ORANGE),
             ],
         }
     };

@@ -57,7 +57,7 @@ export VDLOD_HIERARCHY="$PWD/$OUT/bunny.vdh"
 # --- build both ----------------------------------------------------------------------------
 # Panic locations name their source files by path: mapped to the repository's root (and cargo's
 # home), the firmware, and with it the flash figure, are the same wherever the repository is
-# checked out (a clone at /tmp/ci-clone made it 56 bytes longer than one at /work/main).
+# checked out (a path three characters longer had made it 56 bytes longer).
 # (Encoded flags, separated by 0x1f, so that a path with spaces stays one flag.)
 export CARGO_ENCODED_RUSTFLAGS="--remap-path-prefix=$PWD=.$(printf '\x1f')--remap-path-prefix=${CARGO_HOME:-$HOME/.cargo}=/cargo"
 cargo build --release --manifest-path "$MANIFEST" --target-dir "$FW_TARGET_DIR" --target "$TARGET"
