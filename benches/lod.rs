@@ -24,7 +24,9 @@
 //!    same orbit and policy: ours and SrMesh's runs over a finer tolerance grid in turn, in
 //!    rounds (`VDLOD_ROUNDS`, 3), and the speed-up at equal triangle counts (SrMesh's time
 //!    interpolated log-log at ours), steady frames and the first frame (in a new cut and after
-//!    a reset), as the median over rounds and its range.
+//!    a reset), as the median over rounds and its range. SrMesh is compiled for the processor
+//!    it runs on (`-march=native`); a line says what this bench was compiled for, and
+//!    `RUSTFLAGS="-C target-cpu=native"` compiles ours alike.
 //!
 //! 7. **Settled vertices** skipped or asked (`Cut::set_settling`), without and with geomorphs.
 //!
@@ -291,6 +293,29 @@ const SR_TOLERANCES: [f32; 11] = [
     0.125, 0.177, 0.25, 0.354, 0.5, 0.707, 1.0, 1.414, 2.0, 2.828, 4.0,
 ];
 
+/// The instruction-set extensions this bench was compiled with, of those the cut's code can
+/// use (the baseline x86-64 target has none of them; `-C target-cpu=native` enables what the
+/// processor has).
+fn compiled_for() -> String {
+    let features = [
+        ("popcnt", cfg!(target_feature = "popcnt")),
+        ("sse4.2", cfg!(target_feature = "sse4.2")),
+        ("avx2", cfg!(target_feature = "avx2")),
+        ("bmi2", cfg!(target_feature = "bmi2")),
+        ("fma", cfg!(target_feature = "fma")),
+        ("avx512f", cfg!(target_feature = "avx512f")),
+    ];
+    let on: Vec<&str> = features.iter().filter(|f| f.1).map(|f| f.0).collect();
+    if on.is_empty() {
+        format!(
+            "{}, baseline (none of popcnt, sse4.2, avx2, bmi2, fma)",
+            std::env::consts::ARCH
+        )
+    } else {
+        format!("{} with {}", std::env::consts::ARCH, on.join(", "))
+    }
+}
+
 /// The `srmesh_adapt` lines of `srmesh_orbit` (`../shared/peers/hoppe/`, when built:
 /// `VDLOD_SRMESH` names its work folder, default `$TMPDIR/hoppe-srmesh`), one fresh process per
 /// tolerance.
@@ -419,6 +444,11 @@ fn srmesh(bytes: &[u8], mesh: &IndexedMesh) {
         .iter()
         .map(|p| sorted(p.iter().map(|p| (p.first_tris, p.first_us)).collect()))
         .collect();
+    println!(
+        "Compiled for: ours {}; SrMesh with its library's release flags (-march=native, \
+         -ffast-math). Ours for this processor too: RUSTFLAGS=\"-C target-cpu=native\".\n",
+        compiled_for()
+    );
     println!(
         "{} rounds. SrMesh over its own tolerances (median over rounds): {}\n",
         peers.len(),

@@ -2,12 +2,14 @@
 //! `cargo bench --bench lod` refines its first frame, and the time per split.
 //!
 //! ```text
-//! cargo run --release -p vdlod-demo --example first_frames -- [TOLERANCE]
+//! cargo run --release -p vdlod-demo --example first_frames -- [TOLERANCE [EVICT_MB]]
 //! ```
 //!
 //! Tolerance in pixels (1); `QRefine`, no budget, no geomorphs. The 20 views are refined twice
-//! and the second pass timed. For instruction counts: `valgrind --tool=callgrind
-//! --toggle-collect='first_frames::refine_all' target/release/examples/first_frames 1`, divided
+//! and the second pass timed. With `EVICT_MB`, that many megabytes are written and read before
+//! each view, untimed, so that each first frame starts from cold caches, as the bench's does
+//! after the peer has run. For instruction counts: `valgrind --tool=callgrind
+//! --toggle-collect='first_frames::refine' target/release/examples/first_frames 1`, divided
 //! by 40 times `splits_per_view` (two passes over the 20 views).
 
 use std::time::Instant;
@@ -25,22 +27,43 @@ type BunnyCut = Cut<16384, 32768, 2048>;
 
 /// Refines each view from the base mesh; the splits done.
 #[inline(never)]
-fn refine_all(cut: &mut BunnyCut, h: &HierarchyView<'_>, views: &[View], policy: &QRefine) -> u64 {
-    let mut splits = 0;
-    for view in views {
-        if cut.reset(h).is_err() {
-            return splits;
-        }
-        splits += u64::from(cut.adapt(h, view, policy, &Budget::default()).vsplits);
+fn refine(cut: &mut BunnyCut, h: &HierarchyView<'_>, view: &View, policy: &QRefine) -> u64 {
+    if cut.reset(h).is_err() {
+        return 0;
     }
-    splits
+    u64::from(cut.adapt(h, view, policy, &Budget::default()).vsplits)
+}
+
+/// Refines each view from the base mesh after sweeping `sweep` through the caches; the splits
+/// done and the time they took (the sweeps left out).
+fn refine_all(
+    cut: &mut BunnyCut,
+    h: &HierarchyView<'_>,
+    views: &[View],
+    policy: &QRefine,
+    sweep: &mut [u8],
+) -> (u64, f64) {
+    let (mut splits, mut seconds) = (0, 0.0);
+    for view in views {
+        if !sweep.is_empty() {
+            sweep.iter_mut().for_each(|b| *b = b.wrapping_add(1));
+            std::hint::black_box(sweep.iter().fold(0u8, |a, &b| a ^ b));
+        }
+        let start = Instant::now();
+        splits += refine(cut, h, view, policy);
+        seconds += start.elapsed().as_secs_f64();
+    }
+    (splits, seconds)
 }
 
 fn main() -> Result<(), String> {
-    let tolerance: f32 = match std::env::args().nth(1) {
-        Some(s) => s.parse().map_err(|_| format!("not a number: {s}"))?,
-        None => 1.0,
+    let number = |k: usize, default: f32| -> Result<f32, String> {
+        std::env::args().nth(k).map_or(Ok(default), |s| {
+            s.parse().map_err(|_| format!("not a number: {s}"))
+        })
     };
+    let tolerance = number(1, 1.0)?;
+    let mut sweep = vec![0u8; (number(2, 0.0)? * 1e6) as usize];
     let mesh = load_obj_bytes(BUNNY_NAME, BUNNY_OBJ).map_err(|e| e.to_string())?;
     let (_, bytes, _) =
         build_with_progress(&mesh, &Default::default(), false).map_err(|e| e.to_string())?;
@@ -49,10 +72,9 @@ fn main() -> Result<(), String> {
     let views: Vec<View> = (0..20).map(|i| orbit.camera(i * 10).view()).collect();
     let policy = QRefine::new(tolerance);
     let mut cut = BunnyCut::boxed();
-    refine_all(&mut cut, &h, &views, &policy);
-    let start = Instant::now();
-    let splits = refine_all(&mut cut, &h, &views, &policy);
-    let us = start.elapsed().as_secs_f64() * 1e6;
+    refine_all(&mut cut, &h, &views, &policy, &mut sweep);
+    let (splits, seconds) = refine_all(&mut cut, &h, &views, &policy, &mut sweep);
+    let us = seconds * 1e6;
     println!(
         "tolerance={tolerance} views={} splits_per_view={} us_per_view={:.0} ns_per_split={:.0}",
         views.len(),
