@@ -962,7 +962,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 continue;
             }
             if !blending && frames > 0 && seen {
-                if self.blends.len() + 2 <= Q {
+                if self.blends.len() + 2 <= Self::BLEND_ROOM {
                     self.start_blend(h, a, true);
                     self.start_blend(h, b, true);
                     continue;

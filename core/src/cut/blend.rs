@@ -236,6 +236,10 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         self.v.flags[s] &= !(BLENDING | COLLAPSING);
         if let Some(b) = self.blends.as_mut_slice().get_mut(k) {
             *b = entry;
+        } else if Q > Self::BLEND_ROOM && self.blends.len() >= Self::BLEND_ROOM {
+            // (Only a cut whose arena outgrows what a tag can name checks: for the others a
+            // full arena is this limit, and the push below refuses.)
+            return false;
         } else {
             match self.blends.push(entry) {
                 Ok(k) => self.v.set_blend(s, k),

@@ -30,17 +30,19 @@
 //!
 //! | per | bytes | what |
 //! |---|---|---|
-//! | vertex slot | `4 + 3i + 3 + 8` (21 with `u16`) | node, fan triangle, mate, tag (blend entry while blending, expiry while settled); triangle count (`u16`) and flags (`u8`); the node's [`crate::format::Digest`] (quantized position and two bound codes: most frames decide a vertex from it without reading the file) |
+//! | vertex slot | `4 + 2i + 2 + 3 + 8` (21 with `u16`, 25 with `u32`) | node, fan triangle, mate; a 16-bit tag (blend entry while blending, expiry while settled); triangle count (`u16`) and flags (`u8`); the node's [`crate::format::Digest`] (quantized position and two bound codes: most frames decide a vertex from it without reading the file) |
 //! | triangle slot | `6i + 4 + i` (18 with `u16`) | corners, neighbours, id; one node-map entry |
 //! | queue entry | `4 + 8 + 12 + 28 = 52` | forcing stack, split heap, collapse pairs, blend arena |
 //!
 //! plus 368 bytes of lengths, settings, the walk's position, the chain of vertex slots a
 //! frame's collapses freed and the terms the settled vertices were marked under (`expiry`).
 //! With the recommended `F = 2 V` and `Q = V / 8` that is 21 + 36 + 6.5 = 63.5 bytes per vertex
-//! slot, **31.75 bytes per triangle of capacity** with `u16` (48.75 with `u32`), 32.09 for a
+//! slot, **31.75 bytes per triangle of capacity** with `u16` (47.75 with `u32`), 32.09 for a
 //! 1,000-triangle cut. A cut for a 10,000-triangle budget, `Cut<5000, 10000, 625>`, is 317,868
 //! bytes. The queues only bound how much one frame can do: when one overflows, the rest
-//! waits for the next frame and [`crate::adapt::FrameStats`] says so.
+//! waits for the next frame and [`crate::adapt::FrameStats`] says so. (At most 65,535
+//! geomorphs run at once, whatever `Q`, since a vertex names its blend entry in 16 bits; past
+//! that, changes land without a blend.)
 //!
 //! [`Cut::new`] is `const` and all zeros, so `static CUT: Mutex<RefCell<Cut<..>>>` lands in
 //! `.bss` and never passes through the stack; `Cut::boxed` (feature `build`) puts one on the heap
@@ -319,6 +321,14 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
     /// Bytes of memory the cut occupies: the arenas and queues, nothing else (it allocates
     /// nothing). See the module documentation for the formula.
     pub const BYTES: usize = core::mem::size_of::<Self>();
+
+    /// Blends that can run at once: the queue capacity, up to what a vertex's 16-bit tag can
+    /// name.
+    pub(crate) const BLEND_ROOM: usize = if Q < store::BLEND_ROOM {
+        Q
+    } else {
+        store::BLEND_ROOM
+    };
 
     /// Fails to compile when a capacity does not fit the index type.
     const CAPACITY_FITS: () = assert!(

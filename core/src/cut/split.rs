@@ -176,7 +176,8 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             count,
         } = *plan;
         let second = wr != NIL;
-        let start = (frames > 0 && self.blends.len() + 2 <= Q).then(|| self.vertex(h, ps as usize));
+        let start = (frames > 0 && self.blends.len() + 2 <= Self::BLEND_ROOM)
+            .then(|| self.vertex(h, ps as usize));
         // Room was proven: the vertex arena has a slot, and the node map takes the second child
         // because the first replaces the parent's entry.
         self.reassign(ps as usize, c0);

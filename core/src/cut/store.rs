@@ -1,10 +1,10 @@
 //! The cut's vertex and triangle tables: structure-of-arrays records with one length each, and
 //! the only code that appends, moves or drops a record.
 //!
-//! A vertex record is 21 bytes with 16-bit slots: its node (`u32`), one triangle of its fan, its
-//! triangle count, its sibling's slot when both are active ("mate"), a tag (its geomorph's
-//! entry in the blend arena while it blends, the motion at which its answers expire while it
-//! is settled: it is never both), a flag byte, and the node's 8-byte [`Digest`] (quantized
+//! A vertex record is 21 bytes with 16-bit slots (25 with 32-bit ones): its node (`u32`), one triangle of its fan, its
+//! triangle count, its sibling's slot when both are active ("mate"), a 16-bit tag (its
+//! geomorph's entry in the blend arena while it blends, the motion at which its answers expire
+//! while it is settled: it is never both), a flag byte, and the node's 8-byte [`Digest`] (quantized
 //! position and two bound codes), with which the per-frame pass skips most vertices without
 //! reading the file. Normals,
 //! colours and the rest of the bounds are not stored: they are read from the hierarchy in place
@@ -19,6 +19,9 @@ use super::renumber::scatter;
 use super::slot::{load3, store3, SlotIndex};
 use super::{first_of, BLENDING, COLLAPSING, NIL, RESTLESS, SETTLED};
 use crate::format::Digest;
+
+/// Blend entries a tag can name: its all-ones value is `NIL`.
+pub(crate) const BLEND_ROOM: usize = u16::MAX as usize;
 
 /// `a[k]` (`k < 3`), picked in registers: the three are loaded before `k` is known, so that
 /// their load does not wait for it.
@@ -38,8 +41,10 @@ pub(crate) struct Vertices<const V: usize, I: SlotIndex> {
     /// the cut safe from hierarchies crafted to contradict the mesh).
     pub degree: [u16; V],
     mate: [I; V],
-    /// The blend entry while `BLENDING` or `COLLAPSING`, the expiry while `SETTLED`.
-    tag: [I; V],
+    /// The blend entry while `BLENDING` or `COLLAPSING`, the expiry while `SETTLED`: 16 bits
+    /// whatever the slot index, since an expiry fits them and blend entries stay below
+    /// [`BLEND_ROOM`] (a 32-bit cut's walk then scans half the bytes).
+    tag: [u16; V],
     pub flags: [u8; V],
     /// What the per-frame pass needs of the node without reading the file (see [`Digest`]).
     pub digest: [Digest; V],
@@ -53,7 +58,7 @@ impl<const V: usize, I: SlotIndex> Vertices<V, I> {
             fan: [I::ZERO; V],
             degree: [0; V],
             mate: [I::ZERO; V],
-            tag: [I::ZERO; V],
+            tag: [0; V],
             flags: [0; V],
             digest: [Digest::ZERO; V],
         }
@@ -115,11 +120,12 @@ impl<const V: usize, I: SlotIndex> Vertices<V, I> {
         }
     }
 
-    /// Makes `b` slot `s`'s blend entry (the caller sets `BLENDING`); it is no longer settled.
+    /// Makes `b` (below [`BLEND_ROOM`]) slot `s`'s blend entry (the caller sets `BLENDING`);
+    /// it is no longer settled.
     #[inline(always)]
     pub fn set_blend(&mut self, s: usize, b: u32) {
         if let (Some(x), Some(f)) = (self.tag.get_mut(s), self.flags.get_mut(s)) {
-            *x = I::store(b);
+            *x = <u16 as SlotIndex>::store(b);
             *f &= !SETTLED;
         }
     }
@@ -128,7 +134,7 @@ impl<const V: usize, I: SlotIndex> Vertices<V, I> {
     /// the count's bit (see `super::expiry::lives`).
     #[inline(always)]
     pub fn expiry(&self, s: usize) -> u32 {
-        self.tag[s].index() as u32
+        u32::from(self.tag[s])
     }
 
     /// Marks slot `s` as its measured margins say: settled until the motion passes the
@@ -144,7 +150,7 @@ impl<const V: usize, I: SlotIndex> Vertices<V, I> {
                 Mark::Restless => (false, 0),
             };
             let restless = u8::from(mark == Mark::Restless) * RESTLESS;
-            *x = if settles { I::store(until) } else { *x };
+            *x = if settles { until as u16 } else { *x };
             *f = if settles {
                 (*f & !RESTLESS) | SETTLED
             } else {
@@ -171,14 +177,14 @@ impl<const V: usize, I: SlotIndex> Vertices<V, I> {
         for (c, (f, x)) in fs.zip(xs).enumerate() {
             let f = u64::from_le_bytes(core::array::from_fn(|k| f[k]));
             let late = u64::from_le_bytes(core::array::from_fn(|k| {
-                u8::from(lives(x[k].index() as u32, now))
+                u8::from(lives(u32::from(x[k]), now))
             }));
             let lanes = (f >> SETTLED.trailing_zeros()) & ONES & late;
             bits |= gathered(lanes) << (8 * c);
         }
         for (k, (f, x)) in rest.enumerate() {
             let k = count / 8 * 8 + k;
-            bits |= usize::from((f & SETTLED != 0) & lives(x.index() as u32, now)) << k;
+            bits |= usize::from((f & SETTLED != 0) & lives(u32::from(*x), now)) << k;
         }
         bits
     }
@@ -199,11 +205,11 @@ impl<const V: usize, I: SlotIndex> Vertices<V, I> {
             if *f & SETTLED == 0 {
                 continue;
             }
-            let tag = x.index() as u32;
+            let tag = u32::from(*x);
             let (count, e) = (tag & TURNING, tag & !TURNING);
             let k = usize::from(count != 0);
             match e.checked_sub(by[k]) {
-                Some(e) if e >= now[k] => *x = I::store(count | e),
+                Some(e) if e >= now[k] => *x = (count | e) as u16,
                 _ => *f &= !SETTLED,
             }
         }
@@ -227,7 +233,7 @@ impl<const V: usize, I: SlotIndex> Vertices<V, I> {
         self.fan[s] = I::store(NIL);
         self.degree[s] = 0;
         self.mate[s] = I::store(NIL);
-        self.tag[s] = I::store(NIL);
+        self.tag[s] = u16::MAX;
         self.flags[s] = flags;
     }
 
@@ -492,7 +498,7 @@ fn gathered(bytes: u64) -> usize {
 /// their bytes gathered eight at a time as there. `None` when it does not apply.
 #[cfg(any(target_arch = "x86_64", target_arch = "aarch64"))]
 #[inline(always)]
-fn settled_word<I: SlotIndex>(flags: &[u8], tags: &[I], now: [u32; 2]) -> Option<usize> {
+fn settled_word(flags: &[u8], tags: &[u16], now: [u32; 2]) -> Option<usize> {
     let count = flags.len();
     let thresholds = [now[0], TURNING.saturating_add(now[1])].map(u16::try_from);
     let ([Ok(t0), Ok(t1)], true) = (thresholds, count == usize::BITS as usize) else {
@@ -502,7 +508,7 @@ fn settled_word<I: SlotIndex>(flags: &[u8], tags: &[I], now: [u32; 2]) -> Option
     let mut lanes = [0u8; 64];
     for ((l, &f), &x) in lanes.iter_mut().zip(flags).zip(tags) {
         // `lives` in 16 bits (as `lives` on 32-bit lanes, the frame takes 0.5% more).
-        let t = x.index() as u16;
+        let t = x;
         let threshold = t0 ^ (d & (t >> 15).wrapping_neg());
         *l = ((f >> SETTLED.trailing_zeros()) & 1) & u8::from(t >= threshold);
     }
@@ -518,7 +524,7 @@ fn settled_word<I: SlotIndex>(flags: &[u8], tags: &[I], now: [u32; 2]) -> Option
 /// [`Vertices::settled_until`]: never applies.
 #[cfg(not(any(target_arch = "x86_64", target_arch = "aarch64")))]
 #[inline(always)]
-fn settled_word<I: SlotIndex>(_: &[u8], _: &[I], _: [u32; 2]) -> Option<usize> {
+fn settled_word(_: &[u8], _: &[u16], _: [u32; 2]) -> Option<usize> {
     None
 }
 

@@ -242,13 +242,14 @@ fn refusals_leave_the_cut_as_it_was() {
 
 #[test]
 fn the_size_is_what_the_documentation_says() {
-    // With index size i: 15 + 3i bytes per vertex slot (with its 8-byte digest), 7i + 4 per
+    // With index size i: 17 + 2i bytes per vertex slot (with its 8-byte digest and 16-bit
+    // tag), 7i + 4 per
     // triangle slot (with its node-map entry), 52 per queue entry, plus 368 bytes (lengths,
     // settings, the walk's position, the freed slots' chain and the terms the settled vertices
     // were marked under); the
     // same on 32- and 64-bit targets.
     let per =
-        |i: usize, v: usize, f: usize, q: usize| (15 + 3 * i) * v + (7 * i + 4) * f + 52 * q + 368;
+        |i: usize, v: usize, f: usize, q: usize| (17 + 2 * i) * v + (7 * i + 4) * f + 52 * q + 368;
     assert_eq!(Cut::<1024, 2048, 128>::BYTES, per(2, 1024, 2048, 128));
     assert_eq!(Cut::<5120, 10240, 640>::BYTES, per(2, 5120, 10240, 640));
     assert_eq!(Cut::<1024, 2048, 128, u32>::BYTES, per(4, 1024, 2048, 128));
@@ -900,7 +901,7 @@ fn the_budget_table_of_docs_runtime() {
 #[test]
 fn the_figures_of_the_benchmark_cuts_in_docs_runtime() {
     assert_eq!(Cut::<16384, 32768, 2048>::BYTES, 1_040_752);
-    assert_eq!(Cut::<262144, 524288, 32768, u32>::BYTES, 25_559_408);
+    assert_eq!(Cut::<262144, 524288, 32768, u32>::BYTES, 25_035_120);
 }
 
 #[test]
@@ -948,4 +949,31 @@ fn the_tag_is_the_blend_entry_or_the_expiry_never_both() {
     assert_eq!((v.flags[1] & SETTLED, v.expiry(1)), (SETTLED, 3_616));
     v.unsettle_all();
     assert!(v.flags[..4].iter().all(|f| f & (SETTLED | RESTLESS) == 0));
+}
+
+#[test]
+fn blends_stop_where_a_sixteen_bit_tag_can_no_longer_name_them() {
+    // A 32-bit cut whose queues hold more entries than a vertex's 16-bit tag can name: past
+    // 65,535 running blends a new one is refused (the change then lands unblended), never
+    // stored under a truncated entry.
+    type Wide = Cut<64, 128, 70_000, u32>;
+    assert_eq!(Wide::BLEND_ROOM, 65_535);
+    assert_eq!(Cut::<64, 128, 8>::BLEND_ROOM, 8);
+    let (p, t) = grid(4);
+    let bytes = build_it(&p, &t, BuildOptions::default()).to_bytes(false);
+    let h = HierarchyView::parse(&bytes).unwrap();
+    let mut cut: Box<Wide> = Cut::boxed();
+    cut.reset(&h).unwrap();
+    cut.set_geomorph_frames(4);
+    // Fill the arena up to the last entry a tag can name, as if that many blends ran.
+    while cut.blends.len() < Wide::BLEND_ROOM - 1 {
+        cut.blends.push(blend::Blend::ZERO).unwrap();
+    }
+    // The last one that fits is taken and named exactly; the next is refused.
+    assert!(cut.start_blend(&h, 0, false));
+    assert_eq!(cut.v.blend(0), 65_534);
+    assert!(!cut.start_blend(&h, 1, false));
+    assert_eq!(cut.v.blend(1), NIL);
+    assert_eq!(cut.v.flags[1] & (BLENDING | COLLAPSING), 0);
+    assert_eq!(cut.blends.len(), Wide::BLEND_ROOM);
 }
