@@ -1,16 +1,16 @@
 //! The cut's vertex and triangle tables: structure-of-arrays records with one length each, and
 //! the only code that appends, moves or drops a record.
 //!
-//! A vertex record is 21 bytes with 16-bit slots (25 with 32-bit ones): its node (`u32`), one triangle of its fan, its
-//! triangle count, its sibling's slot when both are active ("mate"), a 16-bit tag (its
-//! geomorph's entry in the blend arena while it blends, the motion at which its answers expire
-//! while it is settled: it is never both), a flag byte, and the node's 8-byte [`Digest`] (quantized
-//! position and two bound codes), with which the per-frame pass skips most vertices without
-//! reading the file. Normals,
-//! colours and the rest of the bounds are not stored: they are read from the hierarchy in place
-//! ([`super::Cut::vertex`]), except for vertices in a geomorph. A
-//! triangle record is 16 bytes: three corner slots, the three neighbouring triangles' slots
-//! (across edges `t[k] -> t[k + 1]`) and its id in the hierarchy's numbering.
+//! A vertex record is 21 bytes with 16-bit slots (25 with 32-bit ones): its node (`u32`), one
+//! triangle of its fan, its triangle count, its sibling's slot when both are active ("mate"),
+//! a 16-bit tag (its geomorph's entry in the blend arena while it blends, the motion at which
+//! its answers expire while it is settled: it is never both), a flag byte, and the node's
+//! 8-byte [`Digest`] (quantized position and two bound codes), with which the per-frame pass
+//! skips most vertices without reading the file. Normals, colours and the rest of the bounds
+//! are not stored: they are read from the hierarchy in place ([`super::Cut::vertex`]), except
+//! for vertices in a geomorph. A triangle record is 16 bytes: three corner slots, the three
+//! neighbouring triangles' slots (across edges `t[k] -> t[k + 1]`) and its id in the
+//! hierarchy's numbering.
 
 use core::hint::select_unpredictable;
 
@@ -506,9 +506,8 @@ fn settled_word(flags: &[u8], tags: &[u16], now: [u32; 2]) -> Option<usize> {
     };
     let d = t0 ^ t1;
     let mut lanes = [0u8; 64];
-    for ((l, &f), &x) in lanes.iter_mut().zip(flags).zip(tags) {
+    for ((l, &f), &t) in lanes.iter_mut().zip(flags).zip(tags) {
         // `lives` in 16 bits (as `lives` on 32-bit lanes, the frame takes 0.5% more).
-        let t = x;
         let threshold = t0 ^ (d & (t >> 15).wrapping_neg());
         *l = ((f >> SETTLED.trailing_zeros()) & 1) & u8::from(t >= threshold);
     }
