@@ -44,11 +44,8 @@ fn refine_all(
     sweep: &mut [u8],
 ) -> (u64, f64) {
     let (mut splits, mut seconds) = (0, 0.0);
-    for view in views {
-        if !sweep.is_empty() {
-            sweep.iter_mut().for_each(|b| *b = b.wrapping_add(1));
-            std::hint::black_box(sweep.iter().fold(0u8, |a, &b| a ^ b));
-        }
+    for (i, view) in views.iter().enumerate() {
+        vdlod_demo::sweep_caches(sweep, i as u8);
         let start = Instant::now();
         splits += refine(cut, h, view, policy);
         seconds += start.elapsed().as_secs_f64();

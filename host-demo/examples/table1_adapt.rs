@@ -71,10 +71,7 @@ fn main() -> Result<(), String> {
     let (mut visited, mut settled, mut ops) = (0u64, 0u64, 0u64);
     let mut adapting = std::time::Duration::ZERO;
     for (i, view) in views[1..].iter().enumerate() {
-        if !sweep.is_empty() {
-            sweep.fill(i as u8);
-            std::hint::black_box(sweep.iter().fold(0u8, |a, &b| a ^ b));
-        }
+        vdlod_demo::sweep_caches(&mut sweep, i as u8);
         let start = Instant::now();
         let s = cut.adapt(&h, view, &policy, &Budget::default());
         adapting += start.elapsed();

@@ -37,3 +37,17 @@ pub fn summary_value<T: std::str::FromStr>(line: &str, key: &str) -> Option<T> {
         .find_map(|kv| kv.strip_prefix(key)?.strip_prefix('='))
         .and_then(|v| v.parse().ok())
 }
+
+/// Writes `pass` over all of `buffer` and reads it back, as a frame's drawing would between two
+/// adaptations: a profiling example that sweeps a buffer larger than the caches before a timed
+/// call sees that call start cold.
+///
+/// ```
+/// let mut buffer = vec![0u8; 1 << 16];
+/// vdlod_demo::sweep_caches(&mut buffer, 3);
+/// assert!(buffer.iter().all(|&b| b == 3));
+/// ```
+pub fn sweep_caches(buffer: &mut [u8], pass: u8) {
+    buffer.fill(pass);
+    std::hint::black_box(buffer.iter().fold(0u8, |a, &b| a ^ b));
+}

@@ -205,6 +205,11 @@ pub struct FrameTimes {
     pub full: f64,
 }
 
+/// One of `frames`' times, frame by frame.
+fn column(frames: &[FrameTimes], time: fn(&FrameTimes) -> f64) -> Vec<f64> {
+    frames.iter().map(time).collect()
+}
+
 impl Row {
     /// Full detail's median frame over the adapted frame's.
     pub fn speedup(&self) -> f64 {
@@ -310,8 +315,8 @@ fn fly(
             orbit.frames, stats.triangles, stats.vsplits, stats.ecols, stats.visited, stats.settled
         );
     }
-    let of = |f: fn(&FrameTimes) -> f64| frames.iter().map(f).collect::<Vec<f64>>();
-    let renumber_ms = mean(of(|f| f.renumber).into_iter());
+    let of = |f: fn(&FrameTimes) -> f64| column(&frames, f);
+    let renumber_ms = mean(frames.iter().map(|f| f.renumber));
     Ok(Row {
         size,
         triangles: mean(tris.into_iter()),
@@ -352,7 +357,7 @@ fn chart_frames(rows: &[Vec<Row>], degrees: f64) -> Result<Vec<u8>, String> {
             .get(k)
             .and_then(|r| r.first())
             .map_or(&[][..], |r| &r.frames);
-        let series = |f: fn(&FrameTimes) -> f64| frames.iter().map(f).collect::<Vec<f64>>();
+        let series = |f: fn(&FrameTimes) -> f64| column(frames, f);
         chart::Panel {
             title: vec![
                 (heads[k].as_str(), ink),

@@ -324,10 +324,10 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
 
     /// Blends that can run at once: the queue capacity, up to what a vertex's 16-bit tag can
     /// name.
-    pub(crate) const BLEND_ROOM: usize = if Q < store::BLEND_ROOM {
+    pub(crate) const BLEND_ROOM: usize = if Q < store::NAMEABLE_BLENDS {
         Q
     } else {
-        store::BLEND_ROOM
+        store::NAMEABLE_BLENDS
     };
 
     /// Fails to compile when a capacity does not fit the index type.

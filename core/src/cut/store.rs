@@ -21,7 +21,7 @@ use super::{first_of, BLENDING, COLLAPSING, NIL, RESTLESS, SETTLED};
 use crate::format::Digest;
 
 /// Blend entries a tag can name: its all-ones value is `NIL`.
-pub(crate) const BLEND_ROOM: usize = u16::MAX as usize;
+pub(crate) const NAMEABLE_BLENDS: usize = u16::MAX as usize;
 
 /// `a[k]` (`k < 3`), picked in registers: the three are loaded before `k` is known, so that
 /// their load does not wait for it.
@@ -43,7 +43,7 @@ pub(crate) struct Vertices<const V: usize, I: SlotIndex> {
     mate: [I; V],
     /// The blend entry while `BLENDING` or `COLLAPSING`, the expiry while `SETTLED`: 16 bits
     /// whatever the slot index, since an expiry fits them and blend entries stay below
-    /// [`BLEND_ROOM`] (a 32-bit cut's walk then scans half the bytes).
+    /// [`NAMEABLE_BLENDS`] (a 32-bit cut's walk then scans half the bytes).
     tag: [u16; V],
     pub flags: [u8; V],
     /// What the per-frame pass needs of the node without reading the file (see [`Digest`]).
@@ -120,7 +120,7 @@ impl<const V: usize, I: SlotIndex> Vertices<V, I> {
         }
     }
 
-    /// Makes `b` (below [`BLEND_ROOM`]) slot `s`'s blend entry (the caller sets `BLENDING`);
+    /// Makes `b` (below [`NAMEABLE_BLENDS`]) slot `s`'s blend entry (the caller sets `BLENDING`);
     /// it is no longer settled.
     #[inline(always)]
     pub fn set_blend(&mut self, s: usize, b: u32) {
