@@ -456,12 +456,13 @@ impl<'o> Engine<'o> {
         // higher for 0.3% more instructions; with a 32nd the first purges leave too little and
         // it grows (a realloc: old and new room at once).
         e.queue.reserve(edges + edges / 8);
+        // Each edge once, from its lower end: a sorted ring's higher neighbours are its tail
+        // (read in place, not looked up again for each edge; slots are still vertex ids).
         for v in 0..n as u32 {
-            for k in 0..e.lists.ring(v as usize).len() {
-                let x = e.lists.ring(v as usize)[k];
-                if v < x {
-                    e.push(v, x);
-                }
+            let ring = e.lists.ring(v as usize);
+            for &x in &ring[ring.partition_point(|&x| x < v)..] {
+                let key = e.key(v, x);
+                e.queue.push(key, (v, x));
             }
         }
         e
@@ -574,9 +575,13 @@ impl<'o> Engine<'o> {
 
     fn push(&mut self, a: u32, b: u32) {
         let (a, b) = (a.min(b), a.max(b));
-        let (_, cost) = self.evaluate(a, b);
         // Ties go to the earlier push.
-        self.queue.push(cost_key(cost), (a, b));
+        self.queue.push(self.key(a, b), (a, b));
+    }
+
+    /// The queue's key for edge `a-b` ([`cost_key`] of its cost).
+    fn key(&self, a: u32, b: u32) -> u32 {
+        cost_key(self.evaluate(a, b).1)
     }
 
     /// Whether collapsing `a-b` into `v` keeps the mesh a manifold of the same topology with no
