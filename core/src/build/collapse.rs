@@ -13,7 +13,7 @@ use alloc::vec::Vec;
 use super::chunks::Chunks;
 use super::closest::Surface;
 use super::flatten::{flatten, PlanarCollapse};
-use super::lists::{faces_in, ring_in, Lists};
+use super::lists::{faces_in, ring_in, In, Lists, Merged};
 use super::positions::Positions;
 use super::quadric::{place, Quadric};
 use super::queue::CostQueue;
@@ -754,6 +754,25 @@ impl<'o> Engine<'o> {
         }
     }
 
+    /// Removes face `f`, which holds `a` and `b`, from the mesh and from its third corner's faces.
+    fn remove_face(&mut self, f: u32, (a, b): (u32, u32)) {
+        let (Some(t), Some(alive)) = (
+            self.faces.get(f as usize),
+            self.face_alive.get_mut(f as usize),
+        ) else {
+            return;
+        };
+        *alive = false;
+        let third = t
+            .iter()
+            .copied()
+            .find(|&x| x != a && x != b)
+            .unwrap_or(NONE);
+        if let Some(&l) = self.slot.get(third as usize) {
+            self.lists.remove_face(l as usize, f);
+        }
+    }
+
     /// Collapses `a-b` into a new vertex at `v`; `wings` are the third corners of the faces with
     /// directed edges `a -> b` and `b -> a` ([`Engine::edge_faces`]).
     fn collapse(&mut self, a: u32, b: u32, v: Vec3d, wings: [u32; 2]) {
@@ -789,33 +808,23 @@ impl<'o> Engine<'o> {
         let mut pf = core::mem::take(&mut self.scratch_faces);
         pf.clear();
         let (la, lb) = (self.lists.take(sa), self.lists.take(sb));
-        for (s, list) in [(a, faces_in(&la)), (b, faces_in(&lb))] {
-            for &f in list {
-                let t = &mut self.faces[f as usize];
-                if t.contains(&a) && t.contains(&b) {
-                    if self.face_alive[f as usize] {
-                        self.face_alive[f as usize] = false;
-                        let third = t
-                            .iter()
-                            .copied()
-                            .find(|&x| x != a && x != b)
-                            .unwrap_or(NONE);
-                        if let Some(&l) = self.slot.get(third as usize) {
-                            self.lists.remove_face(l as usize, f);
-                        }
-                    }
+        // Both face lists are sorted, and a face is in both exactly when it holds both ends (a
+        // face is listed by each of its corners): walked together, they give p's faces sorted,
+        // with no sort, and the faces to remove without a search of their corners.
+        for (f, side) in Merged::new(faces_in(&la), faces_in(&lb)) {
+            let s = match side {
+                In::First => a,
+                In::Second => b,
+                In::Both => {
+                    self.remove_face(f, (a, b));
                     continue;
                 }
-                for x in t.iter_mut() {
-                    if *x == s {
-                        *x = p;
-                    }
-                }
-                pf.push(f);
+            };
+            if let Some(t) = self.faces.get_mut(f as usize) {
+                *t = t.map(|x| if x == s { p } else { x });
             }
+            pf.push(f);
         }
-        pf.sort_unstable();
-        pf.dedup();
         if self.opts.bound != ErrorBound::Offset {
             self.fans.extend(pf.iter().map(|&f| self.faces[f as usize]));
             self.fan_ends.push(self.fans.len() as u32);
@@ -833,44 +842,22 @@ impl<'o> Engine<'o> {
         });
         self.rejected.take(a);
         self.rejected.take(b);
-        // The ring of p: both rings but a and b. Its members swap a and b for p, which as the
-        // newest vertex goes last and keeps their rings sorted.
-        // Both rings are sorted: one merge makes p's, sorted.
+        // The ring of p: both rings but a and b, sorted as both are, in one walk of both. Its
+        // members swap a and b (or the one they hold) for p, which as the newest vertex goes
+        // last and keeps their rings sorted.
         let mut ring = core::mem::take(&mut self.scratch_ring);
         ring.clear();
-        let (ra, rb) = (ring_in(&la), ring_in(&lb));
-        let (mut i, mut j) = (0, 0);
-        loop {
-            let x = match (ra.get(i), rb.get(j)) {
-                (Some(&x), Some(&y)) if x < y => {
-                    i += 1;
-                    x
-                }
-                (Some(&x), Some(&y)) if y < x => {
-                    j += 1;
-                    y
-                }
-                (Some(&x), Some(_)) => {
-                    i += 1;
-                    j += 1;
-                    x
-                }
-                (Some(&x), None) => {
-                    i += 1;
-                    x
-                }
-                (None, Some(&y)) => {
-                    j += 1;
-                    y
-                }
-                (None, None) => break,
-            };
-            if x != a && x != b {
-                ring.push(x);
+        for (x, side) in Merged::new(ring_in(&la), ring_in(&lb)) {
+            if x == a || x == b {
+                continue;
             }
-        }
-        for &x in &ring {
-            self.lists.swap_in_ring(self.at(x), (a, b), p);
+            let s = self.at(x);
+            match side {
+                In::First => self.lists.replace_in_ring(s, a, p),
+                In::Second => self.lists.replace_in_ring(s, b, p),
+                In::Both => self.lists.swap_in_ring(s, (a, b), p),
+            }
+            ring.push(x);
         }
         self.lists.set(sa, &pf, &ring);
         drop((la, lb));

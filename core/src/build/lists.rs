@@ -35,6 +35,71 @@ pub(crate) fn ring_in(l: &[u32]) -> &[u32] {
     }
 }
 
+/// The ring of lists `l`, to change in place; `None` when `l` holds none.
+#[inline]
+fn ring_in_mut(l: &mut [u32]) -> Option<&mut [u32]> {
+    match l {
+        [f, r, rest @ ..] => {
+            let start = *f as usize;
+            rest.get_mut(start..start + *r as usize)
+        }
+        _ => None,
+    }
+}
+
+/// Where an id of [`Merged`] is: in the first list, the second, or both.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+pub(crate) enum In {
+    First,
+    Second,
+    Both,
+}
+
+/// The ids of two sorted lists without repeats, in order and once each, with the lists they are
+/// in: one walk of both gives a collapse's faces and ring in the order a sort would, and which
+/// end each came from (read off slices, with no bounds check apiece).
+pub(crate) struct Merged<'l> {
+    first: &'l [u32],
+    second: &'l [u32],
+}
+
+impl<'l> Merged<'l> {
+    pub fn new(first: &'l [u32], second: &'l [u32]) -> Merged<'l> {
+        Merged { first, second }
+    }
+}
+
+impl Iterator for Merged<'_> {
+    type Item = (u32, In);
+
+    #[inline]
+    fn next(&mut self) -> Option<(u32, In)> {
+        match (self.first.split_first(), self.second.split_first()) {
+            (Some((&x, xs)), Some((&y, ys))) => {
+                if x < y {
+                    self.first = xs;
+                    Some((x, In::First))
+                } else if y < x {
+                    self.second = ys;
+                    Some((y, In::Second))
+                } else {
+                    (self.first, self.second) = (xs, ys);
+                    Some((x, In::Both))
+                }
+            }
+            (Some((&x, xs)), None) => {
+                self.first = xs;
+                Some((x, In::First))
+            }
+            (None, Some((&y, ys))) => {
+                self.second = ys;
+                Some((y, In::Second))
+            }
+            (None, None) => None,
+        }
+    }
+}
+
 /// Lists holding `faces` and `ring`, at their exact length.
 fn made(faces: &[u32], ring: &[u32]) -> Box<[u32]> {
     let mut l = Vec::with_capacity(2 + faces.len() + ring.len());
@@ -106,6 +171,29 @@ impl Lists {
         // The faces after it and the whole ring move down one.
         l.copy_within(2 + k + 1..2 + nf + nr, 2 + k);
         l[0] -= 1;
+    }
+
+    /// In slot `s`'s ring, replaces `old` by `p`, which is larger than every id in it and so goes
+    /// last. A collapse's neighbour of only one end has that end alone in its ring: one walk
+    /// from the end shifts what follows `old` down onto it (a search for either of two ids,
+    /// and a filter of the rest for either, took half as many instructions again).
+    pub fn replace_in_ring(&mut self, s: usize, old: u32, p: u32) {
+        let Some(ring) = self.slots.get_mut(s).and_then(|l| ring_in_mut(l)) else {
+            return;
+        };
+        debug_assert!(
+            ring.contains(&old),
+            "a ring of the collapsing pair holds one of it"
+        );
+        // From the end down to `old`, each id takes the place of the one before it.
+        let mut next = p;
+        for x in ring.iter_mut().rev() {
+            let here = core::mem::replace(x, next);
+            if here == old {
+                break;
+            }
+            next = here;
+        }
     }
 
     /// In slot `s`'s ring, replaces `a` and `b` by `p`, which is larger than every id in it
