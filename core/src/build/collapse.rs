@@ -321,35 +321,66 @@ pub(crate) fn edge_wings(faces: &[[u32; 3]], around: &[u32], a: u32, b: u32) -> 
 pub(crate) fn split_faces(
     faces: &[[u32; 3]],
     around: [&[u32]; 2],
-    [c0, c1]: [u32; 2],
-    [w0, w1]: [u32; 2],
+    children: [u32; 2],
+    wings: [u32; 2],
 ) -> ([u32; 2], [u32; 4]) {
-    let (mut on_edge, mut neighbours) = ([NONE; 2], [NONE; 4]);
+    let mut split = Split::new(children, wings);
+    // Each end's walk on its own, so that `end` is a constant in each.
     for &f in around[0] {
-        if let Some((next, prev)) = after(faces[f as usize], c0) {
-            if next == c1 {
-                on_edge[0] = f;
-            } else if next == w0 {
-                neighbours[1] = f;
-            }
-            if prev == w1 {
-                neighbours[2] = f;
-            }
-        }
+        split.see(0, f, faces[f as usize]);
     }
     for &f in around[1] {
-        if let Some((next, prev)) = after(faces[f as usize], c1) {
+        split.see(1, f, faces[f as usize]);
+    }
+    (split.on_edge, split.neighbours)
+}
+
+/// [`split_faces`] gathered face by face, for a walk that reads the faces round both ends anyway
+/// (the heap engine's collapse): each end's faces in the order of its list, the two ends' in any
+/// order (they fill different records).
+pub(crate) struct Split {
+    children: [u32; 2],
+    wings: [u32; 2],
+    pub on_edge: [u32; 2],
+    pub neighbours: [u32; 4],
+}
+
+impl Split {
+    pub fn new(children: [u32; 2], wings: [u32; 2]) -> Split {
+        Split {
+            children,
+            wings,
+            on_edge: [NONE; 2],
+            neighbours: [NONE; 4],
+        }
+    }
+
+    /// Notes face `f`, of corners `t`, round end `end` (0 for `c0`, 1 for `c1`).
+    #[inline(always)]
+    pub fn see(&mut self, end: usize, f: u32, t: [u32; 3]) {
+        let ([c0, c1], [w0, w1]) = (self.children, self.wings);
+        if end == 0 {
+            if let Some((next, prev)) = after(t, c0) {
+                if next == c1 {
+                    self.on_edge[0] = f;
+                } else if next == w0 {
+                    self.neighbours[1] = f;
+                }
+                if prev == w1 {
+                    self.neighbours[2] = f;
+                }
+            }
+        } else if let Some((next, prev)) = after(t, c1) {
             if next == c0 {
-                on_edge[1] = f;
+                self.on_edge[1] = f;
             } else if next == w1 {
-                neighbours[3] = f;
+                self.neighbours[3] = f;
             }
             if prev == w0 {
-                neighbours[0] = f;
+                self.neighbours[0] = f;
             }
         }
     }
-    (on_edge, neighbours)
 }
 
 impl<'o> Engine<'o> {
@@ -782,8 +813,9 @@ impl<'o> Engine<'o> {
         } else {
             ([b, a], [wings[1], wings[0]])
         };
-        let around = children.map(|c| self.lists.faces(self.at(c)));
-        let (faces, neighbours) = split_faces(&self.faces, around, children, wings);
+        // Which end each child is (0 or 1) for the split's records.
+        let (end_a, end_b) = (usize::from(children[0] != a), usize::from(children[0] == a));
+        let mut split = Split::new(children, wings);
         let p = self.pos.len() as u32;
         let (ia, ib) = (a as usize, b as usize);
         let (sa, sb) = (self.slot[ia] as usize, self.slot[ib] as usize);
@@ -810,19 +842,29 @@ impl<'o> Engine<'o> {
         let (la, lb) = (self.lists.take(sa), self.lists.take(sb));
         // Both face lists are sorted, and a face is in both exactly when it holds both ends (a
         // face is listed by each of its corners): walked together, they give p's faces sorted,
-        // with no sort, and the faces to remove without a search of their corners.
+        // with no sort, and the faces to remove without a search of their corners. The split's
+        // records are read off the same walk, before the corners are renamed.
         for (f, side) in Merged::new(faces_in(&la), faces_in(&lb)) {
+            let Some(t) = self.faces.get_mut(f as usize) else {
+                continue;
+            };
             let s = match side {
-                In::First => a,
-                In::Second => b,
+                In::First => {
+                    split.see(end_a, f, *t);
+                    a
+                }
+                In::Second => {
+                    split.see(end_b, f, *t);
+                    b
+                }
                 In::Both => {
+                    split.see(end_a, f, *t);
+                    split.see(end_b, f, *t);
                     self.remove_face(f, (a, b));
                     continue;
                 }
             };
-            if let Some(t) = self.faces.get_mut(f as usize) {
-                *t = t.map(|x| if x == s { p } else { x });
-            }
+            *t = t.map(|x| if x == s { p } else { x });
             pf.push(f);
         }
         if self.opts.bound != ErrorBound::Offset {
@@ -837,8 +879,8 @@ impl<'o> Engine<'o> {
             parent: p,
             children,
             wings,
-            faces,
-            neighbours,
+            faces: split.on_edge,
+            neighbours: split.neighbours,
         });
         self.rejected.take(a);
         self.rejected.take(b);
