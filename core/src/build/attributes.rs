@@ -251,43 +251,21 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, mut e: Collapsed<'_>, on_border: &Bor
         }
     }
 
-    // Leaves in depth-first order, so that each node's leaves form one range.
-    let mut order = Vec::with_capacity(leaves);
-    let mut range = vec![(0u32, 0u32); m];
-    let mut stack: Vec<(u32, bool)> = (0..m as u32)
-        .rev()
-        .filter(|&i| nodes[i as usize].parent == NONE)
-        .map(|i| (i, false))
-        .collect();
-    while let Some((v, closing)) = stack.pop() {
-        let node = &nodes[v as usize];
-        if closing {
-            range[v as usize].1 = order.len() as u32;
-        } else if node.children[0] == NONE {
-            range[v as usize] = (order.len() as u32, order.len() as u32 + 1);
-            order.push(v);
-        } else {
-            range[v as usize].0 = order.len() as u32;
-            stack.push((v, true));
-            stack.push((node.children[1], false));
-            stack.push((node.children[0], false));
-        }
-    }
+    let (below, range) = depth_first(&nodes, leaves, on_border);
 
     let mut errors: Vec<(f32, f32)> = Vec::new();
     for (k, c) in e.collapses.iter().enumerate() {
         let p = c.parent as usize;
         let n = from_f32(nodes[p].normal);
-        let (s, t) = range[p];
-        let below = &order[s as usize..t as usize];
+        let (s, t) = range[p - leaves];
         let own = if e.opts.bound == ErrorBound::Offset {
-            offset_bound(below, mesh.positions, at(p as u32), n, on_border)
+            offset_bound(&below, s, t, at(p as u32), n)
         } else {
             let start = k.checked_sub(1).map_or(0, |j| e.fan_ends[j] as usize);
             let fan = &e.fans[start..e.fan_ends[k] as usize];
             errors.clear();
-            errors.extend(below.iter().map(|&v| {
-                let x = leaf(v);
+            errors.extend(below.positions[s as usize..t as usize].iter().map(|&x| {
+                let x = from_f32(x);
                 let d = sub(x, nearest(x, fan, &stored).unwrap_or(at(p as u32)));
                 (up(dot(d, n).abs()), up(len(cross(d, n))))
             }));
@@ -308,23 +286,69 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, mut e: Collapsed<'_>, on_border: &Bor
     }
 }
 
-/// [`ErrorBound::Offset`] of a node at `center` with normal `n` over the leaves `below` (at the
-/// input's `positions`).
-fn offset_bound(
-    below: &[u32],
-    positions: &[[f32; 3]],
-    center: Vec3d,
-    n: Vec3d,
-    on_border: &Borders,
-) -> [f32; 2] {
-    let (mut along, mut outline) = (0.0f64, 0.0f64);
-    for &leaf in below {
-        let d = sub(from_f32(positions[leaf as usize]), center);
-        along = along.max(dot(d, n).abs());
-        if on_border.contains(leaf) {
-            outline = outline.max(len(cross(d, n)));
+/// The leaves in depth-first order, so that each node's leaves form one range: their positions,
+/// and which of them lie on a border. The error bounds visit every leaf below every node, and
+/// read them here one after the other rather than each at its index.
+struct Below {
+    positions: Vec<[f32; 3]>,
+    on_border: Borders,
+}
+
+/// The `leaves` first of `nodes` (`on_border` naming those on a border) in depth-first order, and
+/// each parent's range in that order (at its id less the leaves').
+fn depth_first(nodes: &[Node], leaves: usize, on_border: &Borders) -> (Below, Vec<(u32, u32)>) {
+    let mut below = Below {
+        positions: Vec::with_capacity(leaves),
+        on_border: Borders::new(leaves),
+    };
+    let mut range = vec![(0u32, 0u32); nodes.len().saturating_sub(leaves)];
+    let mut stack: Vec<(u32, bool)> = (0..nodes.len() as u32)
+        .rev()
+        .filter(|&i| nodes[i as usize].parent == NONE)
+        .map(|i| (i, false))
+        .collect();
+    while let Some((v, closing)) = stack.pop() {
+        let node = &nodes[v as usize];
+        let here = below.positions.len() as u32;
+        if node.children[0] == NONE {
+            if on_border.contains(v) {
+                below.on_border.insert(here);
+            }
+            below.positions.push(node.position);
+        } else if closing {
+            range[v as usize - leaves].1 = here;
+        } else {
+            range[v as usize - leaves].0 = here;
+            stack.push((v, true));
+            stack.push((node.children[1], false));
+            stack.push((node.children[0], false));
         }
     }
+    (below, range)
+}
+
+/// [`ErrorBound::Offset`] of a node at `center` with normal `n` over the leaves `start..end` of
+/// `below`.
+fn offset_bound(below: &Below, start: u32, end: u32, center: Vec3d, n: Vec3d) -> [f32; 2] {
+    let offset = |p: [f32; 3]| sub(from_f32(p), center);
+    let leaves = &below.positions[start as usize..end as usize];
+    // As `f64::max` with no NaN to skip: the offsets are never below `+0`, and a NaN one fails
+    // the comparison as `max` would skip it.
+    let along = leaves.iter().fold(0.0f64, |along, &p| {
+        let x = dot(offset(p), n).abs();
+        if x > along {
+            x
+        } else {
+            along
+        }
+    });
+    // Only the border leaves measure across the normal (the largest is the same in any order).
+    let outline = below
+        .on_border
+        .within(start, end)
+        .fold(0.0f64, |outline, i| {
+            outline.max(len(cross(offset(below.positions[i as usize]), n)))
+        });
     // The error of replacing the region by the node: each leaf's offset from the coarse
     // surface, which near the node is its tangent plane, so the offset lies along the normal.
     // A region's extent across the normal is not an error: a flat region simplifies to nothing

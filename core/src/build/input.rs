@@ -136,11 +136,13 @@ pub fn validate(mesh: &InputMesh<'_>) -> Result<(), BuildError> {
 pub(crate) struct Borders(Vec<u64>);
 
 impl Borders {
-    fn new(n: usize) -> Borders {
+    /// None of `n` vertices.
+    pub(crate) fn new(n: usize) -> Borders {
         Borders(vec![0; n.div_ceil(64)])
     }
 
-    fn insert(&mut self, v: u32) {
+    /// Marks vertex `v` (nothing for one out of range).
+    pub(crate) fn insert(&mut self, v: u32) {
         if let Some(w) = self.0.get_mut(v as usize / 64) {
             *w |= 1 << (v % 64);
         }
@@ -151,6 +153,27 @@ impl Borders {
         self.0
             .get(v as usize / 64)
             .is_some_and(|w| w >> (v % 64) & 1 != 0)
+    }
+
+    /// The members in `start..end`, ascending: a word read per 64 vertices, so that a range with
+    /// none (an inner region of the mesh) costs next to nothing.
+    pub(crate) fn within(&self, start: u32, end: u32) -> impl Iterator<Item = u32> + '_ {
+        let (start, end) = (start as usize, end as usize);
+        (start / 64..end.div_ceil(64)).flat_map(move |w| {
+            let first = w * 64;
+            // The word's bits from `start` on and before `end`.
+            let from = !0u64 << (start.max(first) - first);
+            let before = match end - first {
+                k if k < 64 => (1u64 << k) - 1,
+                _ => !0,
+            };
+            let mut bits = self.0.get(w).map_or(0, |&b| b & from & before);
+            core::iter::from_fn(move || {
+                let bit = (bits != 0).then(|| bits.trailing_zeros())?;
+                bits &= bits - 1;
+                Some((first as u32) + bit)
+            })
+        })
     }
 }
 
