@@ -20,7 +20,7 @@ use super::bound::{equation3, hoppe};
 use super::closest::{closest, point};
 use super::collapse::{color_of, kept, Collapsed};
 use super::input::Borders;
-use super::vec3::{add, cross, dot, from_f32, len, normalize, scale, sub, Vec3d};
+use super::vec3::{add, cross, dot, from_f32, len, normalize, normalize_by, scale, sub, Vec3d};
 use super::{ErrorBound, Hierarchy, InputMesh, Node, NONE};
 use crate::format::{oct_decode, oct_encode};
 
@@ -117,9 +117,12 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, mut e: Collapsed<'_>, on_border: &Bor
         let [a, b, c] = t.map(leaf);
         cross(sub(b, a), sub(c, a))
     };
+    // Each triangle's unit normal, for the cones below (`None` for a degenerate one).
+    let mut unit = Vec::with_capacity(mesh.triangles.len());
     for t in mesh.triangles {
         let n = face_normal(t);
         let area = len(n);
+        unit.push(normalize_by(n, area));
         let corner = t.map(leaf);
         // Each edge's length once: measured either way it is the same number.
         let edge: [f64; 3] = core::array::from_fn(|k| len(sub(corner[(k + 1) % 3], corner[k])));
@@ -137,18 +140,17 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, mut e: Collapsed<'_>, on_border: &Bor
     // one of the smallest cosine: `atan2` only measures the triangles within `1e-9` of it
     // (angles whose cosines differ by that differ by as much, far above the rounding of either
     // measure, so the largest is among them), one or two of a vertex's six or so. The unit
-    // normals are made again rather than kept from the loop above (32 bytes a triangle); a
-    // degenerate triangle opens the cone wide (`-inf`: no cosine is that small).
+    // normals are kept from the loop above (32 bytes a triangle, less than the nodes and their
+    // cones take below, where this function's memory peaks); a degenerate triangle opens the
+    // cone wide (`-inf`: no cosine is that small).
     let mut least = vec![f64::INFINITY; leaves];
-    for t in mesh.triangles {
-        let n = normalize(face_normal(t));
+    for (t, &n) in mesh.triangles.iter().zip(&unit) {
         for &v in t {
             let (g, least) = (&g[v as usize], &mut least[v as usize]);
             *least = n.map_or(f64::NEG_INFINITY, |n| least.min(dot(g.axis, n)));
         }
     }
-    for t in mesh.triangles {
-        let n = normalize(face_normal(t));
+    for (t, &n) in mesh.triangles.iter().zip(&unit) {
         for &v in t {
             let (g, least) = (&mut g[v as usize], least[v as usize]);
             let widest = match n {
@@ -159,7 +161,7 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, mut e: Collapsed<'_>, on_border: &Bor
             g.half = g.half.max(widest);
         }
     }
-    drop(least);
+    drop((least, unit));
     // Parents, in formation order (children first).
     for c in &e.collapses {
         let p = c.parent as usize;

@@ -39,7 +39,11 @@ pub fn len(a: Vec3d) -> f64 {
 
 /// `a` scaled to unit length, or `None` for a zero or non-finite vector.
 pub fn normalize(a: Vec3d) -> Option<Vec3d> {
-    let l = len(a);
+    normalize_by(a, len(a))
+}
+
+/// [`normalize`] of `a` whose length `l` is already measured (as [`len`] measures it).
+pub fn normalize_by(a: Vec3d, l: f64) -> Option<Vec3d> {
     (l > 0.0 && l.is_finite()).then(|| scale(a, 1.0 / l))
 }
 
