@@ -215,7 +215,7 @@ pub(crate) fn checked(mesh: &InputMesh<'_>) -> Result<Borders, BuildError> {
     }
 
     // Every check reads one table: for each vertex `v`, the link edges `x -> y` of its
-    // triangles `(v, x, y)`, sorted, with the triangle's index. Each check walks the whole table
+    // triangles `(v, x, y)`, with the triangle's index. Each check walks the whole table
     // before the next starts, so the first offender is the one the order of the checks names.
     let around = link_edges(n, mesh.triangles);
     let mut scratch: Vec<(u32, u32, u32)> = Vec::new();
@@ -288,29 +288,42 @@ pub(crate) fn checked(mesh: &InputMesh<'_>) -> Result<Borders, BuildError> {
     Ok(on_border)
 }
 
-/// For each vertex `v`, the link edges `(x, y, t)` of the triangles `t = (v, x, y)` around it,
-/// sorted (each vertex's handful sorted after the filing).
+/// Links up to this long stay in triangle order and are searched one edge after another (a
+/// vertex has six or so: cheaper than sorting them); longer ones, a pole's, are sorted by `x` and
+/// searched by halves, so that a vertex of many triangles costs no square of them.
+const SHORT_LINK: usize = 16;
+
+/// For each vertex `v`, the link edges `(x, y, t)` of the triangles `t = (v, x, y)` around it:
+/// in triangle order, or sorted by `x` when longer than [`SHORT_LINK`].
 fn link_edges(n: usize, triangles: &[[u32; 3]]) -> Around<(u32, u32, u32)> {
     let mut around = Around::filed(n, triangles, |t, k| {
         let tri = triangles[t as usize];
         (tri[(k + 1) % 3], tri[(k + 2) % 3], t)
     });
     for v in 0..n as u32 {
-        around.of_mut(v).sort_unstable();
+        let link = around.of_mut(v);
+        if link.len() > SHORT_LINK {
+            link.sort_unstable_by_key(|e| e.0);
+        }
     }
     around
 }
 
-/// Whether the link edges `(x, y, _)` (sorted by `x`) of one vertex form a single path or cycle.
-/// They come from manifold, consistently oriented edges, so each `x` starts one link edge and
-/// each `y` ends one: the edges form paths and cycles, and the one through the first edge must
-/// hold them all. Walked forwards from there (a cycle closes; most vertices are inside the
-/// surface), then, when a path's end stopped the walk, backwards to its start.
+/// Whether the link edges `(x, y, _)` of one vertex (as [`link_edges`] orders them) form a
+/// single path or cycle. They come from manifold, consistently oriented edges, so each `x`
+/// starts one link edge and each `y` ends one: the edges form paths and cycles, and the one
+/// through the first edge must hold them all (whichever edge is first). Walked forwards from
+/// there (a cycle closes; most vertices are inside the surface), then, when a path's end stopped
+/// the walk, backwards to its start.
 fn single_fan(link: &[(u32, u32, u32)]) -> bool {
     let next = |x: u32| {
-        link.binary_search_by_key(&x, |e| e.0)
-            .ok()
-            .map(|k| link[k].1)
+        if link.len() > SHORT_LINK {
+            link.binary_search_by_key(&x, |e| e.0)
+                .ok()
+                .map(|k| link[k].1)
+        } else {
+            link.iter().find(|e| e.0 == x).map(|e| e.1)
+        }
     };
     let start = link[0].0;
     let mut steps = 0;
@@ -356,7 +369,7 @@ mod tests {
     ];
 
     #[test]
-    fn the_table_around_each_vertex_is_a_full_sort_grouped() {
+    fn the_table_around_each_vertex_holds_its_link_edges() {
         // A small generator (xorshift), so the test needs no dependency.
         let mut x = 0x9E37_79B9u32;
         let mut next = |m: u32| {
@@ -375,9 +388,15 @@ mod tests {
             }
             full.sort_unstable();
             let around = link_edges(n as usize, &triangles);
-            let grouped: Vec<(u32, u32, u32, u32)> = (0..n)
-                .flat_map(|v| around.of(v).iter().map(move |&(x, y, t)| (v, x, y, t)))
-                .collect();
+            let mut grouped: Vec<(u32, u32, u32, u32)> = Vec::new();
+            for v in 0..n {
+                let link = around.of(v);
+                let sorted = link.len() <= SHORT_LINK || link.is_sorted_by_key(|e| e.0);
+                assert!(sorted, "{n} {v}");
+                let at = grouped.len();
+                grouped.extend(link.iter().map(|&(x, y, t)| (v, x, y, t)));
+                grouped[at..].sort_unstable();
+            }
             assert_eq!(grouped, full, "{n}");
         }
         assert!(link_edges(3, &[]).of(2).is_empty());
@@ -422,6 +441,20 @@ mod tests {
         // Two triangles touching at vertex 0 only.
         assert_eq!(
             check(&P, &[[0, 1, 3], [0, 5, 6]]),
+            Err(BuildError::NonManifoldVertex { vertex: 0 })
+        );
+        // Fans longer than `SHORT_LINK`, searched by halves: one closed disc around vertex 0
+        // passes, two touching at it do not.
+        let fan = |rim: core::ops::Range<u32>| {
+            let (first, last) = (rim.start, rim.end - 1);
+            rim.map(move |i| [0, i, if i == last { first } else { i + 1 }])
+        };
+        let points = [[0.0f32; 3]; 41];
+        let disc: Vec<[u32; 3]> = fan(1..21).collect();
+        assert_eq!(check(&points, &disc), Ok(()));
+        let bowtie: Vec<[u32; 3]> = fan(1..21).chain(fan(21..41)).collect();
+        assert_eq!(
+            check(&points, &bowtie),
             Err(BuildError::NonManifoldVertex { vertex: 0 })
         );
         let nan = [[f32::NAN, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
