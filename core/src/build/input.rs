@@ -244,25 +244,27 @@ pub(crate) fn checked(mesh: &InputMesh<'_>) -> Result<Borders, BuildError> {
     }
 
     // Edges, by their lower end `v`: the triangles `(v, x, y)` hold `v -> x` and `y -> v`; an
-    // edge must be in one triangle (a border) or in two, once in each direction.
+    // edge must be in one triangle (a border) or in two, once in each direction. Each end `b`
+    // is kept as `2 b + 1` leaving `v`, `2 b` entering it: plain integers sort cheaper than
+    // pairs, in the same order (the ends are below 2^31).
     let mut on_border = Borders::new(n);
-    let mut ends: Vec<(u32, bool)> = Vec::new();
+    let mut ends: Vec<u32> = Vec::new();
     for v in 0..n as u32 {
         ends.clear();
         for &(x, y, _) in around.of(v) {
             if x > v {
-                ends.push((x, true));
+                ends.push(2 * x + 1);
             }
             if y > v {
-                ends.push((y, false));
+                ends.push(2 * y);
             }
         }
         ends.sort_unstable();
         let mut i = 0;
         while i < ends.len() {
-            let b = ends[i].0;
+            let b = ends[i] / 2;
             let mut j = i + 1;
-            while j < ends.len() && ends[j].0 == b {
+            while j < ends.len() && ends[j] / 2 == b {
                 j += 1;
             }
             match j - i {
@@ -270,7 +272,7 @@ pub(crate) fn checked(mesh: &InputMesh<'_>) -> Result<Borders, BuildError> {
                     on_border.insert(v);
                     on_border.insert(b);
                 }
-                2 if ends[i].1 != ends[i + 1].1 => {}
+                2 if ends[i] != ends[i + 1] => {}
                 2 => return Err(BuildError::InconsistentOrientation { a: v, b }),
                 _ => return Err(BuildError::NonManifoldEdge { a: v, b }),
             }
