@@ -79,6 +79,26 @@ struct Gathered {
     half: f64,
 }
 
+/// `a.max(b)` where `a` is never NaN (and a zero's sign does not matter): a NaN `b` fails the
+/// comparison, as `max` skips it, and `max`'s test for a NaN `a` is left out; on the maxima
+/// taken per triangle corner and per leaf below a node it was a third of their instructions.
+fn larger(a: f64, b: f64) -> f64 {
+    if b > a {
+        b
+    } else {
+        a
+    }
+}
+
+/// `a.min(b)` where `a` is never NaN, as [`larger`].
+fn smaller(a: f64, b: f64) -> f64 {
+    if b < a {
+        b
+    } else {
+        a
+    }
+}
+
 /// Angle between two unit vectors.
 fn angle(a: Vec3d, b: Vec3d) -> f64 {
     libm::atan2(len(cross(a, b)), dot(a, b))
@@ -130,7 +150,7 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, mut e: Collapsed<'_>, on_border: &Bor
             let g = &mut g[v as usize];
             g.axis = add(g.axis, n);
             g.weight += area;
-            g.radius = g.radius.max(edge[k]).max(edge[(k + 2) % 3]);
+            g.radius = larger(larger(g.radius, edge[k]), edge[(k + 2) % 3]);
         }
     }
     for g in g.iter_mut().take(leaves) {
@@ -147,7 +167,7 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, mut e: Collapsed<'_>, on_border: &Bor
     for (t, &n) in mesh.triangles.iter().zip(&unit) {
         for &v in t {
             let (g, least) = (&g[v as usize], &mut least[v as usize]);
-            *least = n.map_or(f64::NEG_INFINITY, |n| least.min(dot(g.axis, n)));
+            *least = n.map_or(f64::NEG_INFINITY, |n| smaller(*least, dot(g.axis, n)));
         }
     }
     for (t, &n) in mesh.triangles.iter().zip(&unit) {
@@ -334,16 +354,9 @@ fn depth_first(nodes: &[Node], leaves: usize, on_border: &Borders) -> (Below, Ve
 fn offset_bound(below: &Below, start: u32, end: u32, center: Vec3d, n: Vec3d) -> [f32; 2] {
     let offset = |p: [f32; 3]| sub(from_f32(p), center);
     let leaves = &below.positions[start as usize..end as usize];
-    // As `f64::max` with no NaN to skip: the offsets are never below `+0`, and a NaN one fails
-    // the comparison as `max` would skip it.
-    let along = leaves.iter().fold(0.0f64, |along, &p| {
-        let x = dot(offset(p), n).abs();
-        if x > along {
-            x
-        } else {
-            along
-        }
-    });
+    let along = leaves
+        .iter()
+        .fold(0.0f64, |along, &p| larger(along, dot(offset(p), n).abs()));
     // Only the border leaves measure across the normal (the largest is the same in any order).
     let outline = below
         .on_border
