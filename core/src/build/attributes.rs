@@ -18,7 +18,7 @@ use alloc::vec::Vec;
 
 use super::bound::{equation3, hoppe};
 use super::closest::{closest, point};
-use super::collapse::{color_of, kept, Collapsed};
+use super::collapse::{kept, Collapsed};
 use super::input::Borders;
 use super::vec3::{add, cross, dot, from_f32, len, normalize, normalize_by, scale, sub, Vec3d};
 use super::{ErrorBound, Hierarchy, InputMesh, Node, NONE};
@@ -133,17 +133,14 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, mut e: Collapsed<'_>, on_border: &Bor
     // Each node's terms side by side, so that a triangle's corners are three records read (the
     // input's triangles come in no order of their vertices).
     let mut g = vec![Gathered::default(); m];
-    let face_normal = |t: &[u32; 3]| {
-        let [a, b, c] = t.map(leaf);
-        cross(sub(b, a), sub(c, a))
-    };
     // Each triangle's unit normal, for the cones below (`None` for a degenerate one).
     let mut unit = Vec::with_capacity(mesh.triangles.len());
     for t in mesh.triangles {
-        let n = face_normal(t);
+        let corner = t.map(leaf);
+        let [a, b, c] = corner;
+        let n = cross(sub(b, a), sub(c, a));
         let area = len(n);
         unit.push(normalize_by(n, area));
-        let corner = t.map(leaf);
         // Each edge's length once: measured either way it is the same number.
         let edge: [f64; 3] = core::array::from_fn(|k| len(sub(corner[(k + 1) % 3], corner[k])));
         for (k, &v) in t.iter().enumerate() {
@@ -228,7 +225,10 @@ pub(crate) fn finish(mesh: &InputMesh<'_>, mut e: Collapsed<'_>, on_border: &Bor
             parent: NONE,
             children: [NONE; 2],
             wings: [NONE; 2],
-            color: color_of(&e.color, i as u32).map(|c| (c * 255.0 + 0.5).clamp(0.0, 255.0) as u8),
+            // Black without colours (what `color_of`'s zero rounds to), at no cost per node.
+            color: e.color.get(i).map_or([0; 3], |c| {
+                c.map(|c| (c * 255.0 + 0.5).clamp(0.0, 255.0) as u8)
+            }),
             ..Node::default()
         })
         .collect();
