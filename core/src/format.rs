@@ -444,8 +444,17 @@ pub fn oct_encode(n: [f32; 3]) -> (i8, i8) {
         u = (1.0 - ov.abs()) * if ou >= 0.0 { 1.0 } else { -1.0 };
         v = (1.0 - ou.abs()) * if ov >= 0.0 { 1.0 } else { -1.0 };
     }
-    let q = |x: f32| libm::roundf(x.clamp(-1.0, 1.0) * 127.0) as i8;
+    let q = |x: f32| round_small(x.clamp(-1.0, 1.0) * 127.0);
     (q(u), q(v))
+}
+
+/// `libm::roundf(x) as i8` (halves away from zero) for `x` in `[-127, 127]` or NaN (0), without
+/// the call: `x` less its integer part toward zero is exact there (Sterbenz), so comparing it
+/// with a half decides as `roundf` does.
+fn round_small(x: f32) -> i8 {
+    let whole = x as i32;
+    let rest = x - whole as f32;
+    (whole + i32::from(rest >= 0.5) - i32::from(rest <= -0.5)) as i8
 }
 
 /// Decodes octahedral coordinates in `[-127, 127]` to a unit vector (one square root and one
@@ -1443,6 +1452,19 @@ mod tests {
         let mut b = Buf([0; 256], 0);
         let _ = fmt::write(&mut b, format_args!("{e}"));
         b.0[..b.1].windows(word.len()).any(|w| w == word.as_bytes())
+    }
+
+    #[test]
+    fn octahedral_rounding_is_roundf() {
+        // Every half and its neighbours, and the integers (all of `[-127, 127]` was checked
+        // once against `libm::roundf`).
+        for k in -254..=254 {
+            let half = k as f32 / 2.0;
+            for x in [half.next_down(), half, half.next_up()] {
+                assert_eq!(round_small(x), libm::roundf(x) as i8, "{x}");
+            }
+        }
+        assert_eq!(round_small(f32::NAN), 0);
     }
 
     #[test]
