@@ -901,8 +901,11 @@ impl<'o> Engine<'o> {
             }
             ring.push(x);
         }
-        self.lists.set(sa, &pf, &ring);
-        drop((la, lb));
+        // p's lists go in the longer of a's and b's when they fit (the other is freed first,
+        // for the allocator to reuse when they do not).
+        let (room, other) = if la.len() >= lb.len() { (la, lb) } else { (lb, la) };
+        drop(other);
+        self.lists.set_in(sa, &pf, &ring, room);
         self.scratch_faces = pf;
         // Fresh costs for the edges of p (no other edge's cost changed); edges around it that were
         // illegal may have become legal.

@@ -152,10 +152,25 @@ impl Lists {
             .unwrap_or_default()
     }
 
-    /// Gives slot `s` these lists, at their exact length.
-    pub fn set(&mut self, s: usize, faces: &[u32], ring: &[u32]) {
-        if let Some(l) = self.slots.get_mut(s) {
-            *l = made(faces, ring);
+    /// Gives slot `s` these lists: in `room` (lists taken out and no longer needed, whose
+    /// length is kept) when they fit there, else at their exact length. A collapse's merged
+    /// lists rarely fit in one end's, but when they do (its lists had shrunk, or the other
+    /// end's were short) an allocation and a free are saved: about 1% of the collapses'
+    /// instructions on the bunny.
+    pub fn set_in(&mut self, s: usize, faces: &[u32], ring: &[u32], mut room: Box<[u32]>) {
+        let Some(l) = self.slots.get_mut(s) else {
+            return;
+        };
+        let (nf, nr) = (faces.len(), ring.len());
+        match room.get_mut(..2 + nf + nr) {
+            Some(into) => {
+                into[0] = nf as u32;
+                into[1] = nr as u32;
+                into[2..2 + nf].copy_from_slice(faces);
+                into[2 + nf..].copy_from_slice(ring);
+                *l = room;
+            }
+            None => *l = made(faces, ring),
         }
     }
 
@@ -251,8 +266,12 @@ mod tests {
             (&[4, 9][..], &[1, 5, 11][..])
         );
         assert!(l.faces(0).is_empty() && l.ring(0).is_empty());
-        l.set(0, &[1, 2], &[3]);
+        l.set_in(0, &[1, 2], &[3], taken);
         assert_eq!((l.faces(0), l.ring(0)), (&[1, 2][..], &[3][..]));
+        // Too long for the room: at their exact length.
+        l.set_in(0, &[1, 2, 3, 4, 5], &[6, 7, 8, 9], Box::new([]));
+        assert_eq!(l.faces(0), &[1, 2, 3, 4, 5]);
+        assert_eq!(l.ring(0), &[6, 7, 8, 9]);
         assert_eq!(l.faces(7), &[] as &[u32]);
     }
 }
