@@ -632,7 +632,7 @@ impl<'o> Engine<'o> {
         if count == 0 {
             return false;
         }
-        let (na, nb) = (self.neighbours(a), self.neighbours(b));
+        let ((fa, na), (fb, nb)) = (self.lists.both(self.at(a)), self.lists.both(self.at(b)));
         // Link condition: the common neighbours are exactly the wings (both rings are sorted,
         // so one merge finds them).
         let w = wings.map(|x| (x != NONE).then_some(x));
@@ -652,7 +652,8 @@ impl<'o> Engine<'o> {
             return false;
         }
         let edge_on_border = count == 1;
-        let (ba, bb) = (self.on_border(a), self.on_border(b));
+        // As [`Engine::on_border`], from the lists in hand.
+        let (ba, bb) = (fa.len() < na.len(), fb.len() < nb.len());
         if ba && bb && !edge_on_border {
             return false; // would pinch two borders (or a border and itself) together
         }
@@ -684,8 +685,8 @@ impl<'o> Engine<'o> {
             return false;
         }
         for x in w.into_iter().flatten() {
-            let ring = self.neighbours(x);
-            let min = if self.on_border(x) {
+            let (faces, ring) = self.lists.both(self.at(x));
+            let min = if faces.len() < ring.len() {
                 3 + straight(x)
             } else {
                 4
@@ -697,8 +698,8 @@ impl<'o> Engine<'o> {
         // No flipped or collapsed triangle, and none worse shaped than `min_shape` allows.
         let mut worst_before = f64::INFINITY;
         let mut worst_after = f64::INFINITY;
-        for &s in &[a, b] {
-            for &f in self.lists.faces(self.at(s)) {
+        for (s, around) in [(a, fa), (b, fb)] {
+            for &f in around {
                 let t = self.faces[f as usize];
                 if t.contains(&a) && t.contains(&b) {
                     continue;

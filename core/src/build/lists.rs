@@ -134,6 +134,16 @@ impl Lists {
         self.slots.get(s).map_or(&[], |l| ring_in(l))
     }
 
+    /// The faces and the sorted neighbours of slot `s`'s vertex, from one look-up of its lists
+    /// (the legality test reads both of each end's: looked up one at a time, each list cost a
+    /// search of the slots and of their lengths).
+    #[inline]
+    pub fn both(&self, s: usize) -> (&[u32], &[u32]) {
+        self.slots
+            .get(s)
+            .map_or((&[], &[]), |l| (faces_in(l), ring_in(l)))
+    }
+
     /// Every slot's ring length, summed.
     pub fn ring_total(&self) -> usize {
         self.slots.iter().map(|l| ring_in(l).len()).sum()
