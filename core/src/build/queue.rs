@@ -37,9 +37,29 @@ const ARITY: usize = 4;
 #[inline]
 fn cheapest(children: &[Entry]) -> Option<(usize, Entry)> {
     match children.first_chunk::<ARITY>() {
-        Some(full) => least(full),
+        Some(full) => Some(least_of_four(full)),
         None => least(children),
     }
+}
+
+/// [`least`] of a full node's children, as the winner of two pairs: only keys and places are
+/// carried through the comparisons, and the entry is read once, where it won.
+#[inline(always)]
+fn least_of_four(full: &[Entry; ARITY]) -> (usize, Entry) {
+    let pair = |i: usize| {
+        if full[i + 1].key < full[i].key {
+            i + 1
+        } else {
+            i
+        }
+    };
+    let (low, high) = (pair(0), pair(2));
+    let k = if full[high].key < full[low].key {
+        high
+    } else {
+        low
+    };
+    (k, full[k])
 }
 
 /// The entry of least key among `entries` and where it is; keys differ, so which of equal keys
