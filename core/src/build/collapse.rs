@@ -904,7 +904,11 @@ impl<'o> Engine<'o> {
         }
         // p's lists go in the longer of a's and b's when they fit (the other is freed first,
         // for the allocator to reuse when they do not).
-        let (room, other) = if la.len() >= lb.len() { (la, lb) } else { (lb, la) };
+        let (room, other) = if la.len() >= lb.len() {
+            (la, lb)
+        } else {
+            (lb, la)
+        };
         drop(other);
         self.lists.set_in(sa, &pf, &ring, room);
         self.scratch_faces = pf;
