@@ -355,29 +355,20 @@ impl Split {
         }
     }
 
-    /// Notes face `f`, of corners `t`, round end `end` (0 for `c0`, 1 for `c1`).
+    /// Notes face `f`, of corners `t`, round end `end` (0 for `c0`, 1 for `c1`; a constant
+    /// where this is inlined). Round `c0` the face with edge `c0 -> w0` is `n1` and the one with
+    /// `w1 -> c0` is `n2`; round `c1`, `c1 -> w1` is `n3` and `w0 -> c1` is `n0`.
     #[inline(always)]
     pub fn see(&mut self, end: usize, f: u32, t: [u32; 3]) {
-        let ([c0, c1], [w0, w1]) = (self.children, self.wings);
-        if end == 0 {
-            if let Some((next, prev)) = after(t, c0) {
-                if next == c1 {
-                    self.on_edge[0] = f;
-                } else if next == w0 {
-                    self.neighbours[1] = f;
-                }
-                if prev == w1 {
-                    self.neighbours[2] = f;
-                }
+        let (other, [own, across]) = (1 - end, [end, 1 - end].map(|k| self.wings[k]));
+        if let Some((next, prev)) = after(t, self.children[end]) {
+            if next == self.children[other] {
+                self.on_edge[end] = f;
+            } else if next == own {
+                self.neighbours[1 + 2 * end] = f;
             }
-        } else if let Some((next, prev)) = after(t, c1) {
-            if next == c0 {
-                self.on_edge[1] = f;
-            } else if next == w1 {
-                self.neighbours[3] = f;
-            }
-            if prev == w0 {
-                self.neighbours[0] = f;
+            if prev == across {
+                self.neighbours[(2 + 2 * end) % 4] = f;
             }
         }
     }
