@@ -100,6 +100,12 @@ pub(crate) struct Passes<'o> {
     faces_alive: usize,
     /// The edges, cheapest first.
     edges: Vec<Edge>,
+    /// Working room kept from pass to pass (each pass makes fewer edges than the one before,
+    /// so after the first they are never grown or filled again): the new vertices' edges,
+    /// the sort's room, a vertex's neighbours.
+    fresh: Vec<Edge>,
+    spare: Vec<Edge>,
+    ring_scratch: Vec<u32>,
     /// Costs computed.
     evaluations: u64,
     surface: Option<Surface>,
@@ -153,6 +159,9 @@ impl<'o> Passes<'o> {
             touched: Vec::new(),
             faces_alive: mesh.triangles.len(),
             edges: Vec::new(),
+            fresh: Vec::new(),
+            spare: Vec::new(),
+            ring_scratch: Vec::new(),
             evaluations: 0,
             surface: (opts.cost == Cost::Color)
                 .then(|| Surface::new(mesh.positions, mesh.triangles)),
@@ -240,13 +249,12 @@ impl<'o> Passes<'o> {
 
     /// Files the faces again and merges the new vertices' edges into the sorted list.
     fn next_pass(&mut self, made: usize) {
-        let alive = &self.alive;
-        self.edges
-            .retain(|e| alive[e.a as usize] && alive[e.b as usize]);
+        let kept = self.drop_dead_edges();
         self.refile();
         let first_new = (self.pos.len() - made) as u32;
-        let mut fresh = Vec::new();
-        let mut ring = Vec::new();
+        let mut fresh = core::mem::take(&mut self.fresh);
+        let mut ring = core::mem::take(&mut self.ring_scratch);
+        fresh.clear();
         for p in first_new..self.pos.len() as u32 {
             self.ring(p, &mut ring);
             for &x in &ring {
@@ -256,12 +264,39 @@ impl<'o> Passes<'o> {
                 }
             }
         }
-        sort_by_cost(&mut fresh, &mut Vec::new());
-        // Merged from the back into the room `fresh` adds at the end: no second list. An old
-        // edge goes before a new one of the same cost.
-        let old = self.edges.len();
-        self.edges.resize(old + fresh.len(), Edge::default());
-        let (mut i, mut j, mut at) = (old, fresh.len(), old + fresh.len());
+        sort_by_cost(&mut fresh, &mut self.spare);
+        self.merge(kept, &fresh);
+        self.fresh = fresh;
+        self.ring_scratch = ring;
+    }
+
+    /// Moves the edges whose ends are both live to the front of the list, in order, and returns
+    /// their number. The list keeps its length: the stale entries behind are room for
+    /// [`Passes::merge`], which then needs no new entries filled first (a pass's collapses end
+    /// more edges than they make).
+    fn drop_dead_edges(&mut self) -> usize {
+        let alive = &self.alive;
+        let mut kept = 0;
+        for i in 0..self.edges.len() {
+            let e = self.edges[i];
+            if alive[e.a as usize] && alive[e.b as usize] {
+                self.edges[kept] = e;
+                kept += 1;
+            }
+        }
+        kept
+    }
+
+    /// Merges the sorted `fresh` edges with the list's first `old` (sorted) ones, from the back
+    /// into room at the end: no second list. An old edge goes before a new one of the same cost.
+    fn merge(&mut self, old: usize, fresh: &[Edge]) {
+        let total = old + fresh.len();
+        if total <= self.edges.len() {
+            self.edges.truncate(total);
+        } else {
+            self.edges.resize(total, Edge::default());
+        }
+        let (mut i, mut j, mut at) = (old, fresh.len(), total);
         while j > 0 {
             at -= 1;
             if i > 0 && self.edges[i - 1].key > fresh[j - 1].key {
@@ -677,7 +712,8 @@ impl<'o> Passes<'o> {
 
 /// Sorts `edges` by cost, keeping the order they came in among equal costs: a radix sort on the
 /// cost's bits, a byte at a time (each pass stable), or an insertion sort of a few. `scratch` is
-/// working room.
+/// working room: every entry it holds is written before it is read, so it is only ever cut or
+/// grown to length (a persistent one, whose sorts shrink pass by pass, is never filled again).
 fn sort_by_cost(edges: &mut Vec<Edge>, scratch: &mut Vec<Edge>) {
     if edges.len() < 64 {
         for i in 1..edges.len() {
@@ -691,27 +727,45 @@ fn sort_by_cost(edges: &mut Vec<Edge>, scratch: &mut Vec<Edge>) {
         }
         return;
     }
-    for byte in 0..4 {
-        let digit = |e: &Edge| (e.key >> (8 * byte)) as usize & 0xff;
-        let mut start = [0usize; 257];
-        for e in edges.iter() {
-            start[digit(e) + 1] += 1;
-        }
-        if start[1..].contains(&edges.len()) {
+    let counts = digit_counts(edges);
+    scratch.resize(edges.len(), Edge::default());
+    for (byte, count) in counts.iter().enumerate() {
+        if count.contains(&edges.len()) {
             continue; // every edge has this digit: nothing moves
         }
-        for d in 0..256 {
-            start[d + 1] += start[d];
+        let mut start = [0usize; 256];
+        let mut at = 0;
+        for (s, &c) in start.iter_mut().zip(count) {
+            *s = at;
+            at += c;
         }
-        scratch.clear();
-        scratch.resize(edges.len(), Edge::default());
         for e in edges.iter() {
-            let d = digit(e);
-            scratch[start[d]] = *e;
-            start[d] += 1;
+            let d = &mut start[digit(e, byte)];
+            // `start[d]` stays below the number of edges of digit `d` or less.
+            if let Some(slot) = scratch.get_mut(*d) {
+                *slot = *e;
+            }
+            *d += 1;
         }
         core::mem::swap(edges, scratch);
     }
+}
+
+/// Byte `byte` of an edge's cost key.
+#[inline(always)]
+fn digit(e: &Edge, byte: usize) -> usize {
+    (e.key >> (8 * byte)) as usize & 0xff
+}
+
+/// How many edges have each value of each byte of their cost key, counted in one walk.
+fn digit_counts(edges: &[Edge]) -> [[usize; 256]; 4] {
+    let mut counts = [[0usize; 256]; 4];
+    for e in edges {
+        for (byte, count) in counts.iter_mut().enumerate() {
+            count[digit(e, byte)] += 1;
+        }
+    }
+    counts
 }
 
 #[cfg(test)]
