@@ -94,8 +94,10 @@ pub(crate) struct Passes<'o> {
     first: Vec<u32>,
     end: Vec<u32>,
     around: Vec<u32>,
-    /// The slots this pass marked, each once.
-    touched: Vec<u32>,
+    /// The wings of this pass's collapses, each once: the only live slots that lost faces (a
+    /// collapse ends just the faces on its edge, whose corners are its ends and wings; the
+    /// region it marks keeps every other vertex's faces, renamed in place, out of the pass).
+    thinned: Vec<u32>,
     /// Faces alive (three entries each in a compact filing).
     faces_alive: usize,
     /// The edges, cheapest first.
@@ -156,7 +158,7 @@ impl<'o> Passes<'o> {
             first: vec![0; n],
             end: vec![0; n],
             around: Vec::new(),
-            touched: Vec::new(),
+            thinned: Vec::new(),
             faces_alive: mesh.triangles.len(),
             edges: Vec::new(),
             fresh: Vec::new(),
@@ -343,16 +345,16 @@ impl<'o> Passes<'o> {
         (collapsed, self.collapses)
     }
 
-    /// Brings the filing up to date after a pass: only the slots the pass marked lost faces
-    /// (each collapse filed its new vertex's anew), so each of those drops its dead faces in
-    /// place; once the garbage left behind outgrows the live entries, everything is filed again.
+    /// Brings the filing up to date after a pass: only the collapses' wings lost faces (each
+    /// collapse filed its new vertex's anew), so each of those drops its dead faces in place;
+    /// once the garbage left behind outgrows the live entries, everything is filed again.
     fn refile(&mut self) {
         if self.around.len() > 6 * self.faces_alive + 1024 {
-            self.touched.clear();
+            self.thinned.clear();
             self.file_faces();
             return;
         }
-        for &s in &self.touched {
+        for &s in &self.thinned {
             let s = s as usize;
             if !self.alive[self.owner[s] as usize] {
                 continue;
@@ -365,7 +367,7 @@ impl<'o> Passes<'o> {
             }
             self.end[s] = kept;
         }
-        self.touched.clear();
+        self.thinned.clear();
     }
 
     /// Files every live face under its corners, in face order: a counting sort over the live
@@ -659,10 +661,7 @@ impl<'o> Passes<'o> {
                 let f = self.around[i as usize] as usize;
                 let t = self.faces[f];
                 for x in t {
-                    if self.mark[x as usize] != k {
-                        self.mark[x as usize] = k;
-                        self.touched.push(x);
-                    }
+                    self.mark[x as usize] = k;
                 }
                 if t.contains(&sa) && t.contains(&sb) {
                     // Filed under both ends: dropped on the first meeting.
@@ -675,6 +674,8 @@ impl<'o> Passes<'o> {
                 }
             }
         }
+        // No earlier collapse of the pass marked a wing, nor will a later one: each is listed once.
+        self.thinned.extend(wings.iter().filter(|&&w| w != NONE));
         if self.opts.bound != ErrorBound::Offset {
             // The faces around p in face order, as the heap engine lists them.
             let mut fan: Vec<u32> = self.faces_of(sa).to_vec();
