@@ -614,7 +614,6 @@ impl<'o> Passes<'o> {
     /// Collapses `a-b` (vertex ids) into a new vertex at `v` and marks the region it touched;
     /// `wings` are the third corners of the faces with directed edges `a -> b` and `b -> a`.
     fn collapse(&mut self, a: u32, b: u32, v: Vec3d, wings: [u32; 2]) {
-        let k = self.pass;
         let (sa, sb) = (self.slot[a as usize], self.slot[b as usize]);
         // Orient so that triangle (children[0], children[1], wings[0]) exists.
         let (children, wings) = if wings[0] != NONE {
@@ -622,8 +621,6 @@ impl<'o> Passes<'o> {
         } else {
             ([sb, sa], [wings[1], wings[0]])
         };
-        let around = children.map(|c| self.faces_of(c));
-        let (faces, neighbours) = split_faces(&self.faces, around, children, wings);
         let id = |s: u32| {
             if s == NONE {
                 NONE
@@ -631,14 +628,8 @@ impl<'o> Passes<'o> {
                 self.owner[s as usize]
             }
         };
-        let record = Collapse {
-            parent: self.pos.len() as u32,
-            children: children.map(id),
-            wings: wings.map(id),
-            faces,
-            neighbours,
-        };
-        let p = record.parent;
+        let (children_ids, wing_ids) = (children.map(id), wings.map(id));
+        let p = self.pos.len() as u32;
         let (ia, ib) = (a as usize, b as usize);
         self.pos.push(v);
         let qa = sa as usize;
@@ -653,27 +644,21 @@ impl<'o> Passes<'o> {
         );
         self.slot.push(sa);
         self.owner[qa] = p;
-        // Mark the region (every corner of the faces around a and b), drop the two faces on
-        // the edge and move b's other faces to a's slot, which p now holds. The lists of a and
-        // b are read as filed: neither slot is filed again before the next pass.
-        for s in [sa, sb] {
-            for i in self.first[s as usize]..self.end[s as usize] {
-                let f = self.around[i as usize] as usize;
-                let t = self.faces[f];
-                for x in t {
-                    self.mark[x as usize] = k;
-                }
-                if t.contains(&sa) && t.contains(&sb) {
-                    // Filed under both ends: dropped on the first meeting.
-                    if self.face_alive[f] {
-                        self.face_alive[f] = false;
-                        self.faces_alive -= 1;
-                    }
-                } else if s == sb {
-                    self.faces[f] = t.map(|x| if x == sb { sa } else { x });
-                }
-            }
-        }
+        // One walk round each end (a's list, then b's, as filed: neither slot is filed again
+        // before the next pass) marks the region, drops the faces on the edge and files p's
+        // other faces anew at the end (the segments of a and b become garbage).
+        let from = self.around.len() as u32;
+        let around = children.map(|c| self.faces_of(c));
+        let (faces, neighbours) = split_faces(&self.faces, around, children, wings);
+        self.take_faces(sa, [sa, sb]);
+        self.take_faces(sb, [sa, sb]);
+        let record = Collapse {
+            parent: p,
+            children: children_ids,
+            wings: wing_ids,
+            faces,
+            neighbours,
+        };
         // No earlier collapse of the pass marked a wing, nor will a later one: each is listed once.
         self.thinned.extend(wings.iter().filter(|&&w| w != NONE));
         if self.opts.bound != ErrorBound::Offset {
@@ -691,16 +676,6 @@ impl<'o> Passes<'o> {
             }
             self.fan_ends.push(self.fans.len() as u32);
         }
-        // p's faces, filed anew at the end (the segments of a and b become garbage).
-        let from = self.around.len() as u32;
-        for s in [sa, sb] {
-            for i in self.first[s as usize]..self.end[s as usize] {
-                let f = self.around[i as usize];
-                if self.face_alive[f as usize] {
-                    self.around.push(f);
-                }
-            }
-        }
         self.first[qa] = from;
         self.end[qa] = self.around.len() as u32;
         self.alive[ia] = false;
@@ -708,6 +683,32 @@ impl<'o> Passes<'o> {
         self.alive.push(true);
         self.alive_count -= 1;
         self.collapses.push(record);
+    }
+
+    /// The walk round end `s` of collapse `[sa, sb]`: marks each face's corners, drops the face
+    /// if on the edge (filed under both ends: on the first meeting) and else renames `sb` to
+    /// `sa` in it and files it for the new vertex, after those already filed.
+    #[inline(always)]
+    fn take_faces(&mut self, s: u32, [sa, sb]: [u32; 2]) {
+        let k = self.pass;
+        for i in self.first[s as usize]..self.end[s as usize] {
+            let f = self.around[i as usize];
+            let t = self.faces[f as usize];
+            for x in t {
+                self.mark[x as usize] = k;
+            }
+            if t.contains(&sa) && t.contains(&sb) {
+                if self.face_alive[f as usize] {
+                    self.face_alive[f as usize] = false;
+                    self.faces_alive -= 1;
+                }
+            } else {
+                if s == sb {
+                    self.faces[f as usize] = t.map(|x| if x == sb { sa } else { x });
+                }
+                self.around.push(f);
+            }
+        }
     }
 }
 
