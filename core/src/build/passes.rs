@@ -455,7 +455,7 @@ impl<'o> Passes<'o> {
                 x ^= next ^ prev;
             }
         }
-        (x != 0, faces.len() + usize::from(x != 0))
+        fan_of(x, faces.len())
     }
 
     /// The two ends of slot `s`'s open fan (`s -> first` and `last -> s` have no twin).
@@ -545,9 +545,15 @@ impl<'o> Passes<'o> {
         // are stamped, then those of `b` looked up, each counted once.
         let tag = self.next_stamp();
         let seen = self.next_stamp();
+        // The same walks find whether each end's fan is open, as [`Passes::fan`] does.
+        let (mut xa, mut xb) = (0, 0);
         for i in self.first[a as usize]..self.end[a as usize] {
             let f = self.around[i as usize];
-            for x in self.faces[f as usize] {
+            let t = self.faces[f as usize];
+            if let Some((next, prev)) = after(t, a) {
+                xa ^= next ^ prev;
+            }
+            for x in t {
                 self.stamp[x as usize] = tag;
             }
         }
@@ -555,7 +561,11 @@ impl<'o> Passes<'o> {
         let mut common = 0;
         for i in self.first[b as usize]..self.end[b as usize] {
             let f = self.around[i as usize];
-            for x in self.faces[f as usize] {
+            let t = self.faces[f as usize];
+            if let Some((next, prev)) = after(t, b) {
+                xb ^= next ^ prev;
+            }
+            for x in t {
                 if x == a || x == b || self.stamp[x as usize] != tag {
                     continue;
                 }
@@ -570,7 +580,8 @@ impl<'o> Passes<'o> {
             return false;
         }
         let edge_on_border = count == 1;
-        let ((ba, ra), (bb, rb)) = (self.fan(a), self.fan(b));
+        let (ba, ra) = fan_of(xa, self.faces_of(a).len());
+        let (bb, rb) = fan_of(xb, self.faces_of(b).len());
         if ba && bb && !edge_on_border {
             return false; // would pinch two borders (or a border and itself) together
         }
@@ -710,6 +721,12 @@ impl<'o> Passes<'o> {
             }
         }
     }
+}
+
+/// [`Passes::fan`]'s answer from the exclusive or `x` of every neighbour a fan's `faces` have
+/// after and before its vertex: whether it is open, and its number of neighbours.
+fn fan_of(x: u32, faces: usize) -> (bool, usize) {
+    (x != 0, faces + usize::from(x != 0))
 }
 
 /// Sorts `edges` by cost, keeping the order they came in among equal costs: a radix sort on the
