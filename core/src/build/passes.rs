@@ -506,6 +506,9 @@ impl<'o> Passes<'o> {
     }
 
     /// Where the merged vertex goes and what the collapse costs (the heap engine's rules).
+    /// Inlined (as are the shared rules it calls): out of line, the calls cost the bunny's
+    /// balanced build 8 million more instructions, 1.4%.
+    #[inline(always)]
     fn evaluate(&self, a: u32, b: u32) -> (Vec3d, f64) {
         let (pa, pb) = (self.pos.get(a), self.pos.get(b));
         let (sa, sb) = (self.slot[a as usize], self.slot[b as usize]);
