@@ -290,7 +290,8 @@ impl<'o> Passes<'o> {
     }
 
     /// Merges the sorted `fresh` edges with the list's first `old` (sorted) ones, from the back
-    /// into room at the end: no second list. An old edge goes before a new one of the same cost.
+    /// into room at the end: no second list. An old edge goes before a new one of the same cost:
+    /// each new edge, last first, goes in after the old ones that cost more are moved up.
     fn merge(&mut self, old: usize, fresh: &[Edge]) {
         let total = old + fresh.len();
         if total <= self.edges.len() {
@@ -298,16 +299,15 @@ impl<'o> Passes<'o> {
         } else {
             self.edges.resize(total, Edge::default());
         }
-        let (mut i, mut j, mut at) = (old, fresh.len(), total);
-        while j > 0 {
-            at -= 1;
-            if i > 0 && self.edges[i - 1].key > fresh[j - 1].key {
+        let (mut i, mut at) = (old, total);
+        for &e in fresh.iter().rev() {
+            while i > 0 && self.edges[i - 1].key > e.key {
                 i -= 1;
+                at -= 1;
                 self.edges[at] = self.edges[i];
-            } else {
-                j -= 1;
-                self.edges[at] = fresh[j];
             }
+            at -= 1;
+            self.edges[at] = e;
         }
     }
 
