@@ -102,12 +102,6 @@ pub(crate) struct Passes<'o> {
     faces_alive: usize,
     /// The edges, cheapest first.
     edges: Vec<Edge>,
-    /// Working room kept from pass to pass (each pass makes fewer edges than the one before,
-    /// so after the first they are never grown or filled again): the new vertices' edges,
-    /// the sort's room, a vertex's neighbours.
-    fresh: Vec<Edge>,
-    spare: Vec<Edge>,
-    ring_scratch: Vec<u32>,
     /// Costs computed.
     evaluations: u64,
     surface: Option<Surface>,
@@ -161,9 +155,6 @@ impl<'o> Passes<'o> {
             thinned: Vec::new(),
             faces_alive: mesh.triangles.len(),
             edges: Vec::new(),
-            fresh: Vec::new(),
-            spare: Vec::new(),
-            ring_scratch: Vec::new(),
             evaluations: 0,
             surface: (opts.cost == Cost::Color)
                 .then(|| Surface::new(mesh.positions, mesh.triangles)),
@@ -254,9 +245,8 @@ impl<'o> Passes<'o> {
         let kept = self.drop_dead_edges();
         self.refile();
         let first_new = (self.pos.len() - made) as u32;
-        let mut fresh = core::mem::take(&mut self.fresh);
-        let mut ring = core::mem::take(&mut self.ring_scratch);
-        fresh.clear();
+        let mut fresh = Vec::new();
+        let mut ring = Vec::new();
         for p in first_new..self.pos.len() as u32 {
             self.ring(p, &mut ring);
             for &x in &ring {
@@ -266,10 +256,9 @@ impl<'o> Passes<'o> {
                 }
             }
         }
-        sort_by_cost(&mut fresh, &mut self.spare);
+        // Both lists are freed before the next pass: the builder's peak heap may come later.
+        sort_by_cost(&mut fresh, &mut Vec::new());
         self.merge(kept, &fresh);
-        self.fresh = fresh;
-        self.ring_scratch = ring;
     }
 
     /// Moves the edges whose ends are both live to the front of the list, in order, and returns
@@ -734,8 +723,8 @@ fn fan_of(x: u32, faces: usize) -> (bool, usize) {
 
 /// Sorts `edges` by cost, keeping the order they came in among equal costs: a radix sort on the
 /// cost's bits, a byte at a time (each pass stable), or an insertion sort of a few. `scratch` is
-/// working room: every entry it holds is written before it is read, so it is only ever cut or
-/// grown to length (a persistent one, whose sorts shrink pass by pass, is never filled again).
+/// working room: every entry it holds is written before it is read, so it is filled once, not
+/// once a digit.
 fn sort_by_cost(edges: &mut Vec<Edge>, scratch: &mut Vec<Edge>) {
     if edges.len() < 64 {
         for i in 1..edges.len() {
