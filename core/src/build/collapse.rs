@@ -374,6 +374,13 @@ impl Split {
     }
 }
 
+/// Whether a vertex of these `faces` and `ring` (its neighbours) is on a border: in a manifold
+/// fan an inner vertex has as many triangles as neighbours, a border vertex one fewer.
+#[inline(always)]
+fn borders(faces: &[u32], ring: &[u32]) -> bool {
+    faces.len() < ring.len()
+}
+
 impl<'o> Engine<'o> {
     pub fn new(mesh: &InputMesh<'o>, opts: &'o BuildOptions) -> Engine<'o> {
         let n = mesh.positions.len();
@@ -526,10 +533,10 @@ impl<'o> Engine<'o> {
         self.slot[v as usize] as usize
     }
 
-    /// Whether live vertex `v` is on a border: in a manifold fan an inner vertex has as many
-    /// triangles as neighbours, a border vertex one fewer.
+    /// Whether live vertex `v` is on a border ([`borders`]).
     pub fn on_border(&self, v: u32) -> bool {
-        self.lists.faces(self.at(v)).len() < self.neighbours(v).len()
+        let (faces, ring) = self.lists.both(self.at(v));
+        borders(faces, ring)
     }
 
     /// Sorted distinct neighbours of a live vertex.
@@ -643,8 +650,7 @@ impl<'o> Engine<'o> {
             return false;
         }
         let edge_on_border = count == 1;
-        // As [`Engine::on_border`], from the lists in hand.
-        let (ba, bb) = (fa.len() < na.len(), fb.len() < nb.len());
+        let (ba, bb) = (borders(fa, na), borders(fb, nb));
         if ba && bb && !edge_on_border {
             return false; // would pinch two borders (or a border and itself) together
         }
@@ -677,7 +683,7 @@ impl<'o> Engine<'o> {
         }
         for x in w.into_iter().flatten() {
             let (faces, ring) = self.lists.both(self.at(x));
-            let min = if faces.len() < ring.len() {
+            let min = if borders(faces, ring) {
                 3 + straight(x)
             } else {
                 4
