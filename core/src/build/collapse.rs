@@ -313,31 +313,12 @@ pub(crate) fn edge_wings(faces: &[[u32; 3]], around: &[u32], a: u32, b: u32) -> 
     (wings, count)
 }
 
-/// The two faces on edge `c0-c1` (`c0 -> c1`, then `c1 -> c0`) and the four across their outer
-/// edges (`w0 -> c1`, `c0 -> w0`, `w1 -> c0`, `c1 -> w1`), or `NONE`, from one walk round each
-/// end (`around`: the faces holding `c0`, then `c1`): every face that holds one of those
-/// directed edges holds `c0` or `c1`, and holds it once. A split's records, as the file keeps
-/// them (Hoppe's `fn0..fn3`).
-pub(crate) fn split_faces(
-    faces: &[[u32; 3]],
-    around: [&[u32]; 2],
-    children: [u32; 2],
-    wings: [u32; 2],
-) -> ([u32; 2], [u32; 4]) {
-    let mut split = Split::new(children, wings);
-    // Each end's walk on its own, so that `end` is a constant in each.
-    for &f in around[0] {
-        split.see(0, f, faces[f as usize]);
-    }
-    for &f in around[1] {
-        split.see(1, f, faces[f as usize]);
-    }
-    (split.on_edge, split.neighbours)
-}
-
-/// [`split_faces`] gathered face by face, for a walk that reads the faces round both ends anyway
-/// (the heap engine's collapse): each end's faces in the order of its list, the two ends' in any
-/// order (they fill different records).
+/// A split's records, as the file keeps them (Hoppe's `fn0..fn3`), gathered face by face from
+/// the walks a collapse makes round its two ends anyway: the two faces on edge `c0-c1` (`c0 ->
+/// c1`, then `c1 -> c0`) and the four across their outer edges (`w0 -> c1`, `c0 -> w0`, `w1 ->
+/// c0`, `c1 -> w1`), or `NONE`. Every face that holds one of those directed edges holds `c0` or
+/// `c1`, and holds it once, so each end's faces may come in the order of its list and the two
+/// ends' in any order (they fill different records).
 pub(crate) struct Split {
     children: [u32; 2],
     wings: [u32; 2],

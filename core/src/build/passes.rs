@@ -27,8 +27,8 @@ use alloc::vec::Vec;
 use super::chunks::Chunks;
 use super::closest::Surface;
 use super::collapse::{
-    after, color_of, cost_at, cost_key, edge_wings, face_sums, merge_sums, placement, split_faces,
-    stays_up, Collapse, Collapsed,
+    after, color_of, cost_at, cost_key, edge_wings, face_sums, merge_sums, placement, stays_up,
+    Collapse, Collapsed, Split,
 };
 use super::input::Borders;
 use super::positions::Positions;
@@ -650,17 +650,23 @@ impl<'o> Passes<'o> {
         // One walk round each end (a's list, then b's, as filed: neither slot is filed again
         // before the next pass) marks the region, drops the faces on the edge and files p's
         // other faces anew at the end (the segments of a and b become garbage).
+        // The split's records come off the same walks.
         let from = self.around.len() as u32;
-        let around = children.map(|c| self.faces_of(c));
-        let (faces, neighbours) = split_faces(&self.faces, around, children, wings);
-        self.take_faces(sa, [sa, sb]);
-        self.take_faces(sb, [sa, sb]);
+        let mut split = Split::new(children, wings);
+        // (Each end's number a constant in its walk.)
+        if children[0] == sa {
+            self.take_faces::<0>(sa, [sa, sb], &mut split);
+            self.take_faces::<1>(sb, [sa, sb], &mut split);
+        } else {
+            self.take_faces::<1>(sa, [sa, sb], &mut split);
+            self.take_faces::<0>(sb, [sa, sb], &mut split);
+        }
         let record = Collapse {
             parent: p,
             children: children_ids,
             wings: wing_ids,
-            faces,
-            neighbours,
+            faces: split.on_edge,
+            neighbours: split.neighbours,
         };
         // No earlier collapse of the pass marked a wing, nor will a later one: each is listed once.
         self.thinned.extend(wings.iter().filter(|&&w| w != NONE));
@@ -688,15 +694,17 @@ impl<'o> Passes<'o> {
         self.collapses.push(record);
     }
 
-    /// The walk round end `s` of collapse `[sa, sb]`: marks each face's corners, drops the face
-    /// if on the edge (filed under both ends: on the first meeting) and else renames `sb` to
-    /// `sa` in it and files it for the new vertex, after those already filed.
+    /// The walk round end `s` of collapse `[sa, sb]`: shows each face to `split` as round its
+    /// end `END`, marks the face's corners, drops the face if on the edge (filed under both
+    /// ends: on the first meeting) and else renames `sb` to `sa` in it and files it for the new
+    /// vertex, after those already filed.
     #[inline(always)]
-    fn take_faces(&mut self, s: u32, [sa, sb]: [u32; 2]) {
+    fn take_faces<const END: usize>(&mut self, s: u32, [sa, sb]: [u32; 2], split: &mut Split) {
         let k = self.pass;
         for i in self.first[s as usize]..self.end[s as usize] {
             let f = self.around[i as usize];
             let t = self.faces[f as usize];
+            split.see(END, f, t);
             for x in t {
                 self.mark[x as usize] = k;
             }
