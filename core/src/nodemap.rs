@@ -67,7 +67,15 @@ impl<const M: usize, I: SlotIndex> NodeMap<M, I> {
     /// above the minimum) less than a 32nd.
     pub fn should_resize(&self, entries: usize) -> bool {
         let span = self.span as usize;
-        (entries * 2 > span && span < M) || (entries * 32 < span && span > MIN_SPAN.min(M))
+        self.should_grow(entries) || (entries * 32 < span && span > MIN_SPAN.min(M))
+    }
+
+    /// Whether `entries` entries call for a wider span: more than half of it (and it is below
+    /// `M`).
+    #[inline(always)]
+    pub fn should_grow(&self, entries: usize) -> bool {
+        let span = self.span as usize;
+        entries * 2 > span && span < M
     }
 
     /// Empties the map and makes it use `span` entries (clamped to `1..=M`).

@@ -445,10 +445,14 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         Ok(())
     }
 
+    /// Empties the cut. The node map keeps a span fit for the vertices the cut had: a cut
+    /// refined again after a reset grows back to about its size, and would otherwise rebuild
+    /// its map two or three times on the way (the end of a frame shrinks it if it stays small).
     fn clear(&mut self) {
+        let entries = self.active();
         self.v.clear();
         self.t.clear();
-        self.map.reset(NodeMap::<F, I>::span_for(0));
+        self.map.reset(NodeMap::<F, I>::span_for(entries));
         self.stack.clear();
         self.candidates.clear();
         self.pairs.clear();
@@ -530,9 +534,11 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
     }
 
     /// Inserts slot `s` (the last, just pushed) into the node map, which the map's rebuild does
-    /// when the count calls for another span.
+    /// when the count calls for a wider span. Only growth is checked: a map left wide by
+    /// [`Cut::clear`] is not narrowed while the cut grows back, and shrinking is for the end of
+    /// a frame ([`Cut::respan_map`]).
     fn map_insert(&mut self, s: u32) -> bool {
-        if self.map.should_resize(self.active()) {
+        if self.map.should_grow(self.active()) {
             self.rebuild_map(self.active());
             return self.slot(self.v.node[s as usize]) == Some(s);
         }
