@@ -695,11 +695,15 @@ fn window_at_end(b: &[u8], byte: usize) -> u128 {
 /// An id read at `width` bits: all ones becomes [`NONE`].
 #[inline]
 fn id(raw: u32, width: u32) -> u32 {
-    if width < 32 && raw == (1u32 << width) - 1 {
-        NONE
-    } else {
-        raw
-    }
+    field_id(raw, low(width))
+}
+
+/// The id in the low bits `mask` ([`low`] of its width) of `raw`, all ones becoming [`NONE`]:
+/// one more than the field, kept to the field and less one, so that all ones wraps round to
+/// zero and from there to [`NONE`] (`u32::MAX`), without a test.
+#[inline(always)]
+fn field_id(raw: u32, mask: u32) -> u32 {
+    (raw.wrapping_add(1) & mask).wrapping_sub(1)
 }
 
 impl<'a> HierarchyView<'a> {
@@ -1385,9 +1389,10 @@ impl<'a> HierarchyView<'a> {
         let at = self.offsets[4] as u64 * 8 + rank as u64 * split_bits(wf);
         let neighbours = if 2 * wf + 7 <= 64 {
             // Two ids in each of two 64-bit words (every hierarchy below 2^28 faces).
+            let mask = low(wf);
             let two = |bit: u64| {
                 let w = word_at(self.bytes, bit);
-                [w as u32, (w >> wf) as u32].map(|raw| id(raw & low(wf), wf))
+                [w as u32, (w >> wf) as u32].map(|raw| field_id(raw, mask))
             };
             let ([n0, n1], [n2, n3]) = (two(at), two(at + 2 * wf as u64));
             [n0, n1, n2, n3]
@@ -1498,6 +1503,8 @@ mod tests {
         assert_eq!(bits_at(&b, 80, 4), 0xF);
         assert_eq!(id_width(4), 3);
         assert_eq!(id(7, 3), NONE);
+        assert_eq!((id(6, 3), id(0, 3)), (6, 0));
+        assert_eq!((id(u32::MAX, 32), id(5, 32), id(0, 0)), (NONE, 5, NONE));
     }
 
     #[test]
