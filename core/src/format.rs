@@ -1160,12 +1160,25 @@ impl<'a> HierarchyView<'a> {
     #[inline]
     #[must_use]
     pub fn digest_at(&self, at: Record) -> Digest {
-        let r = self.record_bytes_at(at);
-        let q = |k: usize| u16::from_le_bytes([r[2 * k], r[2 * k + 1]]);
+        // A leaf's record and a parent's both start with the position, read as one word (as
+        // bytes, LLVM loaded them one by one); only a parent's has the bound codes, one word
+        // more (a leaf's are zeros). A record not in the file reads as all zeros, as in
+        // `record_bytes_at`.
+        let Record { offset: o, parent } = at;
+        let size = if parent { PARENT_SIZE } else { NODE_SIZE };
+        let Some(r) = o.checked_add(size).and_then(|end| self.bytes.get(o..end)) else {
+            return Digest::ZERO;
+        };
+        let head = r.first_chunk::<8>().map_or(0, |h| u64::from_le_bytes(*h));
+        let codes = r
+            .get(NODE_SIZE..)
+            .and_then(<[u8]>::first_chunk::<4>)
+            .map_or(0, |c| u32::from_le_bytes(*c));
+        let [radius, a, b, _] = codes.to_le_bytes();
         Digest {
-            position: [q(0), q(1), q(2)],
-            spheroid: r[9].max(r[10]),
-            radius: r[8],
+            position: [head as u16, (head >> 16) as u16, (head >> 32) as u16],
+            spheroid: a.max(b),
+            radius,
         }
     }
 
