@@ -113,9 +113,9 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             let (x, y) = (ns[into], ns[out]);
             let (kx, ky) = (nc[into] as usize, nc[out] as usize);
             let xy = !present[into]
-                || (self.t.corner_at(x, prev3(kx)) == w && self.t.adj_at(x, prev3(kx)) == y);
+                || (self.t.corner_is(x, prev3(kx), w) && self.t.adj_is(x, prev3(kx), y));
             let yx =
-                !present[out] || (self.t.corner_at(y, next3(ky)) == w && self.t.adj_at(y, ky) == x);
+                !present[out] || (self.t.corner_is(y, next3(ky), w) && self.t.adj_is(y, ky, x));
             xy && yx
         };
         if !meet(0, 1, wl) || (second && !meet(2, 3, wr)) {

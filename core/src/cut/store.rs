@@ -362,10 +362,18 @@ impl<const F: usize, I: SlotIndex> Triangles<F, I> {
         self.corners[f as usize][k].load()
     }
 
-    /// `adj(f)[k]` alone (`f` in range).
+    /// Whether corner `k` of triangle `f` (in range) is `v` (a vertex slot or `NIL`), compared
+    /// in the stored form, so nothing is widened.
     #[inline(always)]
-    pub fn adj_at(&self, f: u32, k: usize) -> u32 {
-        self.adj[f as usize][k].load()
+    pub fn corner_is(&self, f: u32, k: usize, v: u32) -> bool {
+        self.corners[f as usize][k] == I::store(v)
+    }
+
+    /// Whether `adj(f)[k]` (`f` in range) is `g` (a triangle slot or `NIL`), compared in the
+    /// stored form.
+    #[inline(always)]
+    pub fn adj_is(&self, f: u32, k: usize, g: u32) -> bool {
+        self.adj[f as usize][k] == I::store(g)
     }
 
     /// `adj(f)[k]`: the triangle across edge `t[k] -> t[k + 1]`, or `NIL`.
