@@ -262,12 +262,19 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         self.start_blend_from(s, &from, self.geomorph_frames, collapsing)
     }
 
-    /// Ends slot `s`'s blend, if any: it is its node again.
+    /// Ends slot `s`'s blend, if any: it is its node again. The test is inlined (most vertices
+    /// a split or collapse renames are not blending, and none in a first frame), the rest not.
+    #[inline(always)]
     pub(crate) fn free_blend(&mut self, s: usize) {
         let k = self.v.blend(s);
-        if k == NIL {
-            return;
+        if k != NIL {
+            self.end_blend(s, k);
         }
+    }
+
+    /// [`Cut::free_blend`] of slot `s`, blending with entry `k`.
+    #[inline(never)]
+    fn end_blend(&mut self, s: usize, k: u32) {
         self.v.set_blend(s, NIL);
         self.v.flags[s] &= !(BLENDING | COLLAPSING);
         if let Some((_, Some(_))) = self.blends.swap_remove(k as usize) {
