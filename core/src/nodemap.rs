@@ -188,6 +188,8 @@ impl<const M: usize, I: SlotIndex> NodeMap<M, I> {
         }
     }
 
+    /// Removes `key`'s entry, if any. Inlined: every split removes its parent's entry.
+    #[inline(always)]
     pub fn remove(&mut self, key: u32, nodes: &[u32]) {
         let Some(Ok(mut hole)) = self.find(key, nodes) else {
             return;
