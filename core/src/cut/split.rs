@@ -89,22 +89,27 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         let present = at.map(|i| i != NOWHERE);
         let ns = at.map(|i| ring.get(i).map_or(NIL, |a| a.slot));
         let nc = at.map(|i| ring.get(i).map_or(0, |a| a.corner));
-        // Corner `k` of neighbour `j`, the parent's plus `offset`.
-        let beside =
-            |j: usize, offset: usize| self.t.corner_at(ns[j], (nc[j] as usize + offset) % 3);
+        // Corner `k` of neighbour `j`, the parent's plus `offset` (one read a wing, so that
+        // it is inlined, where a closure called at four places was not).
+        let beside = |(j, offset): (usize, usize)| (ns[j], (nc[j] as usize + offset) % 3);
 
         // Wings, read off the neighbours (the nodes there now may be finer than at formation).
         // n1 holds c0 -> wl, n2 holds wr -> c0: both still have the parent's slot as c0.
-        let wl = match present {
-            [_, true, _, _] => beside(1, 1),
-            [true, ..] => beside(0, 2),
+        let (f, k) = beside(match present {
+            [_, true, _, _] => (1, 1),
+            [true, ..] => (0, 2),
             _ => return Err(Refused::Inconsistent),
-        };
-        let wr = match present {
-            _ if !second => NIL,
-            [_, _, true, _] => beside(2, 2),
-            [.., true] => beside(3, 1),
-            _ => return Err(Refused::Inconsistent),
+        });
+        let wl = self.t.corner_at(f, k);
+        let wr = if second {
+            let (f, k) = beside(match present {
+                [_, _, true, _] => (2, 2),
+                [.., true] => (3, 1),
+                _ => return Err(Refused::Inconsistent),
+            });
+            self.t.corner_at(f, k)
+        } else {
+            NIL
         };
         // Each neighbour pair must meet along the edge the new triangle will take over
         // (n0: wl -> p, n1: p -> wl, n2: wr -> p, n3: p -> wr), so the new links are mutual:
