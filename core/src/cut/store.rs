@@ -443,7 +443,8 @@ impl<const F: usize, I: SlotIndex> Triangles<F, I> {
     /// [`Triangles::ccw`], and the corner `v` takes in `f`.
     #[inline(always)]
     pub fn ccw_at(&self, f: u32, v: u32) -> Option<(usize, u32)> {
-        let adj = *self.adj.get(f as usize)?;
+        // Bounded by the length, as `corner_of` is: one test serves both.
+        let adj = *self.adj[..self.len as usize].get(f as usize)?;
         let k = self.corner_of(f, v)?;
         // `adj[prev3(k)]`.
         Some((k, pick([adj[2], adj[0], adj[1]], k).load()))
@@ -452,7 +453,7 @@ impl<const F: usize, I: SlotIndex> Triangles<F, I> {
     /// [`Triangles::cw`], and the corner `v` takes in `f`.
     #[inline(always)]
     pub fn cw_at(&self, f: u32, v: u32) -> Option<(usize, u32)> {
-        let adj = *self.adj.get(f as usize)?;
+        let adj = *self.adj[..self.len as usize].get(f as usize)?;
         let k = self.corner_of(f, v)?;
         Some((k, pick(adj, k).load()))
     }
