@@ -603,11 +603,15 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         self.link_family(h, s as u32);
     }
 
-    /// [`Cut::rename_vertex`] without the links: the caller sets them.
+    /// [`Cut::rename_vertex`] without the links: the caller sets them (slot `s`'s mate too,
+    /// so only the old mate's link back is broken here).
     #[inline(always)]
     fn reassign(&mut self, s: usize, node: u32) {
         self.map.remove(self.v.node[s], self.v.nodes());
-        self.unlink_mate(s);
+        let m = self.v.mate(s);
+        if m != NIL {
+            self.v.set_mate(m as usize, NIL);
+        }
         self.free_blend(s);
         self.v.node[s] = node;
         // The old entry was removed, so there is room.
