@@ -105,10 +105,12 @@ impl<const M: usize, I: SlotIndex> NodeMap<M, I> {
         self.len as usize
     }
 
-    /// The slot stored in table entry `i`, if any.
+    /// The slot stored in table entry `i`, if any. Read as the raw index: an entry is a slot
+    /// plus one, below the index type's [`SlotIndex::LIMIT`], never its all-ones `NIL` (which
+    /// `load` would test for).
     #[inline]
     fn entry(&self, i: usize) -> Option<u32> {
-        let e = self.table.get(i)?.load();
+        let e = self.table.get(i)?.index() as u32;
         e.checked_sub(1)
     }
 
