@@ -71,7 +71,7 @@
 //! ```
 
 use crate::cut::expiry::{lives, Renew, Settling, Tally};
-use crate::cut::margin::{lesser, Either};
+use crate::cut::margin::lesser;
 use crate::cut::split::Split;
 use crate::cut::NIL;
 use crate::cut::{
@@ -558,35 +558,29 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                     .filter(|m| markable & m.measures(flags, i))
                 {
                     // How far the camera may move while it wants no split (answered from its
-                    // sphere, a leaf never splits); with geomorphs also while it is seen (or
-                    // not) as in the frame before, since that flag decides whether a change
-                    // blends.
-                    let seen = if blends || (wants_none && m.margins.culls()) {
+                    // sphere); with geomorphs also while it is seen (or not) as in the frame
+                    // before, since that flag decides whether a change blends. A leaf never
+                    // splits, whatever it is asked (a parent's bounding radius is not 0 but
+                    // where its whole region is a point: looked up then): its answer holds on
+                    // either count however far the camera goes, so nothing of it is measured
+                    // but, with geomorphs, whether it is seen.
+                    let leaf = digest.radius == 0 && !h.is_parent(self.v.node[i]);
+                    let seen = if blends || (!leaf & wants_none && m.margins.culls()) {
                         m.margins.visibility(center, radius)
                     } else {
                         (None, f32::NAN)
                     };
-                    // A leaf never splits, whatever it is asked (a parent's bounding radius
-                    // is not 0 but where its whole region is a point: looked up then).
-                    let leaf = digest.radius == 0 && !h.is_parent(self.v.node[i]);
-                    let (own, e) = if leaf {
-                        let never = Either {
-                            eye: f32::INFINITY,
-                            sway: f32::NEG_INFINITY,
-                        };
-                        (f32::INFINITY, never)
+                    let (own, turns) = if leaf {
+                        (f32::INFINITY, f32::INFINITY)
                     } else if wants_none {
                         let e = m.margins.unwanted(s, radius, d2, seen);
-                        (e.within(m.scale), e)
+                        (e.within(m.scale), m.turned(e, center, radius))
                     } else {
-                        let unproven = Either {
-                            eye: f32::NAN,
-                            sway: f32::NAN,
-                        };
-                        (f32::NAN, unproven)
+                        // Unproven, on either count.
+                        (f32::NAN, f32::NEG_INFINITY)
                     };
                     if !blends {
-                        turned[n] = m.turned(e, center, radius);
+                        turned[n] = turns;
                     }
                     margin[n] = match (blends, seen) {
                         (false, _) => own,
