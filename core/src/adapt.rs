@@ -530,14 +530,24 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 let radius = h.length(digest.radius);
                 let r = sub(center, view.eye);
                 let d2 = dot(r, r);
+                // A leaf never splits, whatever it is asked (a parent's bounding radius is not
+                // 0 but where its whole region is a point: looked up then). Without geomorphs,
+                // the one reader of whether it is seen, it wants nothing the policy could say:
+                // it is not asked (a second child or a lone leaf is done with here).
+                let leaf = digest.radius == 0 && !h.is_parent(self.v.node[i]);
+                let quiet = leaf & !blends;
                 let sphere = if sphere_only {
-                    Some(sphere_demand(policy, (center, radius), view))
+                    Some(if quiet {
+                        Demand::NONE
+                    } else {
+                        sphere_demand(policy, (center, radius), view)
+                    })
                 } else {
                     None
                 };
                 let wants_none = match sphere {
                     Some(d) => d.error <= t,
-                    None => bound_proves_none(s, radius, d2, (upper, &zone), t),
+                    None => quiet || bound_proves_none(s, radius, d2, (upper, &zone), t),
                 };
                 let mate = self.v.mate(i);
                 let still = flags & (BLENDING | COLLAPSING) == 0;
@@ -559,12 +569,9 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 {
                     // How far the camera may move while it wants no split (answered from its
                     // sphere); with geomorphs also while it is seen (or not) as in the frame
-                    // before, since that flag decides whether a change blends. A leaf never
-                    // splits, whatever it is asked (a parent's bounding radius is not 0 but
-                    // where its whole region is a point: looked up then): its answer holds on
-                    // either count however far the camera goes, so nothing of it is measured
-                    // but, with geomorphs, whether it is seen.
-                    let leaf = digest.radius == 0 && !h.is_parent(self.v.node[i]);
+                    // before, since that flag decides whether a change blends. A leaf's
+                    // answer holds on either count however far the camera goes, so nothing of
+                    // it is measured but, with geomorphs, whether it is seen.
                     let seen = if blends || (!leaf & wants_none && m.margins.culls()) {
                         m.margins.visibility(center, radius)
                     } else {
