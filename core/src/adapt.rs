@@ -1150,10 +1150,11 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                     if self.v.node.get(cs as usize) != Some(&c) {
                         continue;
                     }
-                    // Whether it splits, from its digest where that decides (a policy that reads
-                    // spheres gets the digest's, the record's floats; without geomorphs, an
-                    // envelope that proves no split is enough, as in the walk), else from its
-                    // record.
+                    // Whether it splits: never for a leaf (without geomorphs, the one reader of
+                    // whether it is seen, a leaf is not asked, as in the walk); else from its
+                    // digest where that decides (a policy that reads spheres gets the digest's,
+                    // the record's floats; without geomorphs, an envelope that proves no split
+                    // is enough, as in the walk), else from its record.
                     let digest = &self.v.digest[cs as usize];
                     let (center, radius) = (h.digest_center(digest), h.length(digest.radius));
                     let proven = || {
@@ -1161,7 +1162,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                         let s = h.length(digest.spheroid);
                         bound_proves_none(s, radius, dot(r, r), (upper, &zone), t)
                     };
-                    let d = if !sphere_only && frames == 0 && proven() {
+                    let d = if frames == 0 && (!record.is_parent() || !sphere_only && proven()) {
                         Demand::NONE
                     } else if sphere_only {
                         sphere_demand(policy, (center, radius), view)
