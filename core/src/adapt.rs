@@ -70,7 +70,7 @@
 //! # }
 //! ```
 
-use crate::cut::expiry::{lives, Renew, Settling, Tally};
+use crate::cut::expiry::{lives, Mark, Renew, Settling, Tally};
 use crate::cut::margin::lesser;
 use crate::cut::split::Split;
 use crate::cut::NIL;
@@ -686,8 +686,9 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             }
             if let Some(m) = &settling {
                 for &k in pairs {
-                    // Not measured (restless, not its turn), or already too small: no need.
-                    let room = if margin[k] >= m.step || turned[k] >= m.turn {
+                    // Not measured (restless, not its turn), or already too small: no need,
+                    // and the mark is restless (under a step on either count).
+                    if margin[k] >= m.step || turned[k] >= m.turn {
                         let b = &parent_bounds[k];
                         let (wanted, turns) =
                             m.margins
@@ -695,11 +696,12 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                         let wanted = wanted.within(m.scale);
                         // Still wanted from where the eye is now: the pair stays.
                         kept[k] = wanted >= 0.0;
-                        (lesser(margin[k], wanted), lesser(turned[k], turns))
+                        let room = (lesser(margin[k], wanted), lesser(turned[k], turns));
+                        self.mark(listed[k], m, room, &mut tally);
                     } else {
-                        (margin[k], turned[k])
-                    };
-                    self.mark(listed[k], m, room, &mut tally);
+                        tally.count(margin[k], Mark::Restless);
+                        self.v.mark(listed[k], Mark::Restless);
+                    }
                 }
             }
             // 4. The decisions, in slot order. Without geomorphs they touch nothing but the
