@@ -563,10 +563,10 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 let mut next_flags = if done { seen_flags } else { flags };
                 margin[n] = f32::NEG_INFINITY;
                 turned[n] = f32::NEG_INFINITY;
-                if let Some(m) = settling
+                let measured = settling
                     .as_ref()
-                    .filter(|m| markable & m.measures(flags, i))
-                {
+                    .filter(|m| markable & m.measures(flags, i));
+                if let Some(m) = measured {
                     // How far the camera may move while it wants no split (answered from its
                     // sphere); with geomorphs also while it is seen (or not) as in the frame
                     // before, since that flag decides whether a change blends. A leaf's
@@ -604,7 +604,12 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 // A vertex whose record is read is marked once its facing is known (stage 2).
                 let slow_one = !wants_none & sphere.is_none();
                 if let Some(m) = settling.as_ref().filter(|_| alone & !slow_one) {
-                    self.mark(i, m, (margin[n], turned[n]), &mut tally);
+                    if measured.is_some() {
+                        self.mark(i, m, (margin[n], turned[n]), &mut tally);
+                    } else {
+                        // What `Settling::mark` makes of margins not measured.
+                        self.v.mark(i, Mark::Restless);
+                    }
                 }
                 listed[n] = i;
                 lone[n] = alone;
