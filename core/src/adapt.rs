@@ -653,12 +653,16 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             for (k, &i) in listed.iter().enumerate() {
                 let flags = self.v.flags[i];
                 let m = self.v.mate(i);
-                let mate_flags = self.v.flags.get(m as usize).copied().unwrap_or(0);
+                // The sibling's flags (another cache line) only when its own mark says the
+                // pair may be illegal.
+                let blocked = flags & BLOCKED != 0
+                    && self
+                        .v
+                        .flags
+                        .get(m as usize)
+                        .is_some_and(|f| f & BLOCKED != 0);
                 let splits = demands[k].error > t && h.is_parent(self.v.node[i]);
-                let judges = (flags & FIRST_CHILD != 0)
-                    & (m != NIL)
-                    & !splits
-                    & (flags & mate_flags & BLOCKED == 0);
+                let judges = (flags & FIRST_CHILD != 0) & (m != NIL) & !splits & !blocked;
                 pairs[np] = k;
                 np += judges as usize;
                 splitting[nsp] = k;
@@ -869,7 +873,8 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         let j = self.v.mate(i) as usize;
         let e = pair_error(self.judged_pair(h, (i, j), parent_bounds, view, policy));
         if e > frame.threshold {
-            if (self.v.flags[i] | self.v.flags[j]) & COLLAPSING != 0 {
+            // (A collapse under way has a blend entry: without any, the flags are not read.)
+            if self.blends.len() != 0 && (self.v.flags[i] | self.v.flags[j]) & COLLAPSING != 0 {
                 self.start_blend(h, i, false);
                 self.start_blend(h, j, false);
             }
