@@ -560,7 +560,9 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                     None => blends && view.sphere_visible(center, radius),
                 };
                 let seen_flags = seen(flags, visible, blends);
-                let mut next_flags = if done { seen_flags } else { flags };
+                // Calm, whatever else the frame asks of it, its flags move as a vertex's seen
+                // without geomorphs: now, which nothing until then reads.
+                let mut next_flags = if done | calm { seen_flags } else { flags };
                 margin[n] = f32::NEG_INFINITY;
                 turned[n] = f32::NEG_INFINITY;
                 let measured = settling
@@ -716,14 +718,10 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             // 4. The decisions, in slot order. Without geomorphs they touch nothing but the
             // split heap and the pair list, so the pairs can follow the vertices.
             if calm {
-                // What `decide` does without geomorphs: every vertex's flags move, and those
-                // that split join the heap, from lists made without branches (whether a vertex
-                // splits, or a pair is judged, follows no pattern a branch predictor learns).
-                for (k, &i) in listed.iter().enumerate() {
-                    let flags = self.v.flags[i];
-                    debug_assert!(flags & COLLAPSING == 0, "no collapse blends while calm");
-                    self.v.flags[i] = seen(flags, demands[k].visible, false);
-                }
+                // What `decide` does without geomorphs: every vertex's flags move (done in the
+                // first pass), and those that split join the heap, from lists made without
+                // branches (whether a vertex splits, or a pair is judged, follows no pattern a
+                // branch predictor learns).
                 for &k in &splitting[..nsp] {
                     self.want_split(self.v.node[listed[k]], demands[k], frame);
                 }
