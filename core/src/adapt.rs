@@ -479,7 +479,6 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         let mut margin = [f32::NAN; BATCH];
         // The same as turned (see `crate::cut::rigid`), without geomorphs.
         let mut turned = [f32::NAN; BATCH];
-        let mut bounds = [Bounds::default(); BATCH];
         let mut demands = [Demand::NONE; BATCH];
         let mut parents = [NONE; BATCH];
         let mut records = [Record::default(); BATCH];
@@ -616,8 +615,6 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
                 listed[n] = i;
                 lone[n] = alone;
                 slow[ns] = n;
-                bounds[n].center = center;
-                bounds[n].radius = radius;
                 demands[n] = sphere.unwrap_or(Demand {
                     visible,
                     error: 0.0,
@@ -634,15 +631,15 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             }
             core::hint::black_box(touched);
             for &k in slow {
-                bounds[k] = h.bounds_at(records[k]);
-                demands[k] = self.judged(h, listed[k], &bounds[k], view, policy);
+                let bounds = h.bounds_at(records[k]);
+                demands[k] = self.judged(h, listed[k], &bounds, view, policy);
                 if let Some(m) = &settling {
                     // Its bound could not say it wants no split, but a normal cone that stays
                     // turned away does (a culled vertex wants nothing): most such vertices are
                     // the coarse ones on the far side. Measured ones only; with geomorphs its
                     // visibility would have to stay too.
                     if !blends && margin[k] != f32::NEG_INFINITY {
-                        margin[k] = margin[k].max(m.margins.averted(&bounds[k]));
+                        margin[k] = margin[k].max(m.margins.averted(&bounds));
                     }
                     if lone[k] {
                         self.mark(listed[k], m, (margin[k], turned[k]), &mut tally);
