@@ -532,7 +532,9 @@ fn settled_word(flags: &[u8], tags: &[u16], now: [u32; 2]) -> Option<usize> {
 }
 
 /// The transpose of the 8x8 bit matrix whose row `r` is byte `r` of `x` (column `c` its bit
-/// `c`): bit `8r + c` moves to bit `8c + r` (Hacker's Delight, `transpose8`).
+/// `c`): bit `8r + c` moves to bit `8c + r`, by three exchanges of bit blocks (the method of
+/// Henry S. Warren, Jr., *Hacker's Delight*, 2nd ed., 2012, section 7-3, "Transposing a Bit
+/// Matrix").
 #[cfg(any(target_arch = "x86_64", target_arch = "aarch64"))]
 #[inline(always)]
 fn transposed(mut x: u64) -> u64 {
