@@ -328,7 +328,7 @@ impl ModelBox {
             return ModelBox::ZERO;
         }
         let extent = [0, 1, 2].map(|k| (hi[k] - lo[k]).max(0.0));
-        let diagonal = libm::sqrtf(extent.iter().map(|e| e * e).sum::<f32>());
+        let diagonal = crate::root::sqrtf(extent.iter().map(|e| e * e).sum::<f32>());
         let unit = if diagonal.is_finite() && diagonal > 0.0 {
             diagonal
         } else {
@@ -463,7 +463,7 @@ fn round_small(x: f32) -> i8 {
 pub fn oct_decode(x: i8, y: i8) -> [f32; 3] {
     let w = oct_unfold(x, y);
     // Never zero: the components' magnitudes add up to 127.
-    scale(w, 1.0 / libm::sqrtf(dot(w, w)))
+    scale(w, 1.0 / crate::root::sqrtf(dot(w, w)))
 }
 
 /// [`oct_decode`] before normalizing: in units of 1/127, `|u| + |v| + |z| = 127`. The lower
@@ -894,7 +894,7 @@ impl<'a> HierarchyView<'a> {
         let (min, max) = self.bounding_box();
         let center = core::array::from_fn(|k| 0.5 * (min[k] + max[k]));
         let d = [0, 1, 2].map(|k| max[k] - min[k]);
-        let radius = 0.5 * libm::sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        let radius = 0.5 * crate::root::sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
         (center, radius)
     }
 
@@ -1288,7 +1288,7 @@ impl<'a> HierarchyView<'a> {
         }
         let mut inv = [0.0f32; N];
         for (i, s) in inv.iter_mut().zip(squares) {
-            *i = 1.0 / libm::sqrtf(s);
+            *i = 1.0 / crate::root::sqrtf(s);
         }
         for axis in normals.iter_mut() {
             for (c, i) in axis.iter_mut().zip(inv) {

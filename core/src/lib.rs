@@ -21,4 +21,5 @@ mod nodemap;
 pub mod policy;
 #[cfg(feature = "build")]
 pub mod remesh;
+pub mod root;
 pub mod wavelet;

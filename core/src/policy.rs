@@ -257,7 +257,7 @@ pub(crate) fn cross(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
 }
 
 fn normalize(a: [f32; 3]) -> Option<[f32; 3]> {
-    let l = libm::sqrtf(dot(a, a));
+    let l = crate::root::sqrtf(dot(a, a));
     (l > 0.0 && l.is_finite()).then(|| [a[0] / l, a[1] / l, a[2] / l])
 }
 
@@ -548,7 +548,7 @@ impl ScreenError {
     /// needs no square root).
     pub fn pixels(b: &Bounds, view: &View) -> f32 {
         let e = Eye::of(b, view);
-        libm::sqrtf(e.spheroid(b) / (e.d2 * e.d2)) * view.pixels_per_unit
+        crate::root::sqrtf(e.spheroid(b) / (e.d2 * e.d2)) * view.pixels_per_unit
     }
 
     /// `(projected radius / tolerance)^2 = lhs ppu^2 / (tol^2 d^4)`, with one division.
@@ -718,7 +718,7 @@ impl Policy for MergeTree {
         // which spheres are in view and near follows no pattern a branch predictor learns.
         let visible = view.sphere_visible(b.center, b.radius);
         let r = sub(b.center, view.eye);
-        let gap = (libm::sqrtf(dot(r, r)) - b.radius).max(0.0);
+        let gap = (crate::root::sqrtf(dot(r, r)) - b.radius).max(0.0);
         let wanted = 1.0 + 1.0 / (1.0 + gap);
         Demand {
             visible,
@@ -812,7 +812,7 @@ impl Importance {
     #[must_use]
     pub fn for_box(threshold: f32, (min, max): ([f32; 3], [f32; 3])) -> Importance {
         let d = sub(max, min);
-        Importance::new(threshold, libm::sqrtf(dot(d, d)))
+        Importance::new(threshold, crate::root::sqrtf(dot(d, d)))
     }
 
     /// The policy for the model `h` holds, sized by its bounding box.
@@ -834,19 +834,19 @@ impl Importance {
                 dot(r, r)
             })
             .fold(0.0f32, f32::max);
-        if !view.sphere_visible(center, libm::sqrtf(spread) + reach.max(0.0)) {
+        if !view.sphere_visible(center, crate::root::sqrtf(spread) + reach.max(0.0)) {
             return 0.0;
         }
         let n = cross(sub(c[1], c[0]), sub(c[2], c[0]));
-        let twice_area = libm::sqrtf(dot(n, n));
+        let twice_area = crate::root::sqrtf(dot(n, n));
         let r = sub(center, view.eye);
-        let d = libm::sqrtf(dot(r, r));
+        let d = crate::root::sqrtf(dot(r, r));
         if !(twice_area > 0.0 && d > 0.0) {
             // Degenerate, or the eye on its centre: only its size can speak.
             return if twice_area > 0.0 { f32::MAX } else { 0.0 };
         }
         let cos = (dot(n, r) / (twice_area * d)).clamp(-1.0, 1.0);
-        let sin = libm::sqrtf(1.0 - cos * cos);
+        let sin = crate::root::sqrtf(1.0 - cos * cos);
         let area = 0.5 * twice_area / (self.size * self.size);
         area / (d / self.size * view.tan_fov) * (-cos).max(sin)
     }

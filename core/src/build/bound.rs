@@ -37,7 +37,7 @@ pub fn equation3(errors: &[(f32, f32)]) -> [f32; 2] {
     }
     let ratio = along / across;
     let b = errors.iter().fold(0.0f32, |m, &(a, b)| {
-        m.max(libm::sqrtf((a / ratio) * (a / ratio) + b * b))
+        m.max(crate::root::sqrtf((a / ratio) * (a / ratio) + b * b))
     });
     [ratio * b, b]
 }

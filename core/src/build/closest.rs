@@ -126,7 +126,7 @@ impl Surface {
                 }
             }
             let n = cross(sub(t[1], t[0]), sub(t[2], t[0]));
-            area += 0.5 * libm::sqrt(dot(n, n));
+            area += 0.5 * crate::root::sqrt(dot(n, n));
         }
         if corners.is_empty() {
             min = [0.0; 3];
@@ -136,7 +136,7 @@ impl Surface {
         let extent = [0, 1, 2].map(|k| max[k] - min[k]);
         let largest = extent[0].max(extent[1]).max(extent[2]);
         // About two triangles across a cell, fewer cells when the box is mostly empty.
-        let mut cell = (2.0 * libm::sqrt(area / n)).max(largest * 1e-6);
+        let mut cell = (2.0 * crate::root::sqrt(area / n)).max(largest * 1e-6);
         if !(cell > 0.0 && cell.is_finite()) {
             cell = 1.0;
         }
@@ -253,7 +253,7 @@ impl Surface {
                 }
             }
         }
-        libm::sqrt(best)
+        crate::root::sqrt(best)
     }
 }
 
@@ -269,7 +269,7 @@ mod tests {
             .iter()
             .map(|t| triangle_distance2(p, t))
             .fold(f64::INFINITY, f64::min);
-        libm::sqrt(d)
+        crate::root::sqrt(d)
     }
 
     #[test]

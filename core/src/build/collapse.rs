@@ -122,7 +122,7 @@ pub(crate) fn shape(t: [Vec3d; 3]) -> f64 {
     let edges = [sub(b, a), sub(c, b), sub(a, c)];
     let squares: f64 = edges.iter().map(|&e| dot(e, e)).sum();
     if squares > 0.0 {
-        2.0 * libm::sqrt(3.0) * len(cross(edges[0], sub(c, a))) / squares
+        2.0 * crate::root::sqrt(3.0) * len(cross(edges[0], sub(c, a))) / squares
     } else {
         0.0
     }
@@ -195,7 +195,7 @@ pub(crate) fn cost_at(
             let gerr = surface.map_or(0.0, |s| s.distance(v));
             let [ca, cb] = colors();
             let dc = len(sub(ca, cb));
-            gerr * gerr + len2 + libm::sqrt(libm::sqrt(len2) * dc)
+            gerr * gerr + len2 + crate::root::sqrt(crate::root::sqrt(len2) * dc)
         }
     }
 }

@@ -386,7 +386,7 @@ fn least_squares_conformal(
         let x = [e1[0] / l1, e1[1] / l1, e1[2] / l1];
         let y = normalize(cross(normal, x))?;
         let z = [[0.0, 0.0], [l1, 0.0], [dot(e2, x), dot(e2, y)]];
-        let weight = 1.0 / libm::sqrt(area);
+        let weight = 1.0 / crate::root::sqrt(area);
         // W_k = z_{k+2} - z_{k+1}; the residual's real and imaginary rows.
         let w: [Uv; 3] = core::array::from_fn(|k| {
             let (p, q) = (z[(k + 2) % 3], z[(k + 1) % 3]);

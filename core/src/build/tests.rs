@@ -89,7 +89,7 @@ pub(crate) fn sphere(levels: u32) -> (Vec<[f32; 3]>, Vec<[u32; 3]>) {
             }
             let (pa, pb) = (p[a as usize], p[b as usize]);
             let m = [0, 1, 2].map(|k| (pa[k] + pb[k]) * 0.5);
-            let l = libm::sqrtf(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
+            let l = crate::root::sqrtf(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
             p.push(m.map(|c| c / l));
             let id = p.len() as u32 - 1;
             mids.push((key, id));
@@ -318,18 +318,18 @@ fn colour_cost_is_the_papers_formula() {
     // Length 2, colours red and blue: dcolor = sqrt(2).
     let (v, cost) = e.evaluate(0, 1);
     assert_eq!(v, [1.0, 0.0, 0.0]);
-    let want = 4.0 + libm::sqrt(2.0 * libm::sqrt(2.0));
+    let want = 4.0 + crate::root::sqrt(2.0 * crate::root::sqrt(2.0));
     assert!((cost - want).abs() < 1e-9, "{cost} {want}");
     // Length sqrt(5.25) along the diagonal, colours red and green.
     let (v, cost) = e.evaluate(0, 3);
     assert_eq!(v, [1.0, 0.5, 0.25]);
-    let want = 5.25 + libm::sqrt(libm::sqrt(5.25) * libm::sqrt(2.0));
+    let want = 5.25 + crate::root::sqrt(crate::root::sqrt(5.25) * crate::root::sqrt(2.0));
     assert!((cost - want).abs() < 1e-9, "{cost} {want}");
     // Across the other diagonal (no edge), the midpoint lies off the surface: 0.5 / sqrt(5)
     // below the plane -y + 2z = 0 of triangle 0-1-3, over that triangle, so Gerr^2 = 1/20.
     let (v, cost) = e.evaluate(1, 2);
     assert_eq!(v, [1.0, 0.5, 0.0]);
-    let want = 0.05 + 5.0 + libm::sqrt(libm::sqrt(5.0) * libm::sqrt(2.0));
+    let want = 0.05 + 5.0 + crate::root::sqrt(crate::root::sqrt(5.0) * crate::root::sqrt(2.0));
     assert!((cost - want).abs() < 1e-9, "{cost} {want}");
 }
 

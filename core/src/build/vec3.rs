@@ -34,7 +34,7 @@ pub fn cross(a: Vec3d, b: Vec3d) -> Vec3d {
 
 /// Euclidean length.
 pub fn len(a: Vec3d) -> f64 {
-    libm::sqrt(dot(a, a))
+    crate::root::sqrt(dot(a, a))
 }
 
 /// `a` scaled to unit length, or `None` for a zero or non-finite vector.

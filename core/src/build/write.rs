@@ -129,7 +129,7 @@ impl Hierarchy {
                     x * x
                 })
                 .sum();
-            moved = moved.max(libm::sqrt(e));
+            moved = moved.max(crate::root::sqrt(e));
         }
         let grow = (2.0 * moved) as f32 * 1.001;
         let code = |v: f32| encode_length((v + grow) / model.unit());

@@ -193,7 +193,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         let done = 1.0 - b.left.min(total) as f32 / total as f32;
         let from_normal = b.from_normal.map(|c| c as f32 / 32767.0);
         let n = lerp3(from_normal, to.normal, done);
-        let l = libm::sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        let l = crate::root::sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
         let c = |k: usize| {
             let (x, y) = (b.from_color[k] as f32, to.color[k] as f32);
             (x + (y - x) * done + 0.5) as u8

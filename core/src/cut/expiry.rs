@@ -218,7 +218,7 @@ impl Settling {
     fn reach(&self, center: [f32; 3]) -> f32 {
         let r = sub(center, self.centre.0);
         let along = dot(r, self.axis);
-        libm::sqrtf((dot(r, r) - along * along).max(0.0))
+        crate::root::sqrtf((dot(r, r) - along * along).max(0.0))
     }
 
     /// What [`Margins::wanted_turned`] needs of a parent centred at `center`: its
@@ -418,7 +418,7 @@ impl Motion {
         };
         let now = planes(view);
         let moved = sub(view.eye, self.eye);
-        let moved = libm::sqrtf(dot(moved, moved));
+        let moved = crate::root::sqrtf(dot(moved, moved));
         let swayed = if envelope.frustum {
             sway(&self.planes, &now, model)
         } else {

@@ -34,7 +34,8 @@ pub(crate) fn sway(a: &Planes, b: &Planes, (center, radius): ([f32; 3], f32)) ->
     let mut most = 0.0f32;
     for (p, q) in a.iter().zip(b) {
         let dn = [p[0] - q[0], p[1] - q[1], p[2] - q[2]];
-        let shift = libm::sqrtf(dot(dn, dn)) * radius + libm::fabsf(dot(dn, center) + p[3] - q[3]);
+        let shift =
+            crate::root::sqrtf(dot(dn, dn)) * radius + libm::fabsf(dot(dn, center) + p[3] - q[3]);
         most = most.max(shift);
     }
     most
@@ -150,7 +151,7 @@ impl Margins {
         reach: f32,
     ) -> Margins {
         let to = sub(model.0, eye);
-        let farthest = libm::sqrtf(dot(to, to)) + model.1;
+        let farthest = crate::root::sqrtf(dot(to, to)) + model.1;
         let slop = SLACK * (farthest + reach);
         let mut lanes = [[0.0f32; 8]; 4];
         lanes[3] = [f32::MAX; 8];
@@ -165,7 +166,7 @@ impl Margins {
             eye,
             lanes,
             envelope,
-            scale: libm::sqrtf(envelope.upper * slack * (1.0 + SLACK) / t),
+            scale: crate::root::sqrtf(envelope.upper * slack * (1.0 + SLACK) / t),
             slop,
             plane_slop,
             per_across: [1.0; 8],
@@ -272,7 +273,7 @@ impl Margins {
             _ => f32::NEG_INFINITY,
         };
         Either {
-            eye: self.quiet(s, radius, libm::sqrtf(d2)),
+            eye: self.quiet(s, radius, crate::root::sqrtf(d2)),
             sway: out,
         }
     }
@@ -288,7 +289,7 @@ impl Margins {
             return f32::NEG_INFINITY;
         }
         let r = sub(b.center, self.eye);
-        let d = libm::sqrtf(dot(r, r));
+        let d = crate::root::sqrtf(dot(r, r));
         // The test squares the sine: its sign does not matter.
         let cs = libm::fabsf(b.cone_sin);
         // An eye moved by `e` shortens `rn` and lengthens `d` by at most `|e|` each.
@@ -334,7 +335,7 @@ impl Margins {
             (true, _) => f32::NAN,
         };
         let r = sub(b.center, self.eye);
-        let d = libm::sqrtf(dot(r, r));
+        let d = crate::root::sqrtf(dot(r, r));
         let rn = dot(r, b.axis);
         // Not facing away (`s <= 0` or `s <= (d - shift) cone_sin`, `s = rn - radius + shift`,
         // the shift being the reach plus slop): either holds for shifts up to its bound.
@@ -399,7 +400,7 @@ impl Margins {
         // `(b2 - SLACK most) lower far^2 > k far^4` while `far^2 < (b2 - SLACK most) lower / k`.
         let across = (b.b2 - SLACK * most) * lower / k;
         if across > 0.0 {
-            libm::sqrtf(across) / (1.0 + SLACK) - d - self.slop
+            crate::root::sqrtf(across) / (1.0 + SLACK) - d - self.slop
         } else {
             f32::NEG_INFINITY
         }
@@ -430,7 +431,7 @@ impl Margins {
             return margin;
         }
         let most = b.a2.max(b.b2);
-        let axial = libm::sqrtf((d * d - rn * rn).max(0.0));
+        let axial = crate::root::sqrtf((d * d - rn * rn).max(0.0));
         let holds = |reach: f32| {
             let shift = reach + self.slop;
             let far = d + shift;
@@ -576,7 +577,7 @@ mod tests {
             for dy in -1..=1 {
                 for dz in -1..=1 {
                     let dir = [dx as f32, dy as f32, dz as f32];
-                    let len = libm::sqrtf(dot(dir, dir));
+                    let len = crate::root::sqrtf(dot(dir, dir));
                     if len == 0.0 {
                         continue;
                     }

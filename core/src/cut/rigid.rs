@@ -135,7 +135,7 @@ fn turn(a: &Axes, b: &Axes) -> f32 {
         let d = sub(*p, *q);
         squares += dot(d, d);
     }
-    libm::sqrtf(squares * 0.5)
+    crate::root::sqrtf(squares * 0.5)
 }
 
 /// The model's rotation from `a` to `b`, in the world: `N = Bᵀ A` (row `i` of `A` is the
@@ -165,7 +165,7 @@ fn skew(n: &[[f32; 3]; 3]) -> [f32; 3] {
 fn stray(n: &[[f32; 3]; 3], turned: f32, axis: [f32; 3]) -> f32 {
     // turned = 2 sin(angle / 2): cos = 1 - turned^2 / 2, |sin| = turned sqrt(1 - turned^2 / 4).
     let cos = 1.0 - 0.5 * turned * turned;
-    let sin = turned * libm::sqrtf((1.0 - 0.25 * turned * turned).max(0.0));
+    let sin = turned * crate::root::sqrtf((1.0 - 0.25 * turned * turned).max(0.0));
     let sin = if dot(skew(n), axis) < 0.0 { -sin } else { sin };
     let [x, y, z] = axis;
     // Rodrigues: cos I + sin [axis]x + (1 - cos) axis axisᵀ.
@@ -178,7 +178,7 @@ fn stray(n: &[[f32; 3]; 3], turned: f32, axis: [f32; 3]) -> f32 {
             squares += (n[i][j] - r) * (n[i][j] - r);
         }
     }
-    libm::sqrtf(squares) + 8.0 * ROUNDING
+    crate::root::sqrtf(squares) + 8.0 * ROUNDING
 }
 
 /// The unit axis the step from `a` to `b` turned about (a world direction, either way along
@@ -229,11 +229,11 @@ pub(crate) fn pivot(a: &Axes, b: &Axes, axis: [f32; 3]) -> Option<[f32; 3]> {
 /// The part across the unit `axis` of the unit normal `n`: `|n − (n . axis) axis|`.
 pub(crate) fn across(n: [f32; 3], axis: [f32; 3]) -> f32 {
     let along = dot(n, axis);
-    libm::sqrtf((dot(n, n) - along * along).max(0.0))
+    crate::root::sqrtf((dot(n, n) - along * along).max(0.0))
 }
 
 pub(crate) fn norm(v: [f32; 3]) -> f32 {
-    libm::sqrtf(dot(v, v))
+    crate::root::sqrtf(dot(v, v))
 }
 
 #[cfg(test)]
@@ -322,7 +322,7 @@ mod tests {
         for (a, b) in pairs {
             let s = step(&axes(&a), &axes(&b), 1.0, 0.5, [0.0; 3]);
             for &p in &points {
-                let bound = s * libm::sqrtf(dot(p, p)).max(0.5);
+                let bound = s * crate::root::sqrtf(dot(p, p)).max(0.5);
                 let ((pa, da), (pb, db)) = (seen(&a, p), seen(&b, p));
                 let moved = norm(sub(pa, pb));
                 assert!(moved <= bound, "{moved} > {bound}");

@@ -348,7 +348,7 @@ fn relaxed(input: &InputMesh<'_>, mesh: &mut SemiRegular, on_input: &mut [(u32, 
                 from_f32(mesh.positions[a as usize]),
                 from_f32(mesh.positions[b as usize]),
             );
-            libm::sqrt(dot(d, d))
+            crate::root::sqrt(dot(d, d))
         })
         .sum::<f64>()
         / (3 * triangles.len()).max(1) as f64;

@@ -71,7 +71,7 @@ impl Remesh {
             let edges = [sub(b, a), sub(c, b), sub(a, c)];
             let squares: f64 = edges.iter().map(|&e| dot(e, e)).sum();
             let shape = if squares > 0.0 {
-                2.0 * libm::sqrt(3.0) * len(n) / squares
+                2.0 * crate::root::sqrt(3.0) * len(n) / squares
             } else {
                 0.0
             };
@@ -169,7 +169,7 @@ pub fn distances(
     }
     Distances {
         hausdorff: largest / diagonal,
-        rms: libm::sqrt(squares / samples.max(1) as f64) / diagonal,
+        rms: crate::root::sqrt(squares / samples.max(1) as f64) / diagonal,
         samples,
         farthest,
     }

@@ -69,7 +69,7 @@ impl Relax<'_> {
             return (0.0, [[0.0; 3]; 3]);
         };
         let s = 0.5 * dot(cross(sub(c[1], c[0]), sub(c[2], c[0])), m);
-        let root = libm::sqrt(s * s + d * d);
+        let root = crate::root::sqrt(s * s + d * d);
         let slope = s / root - 1.0;
         // d s / d corner k = 0.5 (c[k+1] - c[k+2]) x m.
         let g =

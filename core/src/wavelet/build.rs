@@ -336,7 +336,7 @@ impl SemiRegular {
         SemiRegular::from_fn(&OCTAHEDRON_VERTICES, &OCTAHEDRON_FACES, levels, |f, w| {
             let c = OCTAHEDRON_FACES[f as usize].map(|v| OCTAHEDRON_VERTICES[v as usize]);
             let p = interpolate(c, w, n);
-            let l = libm::sqrtf(p.iter().map(|x| x * x).sum());
+            let l = crate::root::sqrtf(p.iter().map(|x| x * x).sum());
             p.map(|x| x / l)
         })
     }
@@ -611,7 +611,7 @@ fn dot(a: [f32; 3], b: [f32; 3]) -> f32 {
 }
 
 fn norm(a: [f32; 3]) -> f32 {
-    libm::sqrtf(dot(a, a))
+    crate::root::sqrtf(dot(a, a))
 }
 
 fn unit(a: [f32; 3]) -> [f32; 3] {

@@ -858,7 +858,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         let half: [f32; 3] = core::array::from_fn(|k| 0.5 * (hi[k] - lo[k]));
         let model = (
             core::array::from_fn(|k| lo[k] + half[k]),
-            libm::sqrtf(half[0] * half[0] + half[1] * half[1] + half[2] * half[2]),
+            crate::root::sqrtf(half[0] * half[0] + half[1] * half[1] + half[2] * half[2]),
         );
         let mode = self
             .steady
@@ -1041,7 +1041,7 @@ impl<const WORDS: usize, const T: usize, const V: usize, const Q: usize, I: Slot
         let r = sub(b.center, view.eye);
         self.steady.stays_unwanted(
             m,
-            libm::sqrtf(b.a2.max(b.b2)),
+            crate::root::sqrtf(b.a2.max(b.b2)),
             (b.center, b.radius),
             dot(r, r),
         )

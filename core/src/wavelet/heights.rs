@@ -101,7 +101,7 @@ impl SemiRegularView<'_> {
             }
             d = next;
         }
-        let len = libm::sqrtf(sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]);
+        let len = crate::root::sqrtf(sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]);
         if len > 0.0 && len.is_finite() {
             sum.map(|x| x / len)
         } else {
@@ -440,7 +440,7 @@ mod write {
                     continue;
                 };
                 let (a, b) = (positions[v as usize], positions[q as usize]);
-                let gap = libm::sqrtf((0..3).map(|i| (a[i] - b[i]) * (a[i] - b[i])).sum());
+                let gap = crate::root::sqrtf((0..3).map(|i| (a[i] - b[i]) * (a[i] - b[i])).sum());
                 kept[kq].raise(gap + child.radius, child.a, child.cone);
             }
         }
@@ -553,7 +553,8 @@ mod tests {
                     continue;
                 }
                 let c = s.bounds(q);
-                let gap = libm::sqrtf((0..3).map(|k| (b.center[k] - c.center[k]).powi(2)).sum());
+                let gap =
+                    crate::root::sqrtf((0..3).map(|k| (b.center[k] - c.center[k]).powi(2)).sum());
                 assert!(c.a2 >= b.a2 && c.cone_sin >= b.cone_sin, "{q} over {v}");
                 assert!(c.radius >= (gap + b.radius) * 0.9999, "{q} over {v}");
             }

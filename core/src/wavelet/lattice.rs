@@ -281,7 +281,7 @@ impl SemiRegularView<'_> {
         let (face, idx) = (r / inner, r % inner);
         // Row u = j - 1 starts at u (2N - 3 - u) / 2: solve for the last start <= idx.
         let m = 2.0 * n as f64 - 3.0;
-        let disc = libm::sqrt((m * m - 8.0 * idx as f64).max(0.0));
+        let disc = crate::root::sqrt((m * m - 8.0 * idx as f64).max(0.0));
         let mut u = ((m - disc) / 2.0) as u32;
         let start = |u: u32| u * (2 * n - 3 - u) / 2;
         while u > 0 && start(u) > idx {

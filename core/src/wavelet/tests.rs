@@ -173,7 +173,10 @@ fn the_importance_test_subdivides_important_triangles_facing_the_eye() {
     // Close in front of the sphere, seeing all of it: the cap facing the eye is near and seen
     // face-on; the cap behind faces exactly away, so its triangles weigh nothing.
     let view = View::look_at([0.0, 0.0, 3.0], [0.0; 3], [0.0, 1.0, 0.0], 1.0, 1.0, 480.0);
-    let policy = (Frustum, Importance::new(2e-3, 2.0 * libm::sqrtf(3.0)));
+    let policy = (
+        Frustum,
+        Importance::new(2e-3, 2.0 * crate::root::sqrtf(3.0)),
+    );
     let mut cut = Cut::boxed();
     cut.reset(&s).unwrap();
     let first = cut.adapt(&s, &view, &policy, &Budget::default());

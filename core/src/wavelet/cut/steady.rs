@@ -98,7 +98,7 @@ impl Steady {
         }
         let now = planes(view);
         let moved = sub(view.eye, self.eye);
-        let moved = libm::sqrtf(dot(moved, moved));
+        let moved = crate::root::sqrtf(dot(moved, moved));
         let swayed = sway(&self.planes, &now, model);
         if self.valid
             && envelope == self.envelope
