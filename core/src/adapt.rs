@@ -799,6 +799,47 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         (asked, settled)
     }
 
+    /// Reads what each listed pair's collapse reads first, for every pair before the first
+    /// collapse: both vertices' nodes, fans and first fan triangles, and the pair's split
+    /// record. Independent loads, which the processor overlaps, where each collapse in turn
+    /// would wait on them after a frame's drawing has evicted the cut.
+    fn touch_pairs(&self, h: &HierarchyView<'_>) {
+        let mut touched = 0u32;
+        for pair in self.pairs.as_slice() {
+            let a = pair.first as usize;
+            touched ^= self.touch_fan(a) ^ self.touch_fan(self.v.mate(a) as usize);
+            if let Some(&node) = self.v.node.get(a) {
+                touched ^= h.pair_split(node).neighbours[0];
+            }
+        }
+        core::hint::black_box(touched);
+    }
+
+    /// Reads what each waiting split reads first, for every candidate before the first split:
+    /// its slot (the node map), its fan's first triangle and its split record.
+    fn touch_candidates(&self, h: &HierarchyView<'_>) {
+        let mut touched = 0u32;
+        for &(_, node) in self.candidates.as_slice() {
+            if let Some(s) = self.slot(node) {
+                touched ^= self.touch_fan(s as usize);
+            }
+            touched ^= h.split(node).neighbours[0];
+        }
+        core::hint::black_box(touched);
+    }
+
+    /// Reads slot `s`'s fan triangle (its id, corners and neighbours), where a walk of the fan
+    /// starts; 0 for a slot out of range.
+    #[inline(always)]
+    fn touch_fan(&self, s: usize) -> u32 {
+        let f = self.v.fan(s);
+        if (f as usize) < self.t.len() {
+            self.t.id[f as usize] ^ self.t.corner_at(f, 0) ^ self.t.adj(f)[0]
+        } else {
+            0
+        }
+    }
+
     /// Every running blend advances a frame, before the walk decides anything. A pair whose
     /// collapse is reversed restarts both children's blends from where they are; advanced as
     /// the walk reached it, the second child was a frame further or not depending on whether
@@ -917,6 +958,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             sort_pairs(self.pairs.as_mut_slice());
             budget.max_ops - (self.candidates.len() as u32).min(budget.max_ops / 2)
         };
+        self.touch_pairs(h);
         // Scratch for the fans of every collapse tried (made once: making one costs a memset).
         let mut fans = PairFans::default();
         // One pass over a list that grows: a collapse lists the pair it makes and the pairs
@@ -1096,6 +1138,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         // other slots; the order follows nodes and errors only, never slots, so a renumbered cut
         // refines alike. Otherwise every candidate goes largest error first.
         const DEPTH: usize = 32;
+        self.touch_candidates(h);
         let depth_first = budget.max_triangles == u32::MAX
             && budget.max_ops == u32::MAX
             && frames == 0
