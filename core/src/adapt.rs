@@ -312,6 +312,12 @@ struct Frame {
     ops: u32,
 }
 
+/// Whether a frame's operations read ahead ([`Cut::touch_pairs`], [`Cut::touch_candidates`]):
+/// where a miss costs a long wait and the processor keeps many in flight (x86-64, aarch64).
+/// A Cortex-M waits a few cycles on its memory, so there the reads would only add
+/// instructions (1.5% of the firmware's frames).
+const READ_AHEAD: bool = cfg!(any(target_arch = "x86_64", target_arch = "aarch64"));
+
 impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, I> {
     /// Splits and collapses blend over `frames` frames (0: no geomorphs, the default).
     pub fn set_geomorph_frames(&mut self, frames: u16) {
@@ -804,6 +810,9 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
     /// record. Independent loads, which the processor overlaps, where each collapse in turn
     /// would wait on them after a frame's drawing has evicted the cut.
     fn touch_pairs(&self, h: &HierarchyView<'_>) {
+        if !READ_AHEAD {
+            return;
+        }
         let mut touched = 0u32;
         for pair in self.pairs.as_slice() {
             let a = pair.first as usize;
@@ -818,6 +827,9 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
     /// Reads what each waiting split reads first, for every candidate before the first split:
     /// its slot (the node map), its fan's first triangle and its split record.
     fn touch_candidates(&self, h: &HierarchyView<'_>) {
+        if !READ_AHEAD {
+            return;
+        }
         let mut touched = 0u32;
         for &(_, node) in self.candidates.as_slice() {
             if let Some(s) = self.slot(node) {
