@@ -12,6 +12,13 @@
 //! floating-point unit, software elsewhere), the same bits.
 
 /// The square root of `x`, correctly rounded (NaN below zero, as `libm::sqrtf`).
+///
+/// ```
+/// use vdlod_core::root::sqrtf;
+/// assert_eq!(sqrtf(2.25), 1.5);
+/// assert_eq!(sqrtf(2.0), libm::sqrtf(2.0));
+/// assert!(sqrtf(-1.0).is_nan());
+/// ```
 #[inline(always)]
 #[must_use]
 pub fn sqrtf(x: f32) -> f32 {
@@ -28,6 +35,12 @@ pub fn sqrtf(x: f32) -> f32 {
 }
 
 /// The square root of `x` in double precision, correctly rounded (as `libm::sqrt`).
+///
+/// ```
+/// use vdlod_core::root::sqrt;
+/// assert_eq!(sqrt(6.25), 2.5);
+/// assert_eq!(sqrt(2.0), libm::sqrt(2.0));
+/// ```
 #[inline(always)]
 #[must_use]
 pub fn sqrt(x: f64) -> f64 {
