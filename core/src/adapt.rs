@@ -805,16 +805,17 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         (asked, settled)
     }
 
-    /// Reads what each listed pair's collapse reads first, for every pair before the first
-    /// collapse: both vertices' nodes, fans and first fan triangles, and the pair's split
-    /// record. Independent loads, which the processor overlaps, where each collapse in turn
-    /// would wait on them after a frame's drawing has evicted the cut.
-    fn touch_pairs(&self, h: &HierarchyView<'_>) {
+    /// Reads what each listed pair's collapse reads first, for the first `limit` pairs (those
+    /// an operation cap leaves room for) before the first collapse: both vertices' nodes, fans
+    /// and first fan triangles, and the pair's split record. Independent loads, which the
+    /// processor overlaps, where each collapse in turn would wait on them after a frame's
+    /// drawing has evicted the cut.
+    fn touch_pairs(&self, h: &HierarchyView<'_>, limit: usize) {
         if !READ_AHEAD {
             return;
         }
         let mut touched = 0u32;
-        for pair in self.pairs.as_slice() {
+        for pair in self.pairs.as_slice().iter().take(limit) {
             let a = pair.first as usize;
             touched ^= self.touch_fan(a) ^ self.touch_fan(self.v.mate(a) as usize);
             if let Some(&node) = self.v.node.get(a) {
@@ -824,14 +825,15 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         core::hint::black_box(touched);
     }
 
-    /// Reads what each waiting split reads first, for every candidate before the first split:
-    /// its slot (the node map), its fan's first triangle and its split record.
-    fn touch_candidates(&self, h: &HierarchyView<'_>) {
+    /// Reads what each waiting split reads first, for the first `limit` candidates of the heap
+    /// (its top levels: those an operation cap leaves room for) before the first split: its
+    /// slot (the node map), its fan's first triangle and its split record.
+    fn touch_candidates(&self, h: &HierarchyView<'_>, limit: usize) {
         if !READ_AHEAD {
             return;
         }
         let mut touched = 0u32;
-        for &(_, node) in self.candidates.as_slice() {
+        for &(_, node) in self.candidates.as_slice().iter().take(limit) {
             if let Some(s) = self.slot(node) {
                 touched ^= self.touch_fan(s as usize);
             }
@@ -970,7 +972,8 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
             sort_pairs(self.pairs.as_mut_slice());
             budget.max_ops - (self.candidates.len() as u32).min(budget.max_ops / 2)
         };
-        self.touch_pairs(h);
+        // (Under a cap the pairs are sorted, the first to go first.)
+        self.touch_pairs(h, cap.saturating_sub(frame.ops) as usize);
         // Scratch for the fans of every collapse tried (made once: making one costs a memset).
         let mut fans = PairFans::default();
         // One pass over a list that grows: a collapse lists the pair it makes and the pairs
@@ -1150,7 +1153,7 @@ impl<const V: usize, const F: usize, const Q: usize, I: SlotIndex> Cut<V, F, Q, 
         // other slots; the order follows nodes and errors only, never slots, so a renumbered cut
         // refines alike. Otherwise every candidate goes largest error first.
         const DEPTH: usize = 32;
-        self.touch_candidates(h);
+        self.touch_candidates(h, budget.max_ops.saturating_sub(frame.ops) as usize);
         let depth_first = budget.max_triangles == u32::MAX
             && budget.max_ops == u32::MAX
             && frames == 0
