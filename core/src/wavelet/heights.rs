@@ -553,8 +553,8 @@ mod tests {
                     continue;
                 }
                 let c = s.bounds(q);
-                let gap =
-                    crate::root::sqrtf((0..3).map(|k| (b.center[k] - c.center[k]).powi(2)).sum());
+                let d = [0, 1, 2].map(|k| b.center[k] - c.center[k]);
+                let gap = crate::root::sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
                 assert!(c.a2 >= b.a2 && c.cone_sin >= b.cone_sin, "{q} over {v}");
                 assert!(c.radius >= (gap + b.radius) * 0.9999, "{q} over {v}");
             }
