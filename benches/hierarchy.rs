@@ -6,7 +6,8 @@
 //! forest (QEM cost, default options) down to the base mesh, and then the balanced forest
 //! (`balanced`, made in passes); meshopt's `simplify` is asked for the same number of triangles
 //! with no error limit. Each is run `RUNS` times; the table gives the
-//! median time and the peak heap in use during the call (from a counting allocator), plus the
+//! median time and the peak heap in use during the call (from a counting allocator, which also
+//! serves meshoptimizer's own temporary allocations through `meshopt_setAllocator`), plus the
 //! ratios vdlod / meshopt.
 //!
 //! The remesher (`remesh`: its simplification, the map back through the collapses and the
@@ -21,6 +22,7 @@
 //! `-- scale` (only that).
 
 use std::alloc::{GlobalAlloc, Layout, System};
+use std::ffi::c_void;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
@@ -52,6 +54,51 @@ unsafe impl GlobalAlloc for Counting {
 
 #[global_allocator]
 static GLOBAL: Counting = Counting;
+
+/// Bytes before each of meshoptimizer's blocks, holding the block's whole size (its
+/// `deallocate` is told only the pointer), at the alignment `operator new` gives.
+const MESHOPT_HEADER: usize = 16;
+
+/// meshoptimizer's temporary allocations, through the counting allocator. Its `simplify`
+/// allocates everything it works in with `operator new` (its `meshopt_Allocator`), which Rust's
+/// global allocator never sees: until 2026-12-07 the count held only the index buffer it
+/// returns (12 bytes a triangle), not its working memory.
+unsafe extern "C" fn meshopt_allocate(size: usize) -> *mut c_void {
+    let Some(layout) = size
+        .checked_add(MESHOPT_HEADER)
+        .and_then(|total| Layout::from_size_align(total, MESHOPT_HEADER).ok())
+    else {
+        return std::ptr::null_mut();
+    };
+    // SAFETY: `layout` is at least `MESHOPT_HEADER` bytes, so not zero-sized; a null result is
+    // handed to `handle_alloc_error` (as `operator new` would throw). The header is inside the
+    // block and aligned for a `usize`.
+    unsafe {
+        let p = std::alloc::alloc(layout);
+        if p.is_null() {
+            std::alloc::handle_alloc_error(layout);
+        }
+        p.cast::<usize>().write(layout.size());
+        p.add(MESHOPT_HEADER).cast()
+    }
+}
+
+/// Frees a block of [`meshopt_allocate`].
+unsafe extern "C" fn meshopt_deallocate(p: *mut c_void) {
+    if p.is_null() {
+        return;
+    }
+    // SAFETY: meshoptimizer hands back only pointers `meshopt_allocate` returned, once each:
+    // the header before it holds the size the block was allocated with, at this alignment.
+    unsafe {
+        let base = p.cast::<u8>().sub(MESHOPT_HEADER);
+        let size = base.cast::<usize>().read();
+        std::alloc::dealloc(
+            base,
+            Layout::from_size_align_unchecked(size, MESHOPT_HEADER),
+        );
+    }
+}
 
 const RUNS: usize = 3;
 
@@ -174,6 +221,11 @@ fn main() {
     let args: Vec<String> = std::env::args().collect();
     if !args.iter().any(|a| a == "--bench") {
         return;
+    }
+    // SAFETY: set once, before any other meshoptimizer call, and this program calls it from
+    // one thread only.
+    unsafe {
+        meshopt::ffi::meshopt_setAllocator(Some(meshopt_allocate), Some(meshopt_deallocate));
     }
     let named = |what: &str| args.iter().any(|a| a == what);
     // `scale` (minutes, several GB) runs only when named.
