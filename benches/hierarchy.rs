@@ -150,6 +150,12 @@ fn compare(name: &str, mesh: &IndexedMesh, runs: usize) {
             None,
         )
     });
+    // Its working memory (the edge adjacency alone, two `u32`s an index) is far above the
+    // index buffer it returns: a peak not above that buffer means its allocations went uncounted.
+    assert!(
+        m_theirs > 2 * std::mem::size_of_val(indices.as_slice()),
+        "meshoptimizer's allocations were not counted: {m_theirs} bytes"
+    );
     println!(
         "{name:<24} {:>8} tris | vdlod build {:>8.1} ms {:>7.1} MB -> base {:>5} tris | \
          meshopt simplify {:>7.1} ms {:>6.1} MB -> {:>5} tris | vdlod/meshopt time {:.1}x memory {:.1}x",
