@@ -5,8 +5,9 @@
 //! triangles, the stand-in for the merge-tree paper's 160k-face model). vdlod builds the whole
 //! forest (QEM cost, default options) down to the base mesh, and then the balanced forest
 //! (`balanced`, made in passes); meshopt's `simplify` is asked for the same number of triangles
-//! with no error limit. Each is run `RUNS` times; the table gives the
-//! median time and the peak heap in use during the call (from a counting allocator, which also
+//! with no error limit. Each is run `RUNS` times, the three interleaved round by round; the table
+//! gives the median time (and the time ratios as the median of the rounds' ratios, with their
+//! range) and the peak heap in use during the call (from a counting allocator, which also
 //! serves meshoptimizer's own temporary allocations through `meshopt_setAllocator`), plus the
 //! ratios vdlod / meshopt.
 //!
@@ -126,66 +127,103 @@ fn measure_runs<T>(runs: usize, mut f: impl FnMut() -> T) -> (f64, usize, T) {
     (times[runs / 2], peak, last.expect("runs > 0"))
 }
 
+/// The median of `v` (not empty).
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// The median of per-round ratios and their range, as `4.2x (3.9-4.6x)`.
+fn ratios(ours: &[f64], theirs: &[f64]) -> String {
+    let r: Vec<f64> = ours.iter().zip(theirs).map(|(a, b)| a / b).collect();
+    let (lo, hi) = r
+        .iter()
+        .fold((f64::INFINITY, 0.0f64), |(l, h), &x| (l.min(x), h.max(x)));
+    format!("{:.1}x ({lo:.1}-{hi:.1}x)", median(r))
+}
+
+/// Our build, meshoptimizer's `simplify` to the same base and our balanced build, interleaved
+/// round by round (this machine's speed drifts within a run): medians of `runs` rounds, and the
+/// time ratios as the median of the rounds' ratios with their range.
 fn compare(name: &str, mesh: &IndexedMesh, runs: usize) {
     let input = InputMesh {
         positions: &mesh.positions,
         colors: None,
         triangles: &mesh.triangles,
     };
-    let (t_ours, m_ours, h) = measure_runs(runs, || {
-        build(&input, &BuildOptions::default(), &mut |_| {}).expect("valid mesh")
-    });
-    let base = h.base_triangles.len();
-
+    let ours = || build(&input, &BuildOptions::default(), &mut |_| {}).expect("valid mesh");
+    let balanced = || {
+        let opts = BuildOptions {
+            balanced: true,
+            ..BuildOptions::default()
+        };
+        build(&input, &opts, &mut |_| {}).expect("valid mesh")
+    };
     let indices: Vec<u32> = mesh.triangles.iter().flatten().copied().collect();
     let adapter =
         VertexDataAdapter::new(meshopt::typed_to_bytes(&mesh.positions), 12, 0).expect("positions");
-    let (t_theirs, m_theirs, out) = measure_runs(runs, || {
-        meshopt::simplify(
-            &indices,
-            &adapter,
-            base * 3,
-            1.0,
-            SimplifyOptions::None,
-            None,
-        )
-    });
+    let mut times = [Vec::new(), Vec::new(), Vec::new()];
+    let mut peaks = [0usize; 3];
+    let (mut base, mut base_bal, mut out_len) = (0, 0, 0);
+    for _ in 0..runs.max(1) {
+        let (t, m, h) = measure_runs(1, ours);
+        base = h.base_triangles.len();
+        drop(h);
+        times[0].push(t);
+        peaks[0] = peaks[0].max(m);
+        let (t, m, out) = measure_runs(1, || {
+            meshopt::simplify(
+                &indices,
+                &adapter,
+                base * 3,
+                1.0,
+                SimplifyOptions::None,
+                None,
+            )
+        });
+        out_len = out.len();
+        times[1].push(t);
+        peaks[1] = peaks[1].max(m);
+        let (t, m, hb) = measure_runs(1, balanced);
+        base_bal = hb.base_triangles.len();
+        times[2].push(t);
+        peaks[2] = peaks[2].max(m);
+    }
+    let [m_ours, m_theirs, m_bal] = peaks;
     // Its working memory (the edge adjacency alone, two `u32`s an index) is far above the
     // index buffer it returns: a peak not above that buffer means its allocations went uncounted.
     assert!(
         m_theirs > 2 * std::mem::size_of_val(indices.as_slice()),
         "meshoptimizer's allocations were not counted: {m_theirs} bytes"
     );
+    let (t_ours, t_theirs, t_bal) = (
+        median(times[0].clone()),
+        median(times[1].clone()),
+        median(times[2].clone()),
+    );
     println!(
         "{name:<24} {:>8} tris | vdlod build {:>8.1} ms {:>7.1} MB -> base {:>5} tris | \
-         meshopt simplify {:>7.1} ms {:>6.1} MB -> {:>5} tris | vdlod/meshopt time {:.1}x memory {:.1}x",
+         meshopt simplify {:>7.1} ms {:>6.1} MB -> {:>5} tris | vdlod/meshopt time {} memory {:.1}x",
         mesh.triangles.len(),
         t_ours * 1e3,
         m_ours as f64 / 1e6,
         base,
         t_theirs * 1e3,
         m_theirs as f64 / 1e6,
-        out.len() / 3,
-        t_ours / t_theirs,
+        out_len / 3,
+        ratios(&times[0], &times[1]),
         m_ours as f64 / m_theirs as f64
     );
-    // The balanced forest (`--balanced`, made in passes), beside the same meshopt run.
-    let (t_bal, m_bal, hb) = measure_runs(runs, || {
-        let opts = BuildOptions {
-            balanced: true,
-            ..BuildOptions::default()
-        };
-        build(&input, &opts, &mut |_| {}).expect("valid mesh")
-    });
+    // The balanced forest (`--balanced`, made in passes), beside the same meshopt runs.
     println!(
         "{:<24} {:>8} balanced | vdlod build {:>8.1} ms {:>7.1} MB -> base {:>5} tris | \
-         vdlod/meshopt time {:.1}x memory {:.1}x",
+         vdlod/meshopt time {} memory {:.1}x",
         "",
         "",
         t_bal * 1e3,
         m_bal as f64 / 1e6,
-        hb.base_triangles.len(),
-        t_bal / t_theirs,
+        base_bal,
+        ratios(&times[2], &times[1]),
         m_bal as f64 / m_theirs as f64
     );
     let n = mesh.triangles.len() as f64;
