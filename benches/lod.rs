@@ -231,11 +231,7 @@ fn run_vdpm() -> Vec<Peer> {
         .lines()
         .filter(|l| l.starts_with("vdpm_adapt"))
         .filter_map(|l| {
-            let get = |k: &str| {
-                l.split_whitespace()
-                    .find_map(|kv| kv.strip_prefix(k)?.strip_prefix('='))
-                    .and_then(|v| v.parse::<f64>().ok())
-            };
+            let get = |k: &str| field(l, k);
             let ops = get("vsplits_per_frame")? + get("ecols_per_frame")?;
             Some((
                 get("tol_px")? as f32,
@@ -337,11 +333,7 @@ fn run_srmesh_warm() -> Vec<(f64, f64)> {
         .filter(|l| l.starts_with("srmesh_adapt"))
         .skip(1)
         .filter_map(|l| {
-            let get = |k: &str| {
-                l.split_whitespace()
-                    .find_map(|kv| kv.strip_prefix(k)?.strip_prefix('='))
-                    .and_then(|v| v.parse::<f64>().ok())
-            };
+            let get = |k: &str| field(l, k);
             Some((get("first_faces")?, get("first_us")?))
         })
         .collect()
@@ -414,11 +406,7 @@ fn run_srmesh() -> Vec<SrPeer> {
             if !l.starts_with("srmesh_adapt") {
                 continue;
             }
-            let get = |k: &str| {
-                l.split_whitespace()
-                    .find_map(|kv| kv.strip_prefix(k)?.strip_prefix('='))
-                    .and_then(|v| v.parse::<f64>().ok())
-            };
+            let get = |k: &str| field(l, k);
             if let (Some(tol), Some(us), Some(tris), Some(v), Some(e), Some(fu), Some(ft)) = (
                 get("tol_px"),
                 get("median_us"),
@@ -440,6 +428,13 @@ fn run_srmesh() -> Vec<SrPeer> {
         }
     }
     peers
+}
+
+/// The number after `key=` in a peer's `key=value` line.
+fn field(line: &str, key: &str) -> Option<f64> {
+    line.split_whitespace()
+        .find_map(|kv| kv.strip_prefix(key)?.strip_prefix('='))
+        .and_then(|v| v.parse::<f64>().ok())
 }
 
 /// `y` at `x` on the log-log polyline through `points` (sorted by `x`), or `None` outside it.
@@ -998,11 +993,7 @@ fn every_first_fresh(path: &std::path::Path) -> Vec<(f64, f64)> {
                 .ok()?;
             let text = String::from_utf8_lossy(&out.stdout).into_owned();
             let line = text.lines().find(|l| l.starts_with("first_fresh"))?;
-            let get = |k: &str| {
-                line.split_whitespace()
-                    .find_map(|kv| kv.strip_prefix(k)?.strip_prefix('='))
-                    .and_then(|v| v.parse::<f64>().ok())
-            };
+            let get = |k: &str| field(line, k);
             Some((get("tris")?, get("us")?))
         })
         .collect()
