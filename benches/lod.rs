@@ -386,10 +386,6 @@ fn compiled_for() -> String {
 /// tolerance: its first frame there runs cold code into fresh memory (see [`run_srmesh_warm`]).
 fn run_srmesh() -> Vec<SrPeer> {
     let Some((bin, srm, off)) = srmesh_files() else {
-        println!(
-            "(Hoppe's SrMesh not built (VDLOD_SRMESH, default $TMPDIR/hoppe-srmesh): run \
-             ../shared/peers/hoppe/run.sh for the SrMesh section)"
-        );
         return Vec::new();
     };
     let mut peers = Vec::new();
@@ -486,6 +482,13 @@ fn spread(mut v: Vec<f64>) -> String {
 /// look nearly twice its time without the driver's reads).
 fn srmesh(bytes: &[u8], mesh: &IndexedMesh) {
     println!("\n## 6. Beside Hoppe's SrMesh, bunny, peer orbit (640x480, 60 deg, 200 frames)\n");
+    if srmesh_files().is_none() {
+        println!(
+            "(Hoppe's SrMesh not built (VDLOD_SRMESH, default $TMPDIR/hoppe-srmesh): run \
+             ../shared/peers/hoppe/run.sh for the SrMesh section)"
+        );
+        return;
+    }
     let sorted = |mut v: Vec<(f64, f64)>| {
         v.sort_by(|a, b| a.0.total_cmp(&b.0));
         v
@@ -505,6 +508,8 @@ fn srmesh(bytes: &[u8], mesh: &IndexedMesh) {
     for _ in 0..rounds() {
         let peer = run_srmesh();
         if peer.is_empty() {
+            println!("(SrMesh's driver printed no figures)");
+            let _ = std::fs::remove_file(&path);
             return;
         }
         peers.push(peer);
