@@ -31,6 +31,7 @@ use meshopt::{SimplifyOptions, VertexDataAdapter};
 use vdlod_core::build::{build, BuildOptions, InputMesh};
 use vdlod_core::remesh::{remesh, RemeshOptions};
 use vdlod_demo::mesh::{load_obj, load_obj_bytes, IndexedMesh, BUNNY_NAME, BUNNY_OBJ};
+use vdlod_demo::stats::median;
 
 /// The system allocator, counting the bytes in use and their peak.
 struct Counting;
@@ -127,12 +128,6 @@ fn measure_runs<T>(runs: usize, mut f: impl FnMut() -> T) -> (f64, usize, T) {
     (times[runs / 2], peak, last.expect("runs > 0"))
 }
 
-/// The median of `v` (not empty).
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
-
 /// The median of per-round ratios and their range, as `4.2x (3.9-4.6x)`.
 fn ratios(ours: &[f64], theirs: &[f64]) -> String {
     let r: Vec<f64> = ours.iter().zip(theirs).map(|(a, b)| a / b).collect();
@@ -196,11 +191,7 @@ fn compare(name: &str, mesh: &IndexedMesh, runs: usize) {
         m_theirs > 2 * std::mem::size_of_val(indices.as_slice()),
         "meshoptimizer's allocations were not counted: {m_theirs} bytes"
     );
-    let (t_ours, t_theirs, t_bal) = (
-        median(times[0].clone()),
-        median(times[1].clone()),
-        median(times[2].clone()),
-    );
+    let [t_ours, t_theirs, t_bal] = times.clone().map(median);
     println!(
         "{name:<24} {:>8} tris | vdlod build {:>8.1} ms {:>7.1} MB -> base {:>5} tris | \
          meshopt simplify {:>7.1} ms {:>6.1} MB -> {:>5} tris | vdlod/meshopt time {} memory {:.1}x",

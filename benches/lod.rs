@@ -62,6 +62,7 @@ use vdlod_demo::hierarchy::build_with_progress;
 use vdlod_demo::lod::psnr;
 use vdlod_demo::mesh::{load_obj_bytes, IndexedMesh, BUNNY_NAME, BUNNY_OBJ};
 use vdlod_demo::render::{camera_params, style};
+use vdlod_demo::stats::median;
 use vdlod_raster::Shading;
 
 /// The cut of the adaptation benchmark: room for the bunny at 0.25 px with margin.
@@ -73,11 +74,6 @@ const TOLERANCES: [f32; 5] = [0.25, 0.5, 1.0, 2.0, 4.0];
 const FRAMES: u32 = 200;
 const W: usize = 640;
 const H: usize = 480;
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
 
 fn mean(v: &[f64]) -> f64 {
     v.iter().sum::<f64>() / v.len().max(1) as f64

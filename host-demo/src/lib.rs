@@ -17,6 +17,7 @@ pub mod mesh;
 pub mod remesh;
 pub mod render;
 pub mod repair;
+pub mod stats;
 pub mod table1;
 pub mod terrain;
 pub mod terrain_engines;

@@ -24,6 +24,7 @@ use crate::ground::{draw_on_ground, GroundTexture};
 use crate::label;
 use crate::mesh::{vertex_normals, Bounds, IndexedMesh};
 use crate::render::style;
+use crate::stats::median;
 use crate::wavelet::DemoWaveletCut;
 
 /// Calls `$body` with `$cut` bound to a new boxed cut of the smallest capacity class that holds
@@ -533,14 +534,6 @@ pub struct OrbitSummary {
     pub compared: u32,
     /// Whether the screen-space test was Hoppe's (the file has his bounds).
     pub hoppe_test: bool,
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    if v.is_empty() {
-        return 0.0;
-    }
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
 }
 
 /// Each limit of [`FrameStats`] with its name: `budget`, `ops`, `capacity`, `queue`, `blend`,

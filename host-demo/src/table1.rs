@@ -52,7 +52,7 @@ use crate::hierarchy::build_with_progress;
 use crate::importance::{sheet, Panel};
 use crate::mesh::IndexedMesh;
 use crate::render::{camera_params, style};
-use crate::wavelet::{mean, median};
+use crate::stats::{mean, median};
 
 /// The frustum sizes of the paper's Table 1, with the speed-up it measured at each.
 pub const SIZES: [(f32, f32); 3] = [(0.4, 5.0), (0.2, 10.0), (0.1, 12.5)];

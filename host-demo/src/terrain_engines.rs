@@ -42,8 +42,9 @@ use crate::hierarchy::build_with_progress;
 use crate::lod::{cut_triangle_set, new_triangles, psnr, triangle_set, vertex_names};
 use crate::mesh::IndexedMesh;
 use crate::render::style;
+use crate::stats::{mean, median};
 use crate::terrain::{FlyOver, Terrain, DEFAULT_VERTICAL_SCALE, UP_AXIS};
-use crate::wavelet::{mean, median, DemoWaveletCut};
+use crate::wavelet::DemoWaveletCut;
 
 /// The terrain's seed (the `terrain` command's default).
 const SEED: u32 = 1;

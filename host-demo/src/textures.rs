@@ -26,8 +26,8 @@ use crate::frame::Frame;
 use crate::importance::{sheet, Panel};
 use crate::lod::psnr;
 use crate::render::style;
+use crate::stats::mean;
 use crate::terrain_engines::{Engines, Flight, Setup};
-use crate::wavelet::mean;
 
 const WIDTH: usize = 480;
 const HEIGHT: usize = 360;

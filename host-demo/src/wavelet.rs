@@ -21,6 +21,7 @@ use crate::chart::{self, Panel, BLUE, GREEN, GREY, ORANGE};
 use crate::frame::{encode_png, Frame};
 use crate::lod::psnr;
 use crate::mesh::{load_obj_bytes, vertex_normals, IndexedMesh, COW_NAME, COW_OBJ};
+use crate::stats::{mean, median};
 
 /// The demo's wavelet cut: up to 262,144 wavelets, 60,000 triangles and 30,000 vertices (about
 /// 1.1 MB, on the heap).
@@ -546,18 +547,6 @@ pub fn fly_wavelets<P: Policy + Copy>(
         policy: *policy,
     };
     fly(&mut engine, full, cameras)
-}
-
-/// The median of `v` (0 when empty).
-pub(crate) fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v.get(v.len() / 2).copied().unwrap_or(0.0)
-}
-
-/// The mean of `v` (0 when empty).
-pub(crate) fn mean(v: impl Iterator<Item = f64>) -> f64 {
-    let (sum, n) = v.fold((0.0, 0usize), |(s, n), x| (s + x, n + 1));
-    sum / n.max(1) as f64
 }
 
 fn write_csv(path: &Path, frames: &[SessionFrame]) -> Result<(), String> {
