@@ -589,7 +589,7 @@ fn srmesh(bytes: &[u8], mesh: &IndexedMesh) {
                 up_mean.push(sr / mean(&round));
             }
             // SrMesh walks its whole active list every frame: its median is its mean.
-            if let Some(&(tris, us)) = fresh[r].get(k) {
+            if let Some(&Some((tris, us))) = fresh[r].get(k) {
                 fresh_us.push(us);
                 fresh_tris = tris;
                 if let Some(sr) = log_log(round_first, tris) {
@@ -978,14 +978,16 @@ fn first_frame_fresh(path: &str, tolerance: f32) {
     println!("first_fresh us={us} tris={}", s.triangles);
 }
 
-/// [`first_frame_fresh`] at each of [`TOLERANCES`], a process each: `(triangles, us)`.
-fn every_first_fresh(path: &std::path::Path) -> Vec<(f64, f64)> {
+/// [`first_frame_fresh`] at each of [`TOLERANCES`], a process each: `(triangles, us)` by
+/// tolerance, `None` where the process gave no figures (so every entry stays at its
+/// tolerance's place).
+fn every_first_fresh(path: &std::path::Path) -> Vec<Option<(f64, f64)>> {
     let Ok(me) = std::env::current_exe() else {
         return Vec::new();
     };
     TOLERANCES
         .iter()
-        .filter_map(|t| {
+        .map(|t| {
             let out = Command::new(&me)
                 .args(["--bench", FRESH])
                 .arg(path)
