@@ -162,6 +162,29 @@ fn the_valid_file_parses() {
     }
 }
 
+/// The `hierarchy` and `cut` fuzz targets start from `fuzz/seeds/hierarchy`: the seeds must stay
+/// valid files of this format version, or the fuzzers would spend their runs on the version check.
+#[test]
+fn the_fuzz_seeds_are_valid_files() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/seeds/hierarchy");
+    let mut paths: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|entry| entry.unwrap().path())
+        .collect();
+    paths.sort();
+    assert_eq!(paths.len(), 3, "{paths:?}");
+    for path in paths {
+        let bytes = std::fs::read(&path).unwrap();
+        match HierarchyView::parse(&bytes) {
+            Ok(view) => walk(&view),
+            Err(e) => panic!(
+                "{}: {e} (rebuild the seeds: fuzz/README.md)",
+                path.display()
+            ),
+        }
+    }
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(400))]
 

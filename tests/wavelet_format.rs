@@ -87,6 +87,22 @@ fn valid_files_parse_and_fly() {
     fly(&view);
 }
 
+/// The `semiregular` fuzz target starts from `fuzz/seeds/semiregular/sphere2.vdw`
+/// (`vdlod-demo sphere --levels 2`): it must stay a valid file of this format version, or the
+/// fuzzer would spend its runs on the version check.
+#[test]
+fn the_fuzz_seed_is_a_valid_file() {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/fuzz/seeds/semiregular/sphere2.vdw"
+    );
+    let bytes = std::fs::read(path).unwrap();
+    match SemiRegularView::parse(&bytes) {
+        Ok(view) => fly(&view),
+        Err(e) => panic!("{path}: {e} (rebuild the seed: fuzz/README.md)"),
+    }
+}
+
 #[test]
 fn a_height_fields_header_is_checked() {
     let good = heights_bytes();
