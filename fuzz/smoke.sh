@@ -2,7 +2,7 @@
 # A short fuzz run of every target from its seeds, for CI: the targets must build, and a fixed
 # number of runs from a fixed seed must find nothing. Built coverage-guided as `cargo fuzz` builds
 # them but without a sanitizer, so it needs neither cargo-fuzz nor a nightly toolchain, and with
-# overflow checks and debug assertions, so arithmetic that wraps is a finding too. The runs repeat
+# overflow checks and debug assertions, so arithmetic that wraps is a finding too. A build's runs repeat
 # themselves from run to run, but for the `mesh` target's, whose coverage also follows the random
 # hashing of the repair's hash maps (looked up, never iterated: the meshes do not depend on it).
 #
