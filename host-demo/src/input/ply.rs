@@ -288,9 +288,6 @@ fn body_of(elements: &[Element], values: &mut impl Values, body: usize) -> Resul
     let mut colors = Vec::new();
     let mut corners = Vec::new();
     for element in elements {
-        if element.properties.is_empty() {
-            continue;
-        }
         if element.name == b"vertex" {
             let slots: Vec<Slot> = element
                 .properties
@@ -340,7 +337,7 @@ fn body_of(elements: &[Element], values: &mut impl Values, body: usize) -> Resul
             if has_colors {
                 soup.colors = Some(std::mem::take(&mut colors));
             }
-        } else {
+        } else if !element.properties.is_empty() {
             let faces = element.name == b"face";
             for _ in 0..element.count {
                 for property in &element.properties {
@@ -507,5 +504,17 @@ mod tests {
         let e = read(b"ply\nformat ascii 1.0\nelement vertex 1\nproperty half x\nend_header\n")
             .unwrap_err();
         assert_eq!(e.to_string(), "line 4: header: unknown type `half`");
+        // A vertex element without properties gives no positions, whatever its count says (the
+        // mesh fuzz target's finding of 2026-12-07: the faces' indices, checked against the
+        // count, then reached past the positions).
+        let e = read(
+            b"ply\nformat ascii 1.0\nelement vertex 3\nelement face 1\n\
+            property list uchar int vertex_indices\nend_header\n3 0 1 2\n",
+        )
+        .unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "line 1: header: the vertex element has no `x` property"
+        );
     }
 }
