@@ -2,9 +2,9 @@
 # A short fuzz run of every target from its seeds, for CI: the targets must build, and a fixed
 # number of runs from a fixed seed must find nothing. Built coverage-guided as `cargo fuzz` builds
 # them but without a sanitizer, so it needs neither cargo-fuzz nor a nightly toolchain, and with
-# overflow checks and debug assertions, so arithmetic that wraps is a finding too. A build's runs repeat
-# themselves from run to run, but for the `mesh` target's, whose coverage also follows the random
-# hashing of the repair's hash maps (looked up, never iterated: the meshes do not depend on it).
+# overflow checks and debug assertions, so arithmetic that wraps is a finding too. A build's runs
+# repeat themselves from run to run, but for the `mesh` target's, whose coverage also follows the
+# random hashing of the repair's hash maps (looked up, never iterated: no mesh depends on it).
 #
 #   fuzz/smoke.sh                  # about a minute to build, two to run
 #   RUNS_SCALE=10 fuzz/smoke.sh    # ten times the runs
@@ -30,10 +30,12 @@ while read -r target seeds runs; do
     mkdir -p "$work/$target"
     start=$SECONDS
     echo "fuzz $target: $((runs * scale)) runs from seeds/$seeds"
-    ${fixed[@]+"${fixed[@]}"} target/smoke/"$host"/release/"$target" "$work/$target" "seeds/$seeds" \
-        -seed=1 -reload=0 -runs=$((runs * scale)) -artifact_prefix="$work/" 2>"$work/$target.log" || {
+    ${fixed[@]+"${fixed[@]}"} target/smoke/"$host"/release/"$target" \
+        "$work/$target" "seeds/$seeds" -seed=1 -reload=0 -runs=$((runs * scale)) \
+        -artifact_prefix="$work/" 2>"$work/$target.log" || {
         tail -40 "$work/$target.log"
-        mkdir -p artifacts && cp "$work"/crash-* "$work"/oom-* "$work"/timeout-* artifacts/ 2>/dev/null || true
+        mkdir -p artifacts
+        cp "$work"/crash-* "$work"/oom-* "$work"/timeout-* artifacts/ 2>/dev/null || true
         echo "fuzz $target: a finding (above; the input is in fuzz/artifacts/)" >&2
         exit 1
     }
